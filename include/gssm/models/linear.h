@@ -1,0 +1,43 @@
+#pragma once
+// A linear GSSM built from continuous-time matrices (DESIGN.md §1):
+//   d/dt x_c = A_c x_c + A_b x_b + B u,   y = C_c x_c + C_b x_b
+// discretized with F_c = I + A_c T, F_b = A_b T, B_k = B T (Euler, the
+// paper's choice) or exactly with the matrix exponential of the augmented
+// system [[A_c, A_b, B], [0, 0, 0], [0, 0, 0]]·T.
+#include "gssm/model.h"
+
+namespace gssm::models {
+
+struct LinearSystem {
+  Eigen::MatrixXd A_c, A_b, B, C_c, C_b;
+  ModelNoise noise;  ///< T, Q (per nominal step), R, priors
+  ModelNames names;  ///< optional: left empty, names x1.., b1.., u1.., y1.. are used
+};
+
+enum class Discretization { Euler, Exact };
+
+class LinearModel final : public Model {
+ public:
+  explicit LinearModel(LinearSystem sys, Discretization d = Discretization::Euler);
+
+  std::string name() const override { return "linear"; }
+  const LinearSystem& system() const { return sys_; }
+  Discretization discretization() const { return disc_; }
+
+  /// Discrete matrices of a step dt: F_c, F_b, B_k.
+  void discreteMatrices(double dt, Eigen::MatrixXd& F_c, Eigen::MatrixXd& F_b,
+                        Eigen::MatrixXd& B_k) const;
+
+  Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                    const Eigen::VectorXd& u, double dt, Eigen::MatrixXd* J_f_xc = nullptr,
+                    Eigen::MatrixXd* J_f_xb = nullptr) const override;
+  Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                    Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
+
+ private:
+  LinearSystem sys_;
+  Discretization disc_;
+  Eigen::MatrixXd Fc_T_, Fb_T_, Bk_T_;  // cached for the nominal step
+};
+
+}  // namespace gssm::models

@@ -1,0 +1,65 @@
+#include "gssm/gaussian.h"
+
+#include <Eigen/Cholesky>
+#include <sstream>
+
+#include "gssm/error.h"
+
+namespace gssm {
+
+void requireVector(const Eigen::VectorXd& v, Eigen::Index n, const std::string& what) {
+  if (v.size() != n) {
+    std::ostringstream os;
+    os << what << ": expected " << n << " entries, got " << v.size();
+    throw InvalidArgument(os.str());
+  }
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!std::isfinite(v[i])) {
+      std::ostringstream os;
+      os << what << ": entry " << i << " is " << v[i] << " (must be finite)";
+      throw InvalidArgument(os.str());
+    }
+}
+
+void requireCovariance(const Eigen::MatrixXd& m, Eigen::Index n, const std::string& what) {
+  if (m.rows() != n || m.cols() != n) {
+    std::ostringstream os;
+    os << what << ": expected a " << n << "x" << n << " covariance, got " << m.rows() << "x"
+       << m.cols();
+    throw InvalidArgument(os.str());
+  }
+  if (!m.allFinite()) throw InvalidArgument(what + ": covariance has a NaN or infinite entry");
+  const double scale = std::max(1.0, m.cwiseAbs().maxCoeff());
+  if ((m - m.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale)
+    throw InvalidArgument(what + ": covariance is not symmetric");
+  Eigen::LLT<Eigen::MatrixXd> llt(m);
+  if (llt.info() != Eigen::Success) {
+    std::ostringstream os;
+    os << what << ": covariance is not positive definite (diagonal: "
+       << m.diagonal().transpose()
+       << "); every variance must be > 0 and the matrix full rank";
+    throw NumericalError(os.str());
+  }
+}
+
+GaussianNoise::GaussianNoise(const Eigen::MatrixXd& covariance, const std::string& what)
+    : covariance_(covariance) {
+  requireCovariance(covariance, covariance.rows(), what);
+  L_ = Eigen::LLT<Eigen::MatrixXd>(covariance).matrixL();
+}
+
+void GaussianNoise::whitenInPlace(Eigen::VectorXd& v) const {
+  L_.triangularView<Eigen::Lower>().solveInPlace(v);
+}
+
+void GaussianNoise::whitenInPlace(Eigen::MatrixXd& m) const {
+  L_.triangularView<Eigen::Lower>().solveInPlace(m);
+}
+
+Eigen::VectorXd GaussianNoise::whiten(const Eigen::VectorXd& v) const {
+  Eigen::VectorXd out = v;
+  whitenInPlace(out);
+  return out;
+}
+
+}  // namespace gssm

@@ -1,0 +1,45 @@
+#pragma once
+// Internal: a symmetric positive-definite sparse system H x = b factored by
+// CHOLMOD (supernodal LLᵀ, so an indefinite or singular H is detected and
+// the failing column reported). H is given by its upper triangle as
+// triplets whose pattern is fixed after the first analyze().
+#include <Eigen/Core>
+#include <cholmod.h>
+#include <vector>
+
+namespace gssm::internal {
+
+class SparseCholesky {
+ public:
+  SparseCholesky();
+  ~SparseCholesky();
+  SparseCholesky(const SparseCholesky&) = delete;
+  SparseCholesky& operator=(const SparseCholesky&) = delete;
+
+  /// Starts a new pattern of size n with room for `capacity` upper-triangle
+  /// entries; drops any earlier factorization.
+  void reset(Eigen::Index n, std::size_t capacity);
+  /// Appends H(i, j) += v (i <= j required). Duplicates are summed.
+  void add(Eigen::Index i, Eigen::Index j, double v);
+  /// Overwrites the values of entry e (in the order they were added).
+  double& value(std::size_t e);
+  std::size_t entries() const { return count_; }
+
+  /// Factors the current values (analyzing the pattern the first time,
+  /// natural ordering: callers order variables so that fill stays small).
+  /// Returns -1 on success, else the column at which H is not positive definite.
+  Eigen::Index factorize();
+  /// Solves H X = B for a dense right-hand side (n × m).
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& B);
+  Eigen::Index size() const { return n_; }
+
+ private:
+  void freeAll();
+  cholmod_common common_;
+  cholmod_triplet* triplet_ = nullptr;
+  cholmod_factor* factor_ = nullptr;
+  Eigen::Index n_ = 0;
+  std::size_t count_ = 0;
+};
+
+}  // namespace gssm::internal

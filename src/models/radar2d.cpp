@@ -1,0 +1,54 @@
+#include "gssm/models/radar2d.h"
+
+#include <cmath>
+
+namespace gssm::models {
+
+namespace {
+ModelNoise radarNoise(const Radar2D::Params& p) {
+  ModelNoise n;
+  n.T = p.T;
+  n.Q = Eigen::MatrixXd::Constant(1, 1, p.q);
+  n.R = Eigen::MatrixXd::Constant(1, 1, p.r);
+  n.prior_state.mean = Eigen::VectorXd::Constant(1, p.prior_x);
+  n.prior_state.covariance = Eigen::MatrixXd::Constant(1, 1, p.prior_var_x);
+  n.prior_constants.mean = Eigen::Vector2d(p.prior_xdot, p.prior_h);
+  n.prior_constants.covariance = Eigen::Vector2d(p.prior_var_xdot, p.prior_var_h).asDiagonal();
+  return n;
+}
+}  // namespace
+
+Radar2D::Radar2D(const Params& p)
+    : Model({1, 2, 0, 1}, {{"x"}, {"xdot", "h"}, {}, {"range"}}, radarNoise(p)), params_(p) {}
+
+Eigen::VectorXd Radar2D::f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                           const Eigen::VectorXd& /*u*/, double dt, Eigen::MatrixXd* J_f_xc,
+                           Eigen::MatrixXd* J_f_xb) const {
+  if (J_f_xc) *J_f_xc = Eigen::MatrixXd::Ones(1, 1);
+  if (J_f_xb) {
+    J_f_xb->resize(1, 2);
+    *J_f_xb << dt, 0.0;
+  }
+  return Eigen::VectorXd::Constant(1, xc[0] + xb[0] * dt);
+}
+
+// Linearized measurement row [α] on x and [0, β] on [xdot, h], with
+// α = x/ρ and β = h/ρ (the paper's H row [β, α] on [h, x_k]).
+Eigen::VectorXd Radar2D::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                           Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  const double x = xc[0], alt = xb[1];
+  const double rho = std::hypot(x, alt);
+  if (J_h_xc || J_h_xb) {
+    // At x = h = 0 the range is not differentiable; the zero row it gives
+    // makes the information matrix singular, which the solvers report.
+    const double inv = rho > 0 ? 1.0 / rho : 0.0;
+    if (J_h_xc) *J_h_xc = Eigen::MatrixXd::Constant(1, 1, x * inv);
+    if (J_h_xb) {
+      J_h_xb->resize(1, 2);
+      *J_h_xb << 0.0, alt * inv;
+    }
+  }
+  return Eigen::VectorXd::Constant(1, rho);
+}
+
+}  // namespace gssm::models

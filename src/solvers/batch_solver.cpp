@@ -1,0 +1,311 @@
+#include "gssm/batch_solver.h"
+
+#include <chrono>
+#include <map>
+#include <sstream>
+
+#include "gssm/error.h"
+#include "linear/sparse_cholesky.h"
+
+namespace gssm {
+
+bool BatchSolverOptions::validate(std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = "BatchSolverOptions: " + msg;
+    return false;
+  };
+  if (max_iterations < 1) return fail("max_iterations must be >= 1");
+  if (!(relative_cost_tolerance >= 0)) return fail("relative_cost_tolerance must be >= 0");
+  if (!(step_tolerance >= 0)) return fail("step_tolerance must be >= 0");
+  if (!(gradient_tolerance >= 0)) return fail("gradient_tolerance must be >= 0");
+  if (!(initial_lambda > 0)) return fail("initial_lambda must be > 0");
+  if (!(max_lambda > initial_lambda)) return fail("max_lambda must exceed initial_lambda");
+  return true;
+}
+
+const char* toString(BatchSolverSummary::Termination t) {
+  using T = BatchSolverSummary::Termination;
+  switch (t) {
+    case T::CostConverged: return "cost converged";
+    case T::StepConverged: return "step converged";
+    case T::GradientConverged: return "gradient converged";
+    case T::MaxIterations: return "iteration limit reached";
+    case T::NoProgress: return "no progress (damping at its maximum)";
+  }
+  return "?";
+}
+
+std::string BatchSolverSummary::toString() const {
+  std::ostringstream os;
+  os << "BatchSolver: " << gssm::toString(termination) << " after " << iterations
+     << " iterations (" << rejected_steps << " rejected, " << factorizations
+     << " factorizations), cost " << initial_cost << " -> " << final_cost
+     << ", max|gradient| " << gradient_norm << ", " << num_variables << " variables / "
+     << num_factors << " factors / dim " << dimension << ", " << seconds << " s";
+  return os.str();
+}
+
+// The linearized system of one graph: variable offsets, per-factor block
+// offsets into the triplet list, and the factorization.
+struct BatchSolver::Impl {
+  std::map<Key, Eigen::Index> offset;    // column of each variable
+  std::vector<Key> keys_by_column;       // for error messages
+  std::vector<Eigen::Index> dims_by_column;
+  Eigen::Index n = 0;
+  internal::SparseCholesky chol;
+  std::size_t damping_begin = 0;         // triplet index of the first diagonal damping entry
+  bool has_solution = false;
+
+  void setup(const FactorGraph& graph, const Values& values) {
+    offset.clear();
+    keys_by_column.clear();
+    dims_by_column.clear();
+    n = 0;
+    for (const auto& kv : values) {  // std::map order: states by step, constants last
+      offset[kv.first] = n;
+      for (Eigen::Index i = 0; i < kv.second.size(); ++i) {
+        keys_by_column.push_back(kv.first);
+        dims_by_column.push_back(i);
+      }
+      n += kv.second.size();
+    }
+    std::size_t nnz = 0;
+    for (const auto& f : graph) {
+      Eigen::Index d = 0;
+      for (const auto& k : f->keys()) {
+        if (!values.contains(k))
+          throw InvalidArgument("BatchSolver: factor '" + f->describe() + "' uses " +
+                                k.toString() + ", which has no initial value");
+        d += values.at(k).size();
+      }
+      nnz += static_cast<std::size_t>(d * (d + 1) / 2);
+    }
+    chol.reset(n, nnz + static_cast<std::size_t>(n));
+  }
+
+  // Linearizes every factor at x: fills the triplet values of H = JᵀJ (+ the
+  // damping diagonal, zero here), the gradient g = Jᵀr and returns the cost.
+  double linearize(const FactorGraph& graph, const Values& x, Eigen::VectorXd& g,
+                   Eigen::VectorXd& diag, bool first) {
+    g.setZero(n);
+    diag.setZero(n);
+    double cost = 0;
+    std::size_t e = 0;
+    Eigen::VectorXd r;
+    std::vector<Eigen::MatrixXd> J;
+    std::vector<Eigen::Index> offs;
+    for (const auto& f : graph) {
+      f->linearize(x, r, &J);
+      if (!r.allFinite())
+        throw NumericalError("BatchSolver: factor '" + f->describe() +
+                             "' has a non-finite residual at the current estimate");
+      cost += 0.5 * r.squaredNorm();
+      const auto& keys = f->keys();
+      offs.resize(keys.size());
+      for (std::size_t a = 0; a < keys.size(); ++a) offs[a] = offset.at(keys[a]);
+      for (std::size_t a = 0; a < keys.size(); ++a) {
+        g.segment(offs[a], J[a].cols()) += J[a].transpose() * r;
+        for (std::size_t b = 0; b < keys.size(); ++b) {
+          if (offs[a] > offs[b]) continue;  // upper triangle only
+          const Eigen::MatrixXd blk = J[a].transpose() * J[b];
+          for (Eigen::Index j = 0; j < blk.cols(); ++j)
+            for (Eigen::Index i = 0; i < blk.rows(); ++i) {
+              const Eigen::Index gi = offs[a] + i, gj = offs[b] + j;
+              if (gi > gj) continue;  // diagonal block: keep its upper half
+              if (first) chol.add(gi, gj, blk(i, j));
+              else chol.value(e) = blk(i, j);
+              if (gi == gj) diag[gi] += blk(i, j);
+              ++e;
+            }
+        }
+      }
+    }
+    if (first) {
+      damping_begin = chol.entries();
+      for (Eigen::Index i = 0; i < n; ++i) chol.add(i, i, 0.0);
+    }
+    return cost;
+  }
+
+  void setDamping(const Eigen::VectorXd& diag, double lambda) {
+    for (Eigen::Index i = 0; i < n; ++i)
+      chol.value(damping_begin + static_cast<std::size_t>(i)) =
+          lambda * std::max(diag[i], 1e-12);
+  }
+
+  [[noreturn]] void throwSingular(Eigen::Index column) const {
+    const Key k = keys_by_column.at(static_cast<std::size_t>(column));
+    std::ostringstream os;
+    os << "BatchSolver: the information matrix is not positive definite at variable "
+       << k.toString() << " component " << dims_by_column.at(static_cast<std::size_t>(column))
+       << (k.isConstants() ? " (a constant)" : " (a time-series state)")
+       << ": the data and priors do not determine it (unobserved, a zero Jacobian such as a "
+          "range at x = h = 0, or a non-finite value). Add a prior on it or check the model.";
+    throw NumericalError(os.str());
+  }
+};
+
+BatchSolver::BatchSolver(BatchSolverOptions options)
+    : options_(options), impl_(std::make_unique<Impl>()) {
+  std::string why;
+  if (!options_.validate(&why)) throw InvalidArgument(why);
+}
+BatchSolver::~BatchSolver() = default;
+BatchSolver::BatchSolver(BatchSolver&&) noexcept = default;
+BatchSolver& BatchSolver::operator=(BatchSolver&&) noexcept = default;
+
+BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  using T = BatchSolverSummary::Termination;
+  Impl& s = *impl_;
+  s.has_solution = false;
+  s.setup(graph, values);
+
+  BatchSolverSummary sum;
+  sum.num_factors = graph.size();
+  sum.num_variables = values.size();
+  sum.dimension = s.n;
+
+  Values x = values;
+  Eigen::VectorXd g, diag;
+  double cost = s.linearize(graph, x, g, diag, true);
+  sum.initial_cost = cost;
+  const bool lm = options_.method == BatchSolverOptions::Method::LevenbergMarquardt;
+  double lambda = lm ? options_.initial_lambda : 0.0;
+  Eigen::VectorXd delta;
+
+  auto applyStep = [&](const Values& from, const Eigen::VectorXd& d) {
+    Values out = from;
+    for (auto& kv : out) kv.second += d.segment(s.offset.at(kv.first), kv.second.size());
+    return out;
+  };
+
+  // LM leaves a damping bias of order λ in the last step, so once the cost
+  // has converged we finish with undamped Gauss–Newton steps for as long as
+  // they lower the cost ("polish"): on a linear problem this is exact.
+  bool polishing = false;
+  int polish_steps = 0;
+  bool done = false;
+  if (g.lpNorm<Eigen::Infinity>() <= options_.gradient_tolerance) {
+    sum.termination = T::GradientConverged;
+    done = true;
+  }
+  while (!done) {
+    if (sum.iterations >= options_.max_iterations) {
+      sum.termination = T::MaxIterations;
+      break;
+    }
+    s.setDamping(diag, lambda);
+    ++sum.factorizations;
+    const Eigen::Index bad = s.chol.factorize();
+    if (bad >= 0) {
+      if (!lm || lambda >= options_.max_lambda) s.throwSingular(bad);
+      lambda = std::max(lambda * 10, 1e-6);
+      ++sum.rejected_steps;
+      continue;
+    }
+    delta = -s.chol.solve(g);
+    Eigen::VectorXd xflat(s.n);
+    for (const auto& kv : x) xflat.segment(s.offset.at(kv.first), kv.second.size()) = kv.second;
+    if (delta.norm() <= options_.step_tolerance * (xflat.norm() + options_.step_tolerance)) {
+      sum.termination = T::StepConverged;
+      break;
+    }
+    Values candidate = applyStep(x, delta);
+    const double new_cost = graph.cost(candidate);
+    if (polishing) {
+      // Near the minimum the cost change (∝ ‖δ‖²) is below rounding, so a
+      // polish step is kept unless it makes the cost clearly worse.
+      if (new_cost <= cost * (1 + 1e-10)) {
+        ++sum.iterations;
+        x = std::move(candidate);
+        cost = s.linearize(graph, x, g, diag, false);
+      } else {
+        ++sum.rejected_steps;
+      }
+      sum.termination = T::CostConverged;
+      if (++polish_steps >= 3) break;
+      continue;
+    }
+    if (lm && !(new_cost < cost)) {
+      ++sum.rejected_steps;
+      lambda *= 10;
+      if (lambda > options_.max_lambda) {
+        sum.termination = T::NoProgress;
+        break;
+      }
+      continue;
+    }
+    ++sum.iterations;
+    x = std::move(candidate);
+    const double old_cost = cost;
+    cost = s.linearize(graph, x, g, diag, false);
+    if (lm && !polishing) lambda = std::max(lambda / 10, 1e-12);
+    if (g.lpNorm<Eigen::Infinity>() <= options_.gradient_tolerance) {
+      sum.termination = T::GradientConverged;
+      break;
+    }
+    if (old_cost - cost <= options_.relative_cost_tolerance * old_cost) {
+      if (lm && !polishing) {
+        polishing = true;
+        lambda = 0.0;
+        continue;
+      }
+      sum.termination = T::CostConverged;
+      break;
+    }
+  }
+  // Factor the undamped information matrix at the solution: it gives the
+  // marginal covariances and tells whether the solution is determined.
+  s.setDamping(diag, 0.0);
+  ++sum.factorizations;
+  const Eigen::Index bad = s.chol.factorize();
+  if (bad >= 0) s.throwSingular(bad);
+  s.has_solution = true;
+  values = std::move(x);
+
+  sum.final_cost = cost;
+  sum.gradient_norm = g.lpNorm<Eigen::Infinity>();
+  sum.converged = sum.termination == T::CostConverged || sum.termination == T::StepConverged ||
+                  sum.termination == T::GradientConverged;
+  sum.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  sum.message = toString(sum.termination);
+  return sum;
+}
+
+Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& keys) const {
+  Impl& s = *impl_;
+  if (!s.has_solution)
+    throw InvalidArgument("BatchSolver: no solution yet; call solve() before asking for covariances");
+  std::vector<Eigen::Index> offs, dims;
+  Eigen::Index m = 0;
+  for (const auto& k : keys) {
+    auto it = s.offset.find(k);
+    if (it == s.offset.end())
+      throw InvalidArgument("BatchSolver: " + k.toString() + " is not a variable of the last solve");
+    offs.push_back(it->second);
+    const auto next = std::next(it);
+    dims.push_back((next == s.offset.end() ? s.n : next->second) - it->second);
+    m += dims.back();
+  }
+  // Columns of H⁻¹ for the requested variables: solve H X = E.
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(s.n, m);
+  Eigen::Index c = 0;
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    for (Eigen::Index j = 0; j < dims[i]; ++j) E(offs[i] + j, c++) = 1.0;
+  const Eigen::MatrixXd X = s.chol.solve(E);
+  Eigen::MatrixXd out(m, m);
+  Eigen::Index r = 0;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    out.middleRows(r, dims[i]) = X.middleRows(offs[i], dims[i]);
+    r += dims[i];
+  }
+  return 0.5 * (out + out.transpose());
+}
+
+Eigen::MatrixXd BatchSolver::marginalCovariance(const Key& key) const {
+  return jointMarginalCovariance({key});
+}
+
+}  // namespace gssm

@@ -1,0 +1,99 @@
+#include "gssm/ekf.h"
+
+#include <Eigen/Cholesky>
+#include <sstream>
+
+#include "gssm/error.h"
+#include "gssm/gaussian.h"
+
+namespace gssm {
+
+bool ExtendedKalmanFilterOptions::validate(int nb, std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = "ExtendedKalmanFilterOptions: " + msg;
+    return false;
+  };
+  if (constant_process_noise.size() != 0 && constant_process_noise.size() != nb)
+    return fail("constant_process_noise needs " + std::to_string(nb) + " entries (one per constant), got " +
+                std::to_string(constant_process_noise.size()));
+  for (Eigen::Index i = 0; i < constant_process_noise.size(); ++i)
+    if (!(constant_process_noise[i] >= 0) || !std::isfinite(constant_process_noise[i]))
+      return fail("constant_process_noise entry " + std::to_string(i) + " must be a finite variance >= 0");
+  return true;
+}
+
+ExtendedKalmanFilter::ExtendedKalmanFilter(const Model& model, ExtendedKalmanFilterOptions options,
+                                           double t0)
+    : model_(&model), options_(std::move(options)), t_(t0) {
+  const ModelDims& d = model.dims();
+  std::string why;
+  if (!options_.validate(d.nb, &why)) throw InvalidArgument(why);
+  if (options_.constant_process_noise.size() == 0)
+    options_.constant_process_noise = Eigen::VectorXd::Zero(d.nb);
+  z_.resize(d.nc + d.nb);
+  z_ << model.priorState().mean, model.priorConstants().mean;
+  P_ = Eigen::MatrixXd::Zero(d.nc + d.nb, d.nc + d.nb);
+  P_.topLeftCorner(d.nc, d.nc) = model.priorState().covariance;
+  if (d.nb > 0) P_.bottomRightCorner(d.nb, d.nb) = model.priorConstants().covariance;
+}
+
+void ExtendedKalmanFilter::predict(double t, const Eigen::VectorXd& u) {
+  const ModelDims& d = model_->dims();
+  if (!std::isfinite(t) || !(t > t_)) {
+    std::ostringstream os;
+    os << "ExtendedKalmanFilter::predict: time " << t << " must be after the filter time " << t_;
+    throw InvalidArgument(os.str());
+  }
+  requireVector(u, d.nu, "ExtendedKalmanFilter::predict: input u");
+  const double dt = t - t_;
+  Eigen::MatrixXd J_f_xc, J_f_xb;
+  const Eigen::VectorXd xc = model_->f(z_.head(d.nc), z_.tail(d.nb), u, dt, &J_f_xc, &J_f_xb);
+  const int n = d.nc + d.nb;
+  Eigen::MatrixXd F = Eigen::MatrixXd::Identity(n, n);
+  F.topLeftCorner(d.nc, d.nc) = J_f_xc;
+  F.topRightCorner(d.nc, d.nb) = J_f_xb;
+  Eigen::MatrixXd Qz = Eigen::MatrixXd::Zero(n, n);
+  Qz.topLeftCorner(d.nc, d.nc) = model_->processNoise(dt);
+  Qz.diagonal().tail(d.nb) = options_.constant_process_noise * (dt / model_->nominalStep());
+  Eigen::MatrixXd P = F * P_ * F.transpose() + Qz;
+  if (!xc.allFinite() || !P.allFinite())
+    throw NumericalError("ExtendedKalmanFilter::predict: the prediction to t = " +
+                         std::to_string(t) + " is not finite; filter left at t = " +
+                         std::to_string(t_));
+  z_.head(d.nc) = xc;
+  P_ = 0.5 * (P + P.transpose());
+  t_ = t;
+}
+
+void ExtendedKalmanFilter::update(const Eigen::VectorXd& y) {
+  const ModelDims& d = model_->dims();
+  requireVector(y, d.ny, "ExtendedKalmanFilter::update: measurement y");
+  Eigen::MatrixXd J_h_xc, J_h_xb;
+  const Eigen::VectorXd yhat = model_->h(z_.head(d.nc), z_.tail(d.nb), &J_h_xc, &J_h_xb);
+  const int n = d.nc + d.nb;
+  Eigen::MatrixXd H(d.ny, n);
+  H << J_h_xc, J_h_xb;
+  const Eigen::MatrixXd& R = model_->measurementNoise();
+  const Eigen::MatrixXd S = H * P_ * H.transpose() + R;
+  Eigen::LLT<Eigen::MatrixXd> llt(S);
+  if (llt.info() != Eigen::Success || !S.allFinite())
+    throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
+                         ": innovation covariance S = HPHᵀ + R is not positive definite; "
+                         "check R and the covariance P (filter unchanged)");
+  const Eigen::MatrixXd K = llt.solve(H * P_).transpose();  // P Hᵀ S⁻¹ (P, S symmetric)
+  const Eigen::VectorXd innov = y - yhat;
+  const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(n, n) - K * H;
+  Eigen::MatrixXd P = options_.joseph_form
+                          ? Eigen::MatrixXd(IKH * P_ * IKH.transpose() + K * R * K.transpose())
+                          : Eigen::MatrixXd(IKH * P_);
+  P = 0.5 * (P + P.transpose());
+  Eigen::LLT<Eigen::MatrixXd> pcheck(P);
+  if (pcheck.info() != Eigen::Success || !P.allFinite())
+    throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
+                         ": the updated covariance is not positive definite (filter unchanged)");
+  z_ += K * innov;
+  P_ = std::move(P);
+  nis_ = innov.dot(llt.solve(innov));
+}
+
+}  // namespace gssm

@@ -1,0 +1,85 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "gssm/ekf.h"
+#include "gssm/error.h"
+#include "gssm/models/linear.h"
+#include "gssm/models/radar2d.h"
+#include "gssm/simulation.h"
+#include "reference_kalman.h"
+
+using namespace gssm;
+using gssm::testing::relativeError;
+
+namespace {
+NormalSampler normalSampler(unsigned seed) {
+  auto rng = std::make_shared<std::mt19937>(seed);
+  auto dist = std::make_shared<std::normal_distribution<double>>(0.0, 1.0);
+  return [rng, dist] { return (*dist)(*rng); };
+}
+}  // namespace
+
+TEST(ExtendedKalmanFilter, EqualsLinearKalmanFilterOnLinearModel) {
+  std::mt19937 rng(21);
+  const models::LinearModel model(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1),
+                                  models::Discretization::Exact);
+  SimulationSpec spec;
+  spec.steps = 80;
+  const SimulatedRun run = simulate(model, spec, normalSampler(4));
+  const auto ref = gssm::testing::kalmanAndRts(gssm::testing::stack(model, 0.1), run.measurements);
+  ExtendedKalmanFilter ekf(model);
+  for (std::size_t i = 0; i < run.measurements.size(); ++i) {
+    ekf.predict(run.measurements[i].t, Eigen::VectorXd(0));
+    ekf.update(run.measurements[i].y);
+    EXPECT_LT(relativeError(ekf.mean(), ref.zf[i + 1]), 1e-10) << "step " << i + 1;
+    EXPECT_LT(relativeError(ekf.covariance(), ref.Pf[i + 1]), 1e-10) << "step " << i + 1;
+  }
+}
+
+TEST(ExtendedKalmanFilter, JosephAndSimpleFormAgree) {
+  const models::Radar2D radar;
+  SimulationSpec spec;
+  spec.steps = 50;
+  const SimulatedRun run = simulate(radar, spec, normalSampler(5));
+  ExtendedKalmanFilterOptions simple;
+  simple.joseph_form = false;
+  ExtendedKalmanFilter a(radar), b(radar, simple);
+  for (const auto& m : run.measurements) {
+    a.predict(m.t, Eigen::VectorXd(0));
+    b.predict(m.t, Eigen::VectorXd(0));
+    a.update(m.y);
+    b.update(m.y);
+  }
+  EXPECT_LT(relativeError(a.mean(), b.mean()), 1e-8);
+  EXPECT_LT(relativeError(a.covariance(), b.covariance()), 1e-6);
+}
+
+TEST(ExtendedKalmanFilter, ConstantProcessNoiseInflatesOnlyThatConstant) {
+  const models::Radar2D radar;
+  ExtendedKalmanFilterOptions o;
+  o.constant_process_noise = Eigen::Vector2d(0.005 * 0.005, 0.0);
+  ExtendedKalmanFilter plain(radar), noisy(radar, o);
+  plain.predict(0.05, Eigen::VectorXd(0));
+  noisy.predict(0.05, Eigen::VectorXd(0));
+  EXPECT_NEAR(noisy.covariance()(1, 1) - plain.covariance()(1, 1), 0.005 * 0.005, 1e-15);
+  EXPECT_EQ(noisy.covariance()(2, 2), plain.covariance()(2, 2));
+}
+
+TEST(ExtendedKalmanFilter, BadCallsThrowAndLeaveTheFilterUnchanged) {
+  const models::Radar2D radar;
+  ExtendedKalmanFilter ekf(radar);
+  ekf.predict(0.05, Eigen::VectorXd(0));
+  ekf.update(Eigen::VectorXd::Constant(1, 2000));
+  const Eigen::VectorXd z = ekf.mean();
+  const Eigen::MatrixXd P = ekf.covariance();
+  EXPECT_THROW(ekf.predict(0.05, Eigen::VectorXd(0)), InvalidArgument);  // time not after
+  EXPECT_THROW(ekf.update(Eigen::VectorXd::Constant(1, NAN)), InvalidArgument);
+  EXPECT_THROW(ekf.update(Eigen::VectorXd::Constant(2, 1.0)), InvalidArgument);
+  EXPECT_EQ(ekf.mean(), z);
+  EXPECT_EQ(ekf.covariance(), P);
+  EXPECT_DOUBLE_EQ(ekf.time(), 0.05);
+  ExtendedKalmanFilterOptions bad;
+  bad.constant_process_noise = Eigen::VectorXd::Constant(3, 0.0);
+  EXPECT_THROW(ExtendedKalmanFilter(radar, bad), InvalidArgument);
+}
