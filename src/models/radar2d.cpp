@@ -18,8 +18,10 @@ ModelNoise radarNoise(const Radar2D::Params& p) {
 }
 }  // namespace
 
-Radar2D::Radar2D(const Params& p)
-    : Model({1, 2, 0, 1}, {{"x"}, {"xdot", "h"}, {}, {"range"}}, radarNoise(p)), params_(p) {}
+Radar2D::Radar2D(const Params& p) : Radar2D(radarNoise(p)) {}
+
+Radar2D::Radar2D(const ModelNoise& noise)
+    : Model({1, 2, 0, 1}, {{"x"}, {"xdot", "h"}, {}, {"range"}}, noise) {}
 
 Eigen::VectorXd Radar2D::f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                            const Eigen::VectorXd& /*u*/, double dt, Eigen::MatrixXd* J_f_xc,

@@ -19,18 +19,16 @@ class Radar2D final : public Model {
 
   Radar2D() : Radar2D(Params{}) {}
   explicit Radar2D(const Params& p);
+  /// Any step, noise and (full-covariance) priors, e.g. from a config file.
+  explicit Radar2D(const ModelNoise& noise);
 
   std::string name() const override { return "radar2d"; }
-  const Params& params() const { return params_; }
 
   Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     const Eigen::VectorXd& u, double dt, Eigen::MatrixXd* J_f_xc = nullptr,
                     Eigen::MatrixXd* J_f_xb = nullptr) const override;
   Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
-
- private:
-  Params params_;
 };
 
 }  // namespace gssm::models

@@ -1,0 +1,38 @@
+#pragma once
+// Dataset folders: measurements.csv (t,<measurement names>, rows k = 1..N),
+// truth.csv (t,<state names>,<constant names>, rows k = 0..N, optional) and
+// scenario.ini (model, priors, truth settings, seed).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gssm/data.h"
+#include "gssm/io/ini.h"
+#include "gssm/model.h"
+#include "gssm/simulation.h"
+
+namespace gssm::io {
+
+struct Truth {
+  std::vector<double> times;
+  std::vector<Eigen::VectorXd> states;  ///< stacked [x_c(k); x_b] per row
+};
+
+struct Dataset {
+  std::string dir;
+  IniDocument scenario;
+  std::vector<Measurement> measurements;
+  std::optional<Truth> truth;
+};
+
+/// Reads scenario.ini (or `config_override` when non-empty).
+IniDocument readScenario(const std::string& dir, const std::string& config_override = "");
+/// Reads measurements.csv and truth.csv (if present) of a model's shape;
+/// checks column names and increasing timestamps, naming file and line.
+void readDatasetData(const std::string& dir, const Model& model, Dataset& out);
+
+/// Writes measurements.csv, truth.csv and scenario.ini.
+void writeDataset(const std::string& dir, const Model& model, const SimulatedRun& run,
+                  const IniDocument& scenario);
+
+}  // namespace gssm::io

@@ -1,0 +1,42 @@
+#pragma once
+// Runs an estimator over a recorded sequence of measurements in streaming
+// order and collects what it reports after each one: the common back end of
+// the dataset processor and the Monte Carlo runner.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "gssm/batch_solver.h"
+#include "gssm/data.h"
+#include "gssm/ekf.h"
+#include "gssm/model.h"
+
+namespace gssm {
+
+/// The estimate of the stacked state [x_c(k); x_b] at one measurement time.
+struct EstimateRow {
+  double t = 0;
+  Eigen::VectorXd mean;        ///< stacked [x_c; x_b]
+  Eigen::MatrixXd covariance;  ///< stacked, (n_c + n_b)²
+};
+
+struct OfflineRun {
+  std::string method;
+  std::vector<EstimateRow> rows;       ///< one per measurement (plus none for t0)
+  std::vector<double> update_seconds;  ///< wall time of each update
+  double total_seconds = 0;
+  int iterations = 0;                  ///< solver iterations (batch), 0 for filters
+  std::string summary;                 ///< the solver's own report line
+};
+
+OfflineRun runEkf(const Model& model, const ExtendedKalmanFilterOptions& options,
+                  const std::vector<Measurement>& measurements,
+                  const std::vector<Input>& inputs = {});
+
+/// The batch MAP of the whole run; rows hold the smoothed estimate at each
+/// measurement time with its marginal covariance.
+OfflineRun runBatch(const Model& model, const BatchSolverOptions& options,
+                    const std::vector<Measurement>& measurements,
+                    const std::vector<Input>& inputs = {});
+
+}  // namespace gssm

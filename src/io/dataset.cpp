@@ -1,0 +1,87 @@
+#include "gssm/io/dataset.h"
+
+#include <filesystem>
+
+#include "gssm/error.h"
+#include "gssm/io/csv.h"
+
+namespace gssm::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+// Checks that the header is exactly t,<names> and times increase strictly.
+void checkTable(const CsvTable& t, const std::vector<std::string>& names) {
+  std::vector<std::string> expected{"t"};
+  expected.insert(expected.end(), names.begin(), names.end());
+  if (t.header != expected) {
+    std::string want, got;
+    for (const auto& n : expected) want += (want.empty() ? "" : ",") + n;
+    for (const auto& n : t.header) got += (got.empty() ? "" : ",") + n;
+    throw InputError(t.source + ":1: header is '" + got + "', expected '" + want + "'");
+  }
+  for (std::size_t r = 1; r < t.rows.size(); ++r)
+    if (!(t.rows[r][0] > t.rows[r - 1][0]))
+      throw InputError(t.source + ":" + std::to_string(t.line_of_row[r]) + ": column 't': time " +
+                       formatDouble(t.rows[r][0]) + " is not after the previous row's " +
+                       formatDouble(t.rows[r - 1][0]) +
+                       (t.rows[r][0] == t.rows[r - 1][0] ? " (duplicated timestamp)" : ""));
+}
+}  // namespace
+
+IniDocument readScenario(const std::string& dir, const std::string& config_override) {
+  const std::string path = config_override.empty() ? (fs::path(dir) / "scenario.ini").string()
+                                                   : config_override;
+  return IniDocument::load(path);
+}
+
+void readDatasetData(const std::string& dir, const Model& model, Dataset& out) {
+  out.dir = dir;
+  const CsvTable m = readCsv((fs::path(dir) / "measurements.csv").string());
+  checkTable(m, model.names().measurement);
+  out.measurements.clear();
+  for (const auto& row : m.rows)
+    out.measurements.push_back(
+        {row[0], Eigen::Map<const Eigen::VectorXd>(row.data() + 1, model.dims().ny)});
+  out.truth.reset();
+  const fs::path tp = fs::path(dir) / "truth.csv";
+  if (fs::exists(tp)) {
+    const CsvTable t = readCsv(tp.string());
+    checkTable(t, model.stackedStateNames());
+    Truth truth;
+    const int n = model.dims().nc + model.dims().nb;
+    for (const auto& row : t.rows) {
+      truth.times.push_back(row[0]);
+      truth.states.push_back(Eigen::Map<const Eigen::VectorXd>(row.data() + 1, n));
+    }
+    out.truth = std::move(truth);
+  }
+}
+
+void writeDataset(const std::string& dir, const Model& model, const SimulatedRun& run,
+                  const IniDocument& scenario) {
+  fs::create_directories(dir);
+  std::vector<std::string> mh{"t"};
+  for (const auto& n : model.names().measurement) mh.push_back(n);
+  std::vector<std::vector<double>> rows;
+  for (const auto& m : run.measurements) {
+    std::vector<double> r{m.t};
+    r.insert(r.end(), m.y.data(), m.y.data() + m.y.size());
+    rows.push_back(std::move(r));
+  }
+  writeCsv((fs::path(dir) / "measurements.csv").string(), mh, rows);
+
+  std::vector<std::string> th{"t"};
+  for (const auto& n : model.stackedStateNames()) th.push_back(n);
+  rows.clear();
+  for (std::size_t k = 0; k < run.states.size(); ++k) {
+    std::vector<double> r{run.times[k]};
+    r.insert(r.end(), run.states[k].data(), run.states[k].data() + run.states[k].size());
+    r.insert(r.end(), run.constants.data(), run.constants.data() + run.constants.size());
+    rows.push_back(std::move(r));
+  }
+  writeCsv((fs::path(dir) / "truth.csv").string(), th, rows);
+  scenario.save((fs::path(dir) / "scenario.ini").string());
+}
+
+}  // namespace gssm::io

@@ -1,0 +1,44 @@
+#!/usr/bin/env python3
+"""gssm-process end to end: files written, CSV columns and row counts right,
+metrics.json parses and its RMSE equals one recomputed here from the CSVs;
+a bad option gives a one-line error and a non-zero exit."""
+import csv, json, math, os, shutil, subprocess, sys
+
+bin_dir, work = sys.argv[1], sys.argv[2]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+data, out = os.path.join(work, "data"), os.path.join(work, "out")
+subprocess.run([f"{bin_dir}/gssm-simulate", "--scenario", "consistent", "--seed", "3",
+                "--steps", "60", "--out", data], check=True, capture_output=True)
+subprocess.run([f"{bin_dir}/gssm-process", "--data", data, "--method", "all", "--out", out],
+               check=True, capture_output=True)
+
+def read(path):
+    with open(path) as f:
+        rows = list(csv.reader(f))
+    return rows[0], [[float(v) for v in r] for r in rows[1:]]
+
+_, truth = read(os.path.join(data, "truth.csv"))
+truth_by_t = {r[0]: r[1:] for r in truth}
+metrics = json.load(open(os.path.join(out, "metrics.json")))
+names = ["x", "xdot", "h"]
+for method, m in metrics["methods"].items():
+    header, rows = read(os.path.join(out, f"estimates-{method}.csv"))
+    assert header == ["t"] + names + ["sd_" + n for n in names], header
+    assert len(rows) == 60, (method, len(rows))
+    assert m["rows"] == 60
+    for i, n in enumerate(names):
+        sq = [(r[1 + i] - truth_by_t[r[0]][i]) ** 2 for r in rows]
+        rmse = math.sqrt(sum(sq) / len(sq))
+        assert abs(rmse - m["rmse"][n]) <= 1e-9 * max(1.0, rmse), (method, n, rmse, m["rmse"][n])
+        assert all(r[4 + i] > 0 for r in rows)
+assert set(metrics["methods"]) >= {"ekf", "batch"}, metrics["methods"].keys()
+
+bad = subprocess.run([f"{bin_dir}/gssm-process", "--data", data, "--method", "kalman",
+                      "--out", out], capture_output=True, text=True)
+assert bad.returncode != 0
+assert "kalman" in bad.stderr and bad.stderr.count("\n") == 1, bad.stderr
+missing = subprocess.run([f"{bin_dir}/gssm-process", "--data", os.path.join(work, "nope"),
+                          "--out", out], capture_output=True, text=True)
+assert missing.returncode != 0 and "nope" in missing.stderr, missing.stderr
+print("process end to end: ok")

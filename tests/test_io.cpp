@@ -1,0 +1,106 @@
+#include <gtest/gtest.h>
+
+#include "gssm/error.h"
+#include "gssm/io/config.h"
+#include "gssm/io/csv.h"
+#include "gssm/io/ini.h"
+#include "gssm/models/radar2d.h"
+
+using namespace gssm;
+using namespace gssm::io;
+
+namespace {
+// Asserts that `fn` throws InputError whose message contains every fragment.
+template <class Fn>
+void expectInputError(Fn fn, std::initializer_list<const char*> fragments) {
+  try {
+    fn();
+    FAIL() << "no error thrown";
+  } catch (const InputError& e) {
+    for (const char* f : fragments)
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
+          << "message '" << e.what() << "' lacks '" << f << "'";
+  }
+}
+}  // namespace
+
+TEST(IniDocument, ParsesSectionsCommentsAndMatrices) {
+  const auto ini = IniDocument::parse(
+      "; comment\n[model]\ntype = radar2d  # trailing\nQ = [1 2; 3 4] // c\n\n[prior]\n"
+      "v = 1, 2, 3\n",
+      "t.ini");
+  EXPECT_EQ(ini.getString("model", "type"), "radar2d");
+  const Eigen::MatrixXd Q = ini.getMatrix("model", "Q", 2, 2);
+  EXPECT_EQ(Q(1, 0), 3);
+  EXPECT_EQ(ini.getVector("prior", "v", 3)[2], 3);
+  // diagonal shorthand
+  EXPECT_EQ(ini.getMatrix("prior", "v", 3, 3)(2, 2), 3);
+  EXPECT_EQ(ini.getMatrix("prior", "v", 3, 3)(0, 1), 0);
+}
+
+TEST(IniDocument, ErrorsNameFileLineSectionKeyAndValue) {
+  expectInputError([] { IniDocument::parse("[a]\nx = 1\nnot a pair\n", "f.ini"); },
+                   {"f.ini:3", "key = value"});
+  expectInputError([] { IniDocument::parse("x = 1\n", "f.ini"); }, {"f.ini:1", "before any"});
+  expectInputError([] { IniDocument::parse("[a]\nx = 1\nx = 2\n", "f.ini"); },
+                   {"f.ini:3", "repeated", "line 2"});
+  const auto ini = IniDocument::parse("[m]\nT = abc\nQ = [1 2; 3]\n", "f.ini");
+  expectInputError([&] { ini.getDouble("m", "T"); }, {"f.ini:2", "[m] T", "abc", "number"});
+  expectInputError([&] { ini.getMatrix("m", "Q"); }, {"f.ini:3", "row 2"});
+  expectInputError([&] { ini.getDouble("m", "R"); }, {"missing", "'R'", "[m]"});
+}
+
+TEST(IniDocument, WriteThenParseRoundTripsBits) {
+  IniDocument a;
+  a.set("s", "x", 0.1 + 0.2);
+  Eigen::MatrixXd m(2, 2);
+  m << 1.0 / 3, -2e-17, 4e100, 5;
+  a.set("s", "m", m);
+  const auto b = IniDocument::parse(a.toString());
+  EXPECT_EQ(b.getDouble("s", "x"), 0.1 + 0.2);
+  EXPECT_EQ(b.getMatrix("s", "m"), m);
+}
+
+TEST(Config, BuiltinScenarioBuildsThePaperModel) {
+  const auto ini = IniDocument::parse(builtinScenario("paper", 3, 50).toString(), "p.ini");
+  const auto model = makeModel(ini);
+  const models::Radar2D paper;
+  EXPECT_EQ(model->name(), "radar2d");
+  EXPECT_EQ(model->noise().Q, paper.noise().Q);
+  EXPECT_EQ(model->priorConstants().mean, paper.priorConstants().mean);
+  EXPECT_EQ(model->priorConstants().covariance, paper.priorConstants().covariance);
+  const auto spec = simulationSpec(ini, *model);
+  EXPECT_EQ(spec.steps, 50);
+  EXPECT_FALSE(spec.process_noise);
+  EXPECT_EQ((*spec.xb)[1], 1000);
+  EXPECT_EQ(ekfOptions(ini, *model).constant_process_noise[0], 0.005 * 0.005);
+  EXPECT_THROW(builtinScenario("nope", 1, 1), InvalidArgument);
+}
+
+TEST(Config, BadModelConfigsNameTheProblem) {
+  auto base = builtinScenario("paper", 1, 10);
+  base.set("model", "type", "radar3d");
+  expectInputError([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
+                   {"c.ini", "radar3d", "unknown model"});
+  base = builtinScenario("paper", 1, 10);
+  base.set("prior", "constants_cov", "[49 0; 0 -1]");
+  expectInputError([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
+                   {"c.ini", "positive definite", "x_b"});
+  base = builtinScenario("paper", 1, 10);
+  base.set("model", "Qq", "1");
+  expectInputError([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
+                   {"unknown key 'Qq'"});
+}
+
+TEST(Csv, ParsesAndReportsLineColumnValue) {
+  const auto t = parseCsv("t,range\n0.05,1000\n\n0.1,1001.5\n", "m.csv");
+  ASSERT_EQ(t.rows.size(), 2u);
+  EXPECT_EQ(t.line_of_row[1], 4);
+  EXPECT_EQ(t.rows[1][1], 1001.5);
+  expectInputError([] { parseCsv("t,range\n0.05,abc\n", "m.csv"); },
+                   {"m.csv:2", "'range'", "'abc'"});
+  expectInputError([] { parseCsv("t,range\n0.05,nan\n", "m.csv"); }, {"m.csv:2", "nan"});
+  expectInputError([] { parseCsv("t,range\n0.05\n", "m.csv"); }, {"m.csv:2", "1 fields"});
+  expectInputError([] { parseCsv("0.05,1000\n", "m.csv"); }, {"m.csv:1", "header"});
+  expectInputError([] { parseCsv("", "m.csv"); }, {"m.csv", "empty"});
+}
