@@ -4,6 +4,7 @@
 #include <random>
 
 #include "gssm/batch_solver.h"
+#include "gssm/ekf.h"
 #include "gssm/error.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
@@ -173,6 +174,10 @@ TEST(BatchSolver, MarginalCovariancesEqualDenseInverse) {
     EXPECT_NEAR(joint(0, 1), Sigma(k, nb0), tol * std::sqrt(Sigma(k, k) * Sigma(nb0, nb0)));
     EXPECT_NEAR(joint(0, 2), Sigma(k, nb0 + 1), tol * std::sqrt(Sigma(k, k) * Sigma(nb0 + 1, nb0 + 1)));
   }
+  // A pair the factor does not couple (x_c(0), x_c(25)) takes the solve path.
+  const Eigen::MatrixXd far = solver.jointMarginalCovariance({Key::state(0), Key::state(25)});
+  EXPECT_NEAR(far(0, 1), Sigma(0, 25), tol * std::sqrt(Sigma(0, 0) * Sigma(25, 25)));
+  EXPECT_NEAR(far(1, 1), Sigma(25, 25), tol * Sigma(25, 25));
 }
 
 TEST(BatchSolver, SingularSystemNamesTheVariableAndLeavesValuesUnchanged) {
@@ -231,4 +236,16 @@ TEST(Problem, RejectsTimesThatDoNotIncrease) {
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("measurement 1"), std::string::npos) << e.what();
   }
+}
+
+TEST(BatchSolver, EkfAndDeadReckoningInitialGuessesReachTheSameMap) {
+  const models::Radar2D radar;
+  const SimulatedRun run = radarPaperRun(radar, 400, 4);
+  Problem p = buildProblem(radar, run.measurements);
+  Values a = p.initial;
+  Values b = ekfInitialGuess(radar, ExtendedKalmanFilterOptions{}, run.measurements);
+  BatchSolver solver;
+  ASSERT_TRUE(solver.solve(p.graph, a).converged);
+  ASSERT_TRUE(solver.solve(p.graph, b).converged);
+  for (const auto& kv : a) EXPECT_LT(relativeError(kv.second, b.at(kv.first)), 1e-7) << kv.first.toString();
 }

@@ -6,7 +6,11 @@
 #include <Eigen/Core>
 #include <string>
 
+#include <vector>
+
+#include "gssm/data.h"
 #include "gssm/model.h"
+#include "gssm/values.h"
 
 namespace gssm {
 
@@ -49,5 +53,14 @@ class ExtendedKalmanFilter {
   Eigen::MatrixXd P_;
   double nis_ = 0.0;
 };
+
+/// An initial guess for a batch solve from one EKF pass: x_c(k) from the
+/// filtered estimates, x_b from the filter's final estimate. From a poor
+/// prior, dead reckoning drifts without bound over a long run (e.g. x off by
+/// 5·10⁵ m after 10⁵ radar steps), which LM cannot recover from; the filter's
+/// estimates stay near the data.
+Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
+                       const std::vector<Measurement>& measurements,
+                       const std::vector<Input>& inputs = {}, double t0 = 0.0);
 
 }  // namespace gssm

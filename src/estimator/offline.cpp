@@ -38,7 +38,7 @@ OfflineRun runBatch(const Model& model, const BatchSolverOptions& options,
   out.method = "batch";
   const auto start = Clock::now();
   Problem p = buildProblem(model, measurements, inputs);
-  Values x = p.initial;
+  Values x = ekfInitialGuess(model, ExtendedKalmanFilterOptions{}, measurements, inputs);
   BatchSolver solver(options);
   const BatchSolverSummary sum = solver.solve(p.graph, x);
   out.iterations = sum.iterations;

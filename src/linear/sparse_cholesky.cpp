@@ -1,6 +1,8 @@
 #include "linear/sparse_cholesky.h"
 
+#include <algorithm>
 #include <cstring>
+#include <numeric>
 
 #include "gssm/error.h"
 
@@ -74,6 +76,76 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& B) {
   Eigen::MatrixXd X = Eigen::Map<Eigen::MatrixXd>(static_cast<double*>(x->x), B.rows(), B.cols());
   cholmod_free_dense(&x, &common_);
   return X;
+}
+
+bool SparseCholesky::SelectedInverse::lookup(Eigen::Index i, Eigen::Index j, double& out) const {
+  if (i < j) std::swap(i, j);
+  const auto b = rows.begin() + colptr[static_cast<std::size_t>(j)];
+  const auto e = rows.begin() + colptr[static_cast<std::size_t>(j) + 1];
+  const auto it = std::lower_bound(b, e, static_cast<int>(i));
+  if (it == e || *it != i) return false;
+  out = values[static_cast<std::size_t>(it - rows.begin())];
+  return true;
+}
+
+SparseCholesky::SelectedInverse SparseCholesky::selectedInverse() const {
+  if (!factor_) throw NumericalError("selectedInverse: nothing factored");
+  cholmod_common& c = const_cast<cholmod_common&>(common_);
+  // A simplicial LDLᵀ copy (unit L, D) of the factor, with sorted rows.
+  cholmod_factor* F = cholmod_copy_factor(factor_, &c);
+  if (!F || !cholmod_change_factor(CHOLMOD_REAL, false, false, true, true, F, &c)) {
+    if (F) cholmod_free_factor(&F, &c);
+    throw NumericalError("selectedInverse: CHOLMOD could not convert the factor");
+  }
+  const int* perm = static_cast<const int*>(F->Perm);
+  for (Eigen::Index k = 0; k < n_; ++k)
+    if (perm && perm[k] != k) {
+      cholmod_free_factor(&F, &c);
+      throw NumericalError("selectedInverse: expected the natural ordering");
+    }
+  const int* Lp = static_cast<const int*>(F->p);
+  const int* Li = static_cast<const int*>(F->i);
+  const int* Lnz = static_cast<const int*>(F->nz);
+  const double* Lx = static_cast<const double*>(F->x);
+  SelectedInverse S;
+  S.colptr.assign(static_cast<std::size_t>(n_) + 1, 0);
+  for (Eigen::Index j = 0; j < n_; ++j) S.colptr[j + 1] = S.colptr[j] + Lnz[j];
+  S.rows.resize(static_cast<std::size_t>(S.colptr.back()));
+  S.values.assign(S.rows.size(), 0.0);
+  std::vector<double> d(static_cast<std::size_t>(n_));
+  std::vector<std::vector<std::pair<int, double>>> below(static_cast<std::size_t>(n_));
+  for (Eigen::Index j = 0; j < n_; ++j) {
+    auto& col = below[static_cast<std::size_t>(j)];
+    for (int p = Lp[j]; p < Lp[j] + Lnz[j]; ++p) {
+      if (Li[p] == j) d[static_cast<std::size_t>(j)] = Lx[p];
+      else col.emplace_back(Li[p], Lx[p]);
+    }
+    std::sort(col.begin(), col.end());
+    int q = S.colptr[j];
+    S.rows[static_cast<std::size_t>(q++)] = static_cast<int>(j);
+    for (const auto& e : col) S.rows[static_cast<std::size_t>(q++)] = e.first;
+  }
+  cholmod_free_factor(&F, &c);
+  // Backward sweep: Σ_ij = −Σ_k Σ_ik l_kj (i > j), Σ_jj = 1/d_j − Σ_k l_kj Σ_kj.
+  for (Eigen::Index j = n_ - 1; j >= 0; --j) {
+    const auto& col = below[static_cast<std::size_t>(j)];
+    const int base = S.colptr[j];
+    for (std::size_t a = 0; a < col.size(); ++a) {
+      double sum = 0;
+      for (const auto& [k, lkj] : col) {
+        double sik;
+        if (!S.lookup(col[a].first, k, sik))
+          throw NumericalError("selectedInverse: pattern is not closed (internal error)");
+        sum += sik * lkj;
+      }
+      S.values[static_cast<std::size_t>(base) + 1 + a] = -sum;
+    }
+    double diag = 1.0 / d[static_cast<std::size_t>(j)];
+    for (std::size_t a = 0; a < col.size(); ++a)
+      diag -= col[a].second * S.values[static_cast<std::size_t>(base) + 1 + a];
+    S.values[static_cast<std::size_t>(base)] = diag;
+  }
+  return S;
 }
 
 }  // namespace gssm::internal

@@ -31,6 +31,18 @@ class SparseCholesky {
   Eigen::Index factorize();
   /// Solves H X = B for a dense right-hand side (n × m).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& B);
+
+  /// Entries of H⁻¹ on the sparsity pattern of the factor L (Takahashi's
+  /// selected inversion): every diagonal entry and every (i, j) that L
+  /// couples. Costs O(Σ_j |col_j(L)|²), linear in n for a banded-plus-border
+  /// pattern such as the GSSM's.
+  struct SelectedInverse {
+    std::vector<int> colptr, rows;  // lower triangle, rows sorted, diagonal first
+    std::vector<double> values;
+    /// H⁻¹(i, j) if (i, j) is on the pattern.
+    bool lookup(Eigen::Index i, Eigen::Index j, double& out) const;
+  };
+  SelectedInverse selectedInverse() const;
   Eigen::Index size() const { return n_; }
 
  private:

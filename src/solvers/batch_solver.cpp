@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "gssm/error.h"
@@ -55,6 +56,8 @@ struct BatchSolver::Impl {
   internal::SparseCholesky chol;
   std::size_t damping_begin = 0;         // triplet index of the first diagonal damping entry
   bool has_solution = false;
+  // H⁻¹ on the factor's pattern, computed on the first covariance query.
+  mutable std::optional<internal::SparseCholesky::SelectedInverse> selected;
 
   void setup(const FactorGraph& graph, const Values& values) {
     offset.clear();
@@ -160,6 +163,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   using T = BatchSolverSummary::Termination;
   Impl& s = *impl_;
   s.has_solution = false;
+  s.selected.reset();
   s.setup(graph, values);
 
   BatchSolverSummary sum;
@@ -289,13 +293,23 @@ Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& key
     dims.push_back((next == s.offset.end() ? s.n : next->second) - it->second);
     m += dims.back();
   }
-  // Columns of H⁻¹ for the requested variables: solve H X = E.
+  Eigen::MatrixXd out(m, m);
+  // Fast path: every requested entry lies on the factor's pattern (true for
+  // any x_c(k) with x_b), so it is read from the selected inverse.
+  if (!s.selected) s.selected = s.chol.selectedInverse();
+  bool on_pattern = true;
+  for (std::size_t a = 0, r = 0; a < keys.size() && on_pattern; r += dims[a], ++a)
+    for (std::size_t b = 0, c = 0; b < keys.size() && on_pattern; c += dims[b], ++b)
+      for (Eigen::Index i = 0; i < dims[a] && on_pattern; ++i)
+        for (Eigen::Index j = 0; j < dims[b] && on_pattern; ++j)
+          on_pattern = s.selected->lookup(offs[a] + i, offs[b] + j, out(r + i, c + j));
+  if (on_pattern) return out;
+  // Otherwise: the needed columns of H⁻¹ by solving H X = E.
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(s.n, m);
   Eigen::Index c = 0;
   for (std::size_t i = 0; i < keys.size(); ++i)
     for (Eigen::Index j = 0; j < dims[i]; ++j) E(offs[i] + j, c++) = 1.0;
   const Eigen::MatrixXd X = s.chol.solve(E);
-  Eigen::MatrixXd out(m, m);
   Eigen::Index r = 0;
   for (std::size_t i = 0; i < keys.size(); ++i) {
     out.middleRows(r, dims[i]) = X.middleRows(offs[i], dims[i]);

@@ -5,6 +5,8 @@
 
 #include "gssm/error.h"
 #include "gssm/gaussian.h"
+#include "gssm/key.h"
+#include "gssm/problem.h"
 
 namespace gssm {
 
@@ -94,6 +96,22 @@ void ExtendedKalmanFilter::update(const Eigen::VectorXd& y) {
   z_ += K * innov;
   P_ = std::move(P);
   nis_ = innov.dot(llt.solve(innov));
+}
+
+Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
+                       const std::vector<Measurement>& measurements,
+                       const std::vector<Input>& inputs, double t0) {
+  const ModelDims& d = model.dims();
+  ExtendedKalmanFilter ekf(model, options, t0);
+  Values x;
+  x.insert(Key::state(0), model.priorState().mean);
+  for (std::size_t i = 0; i < measurements.size(); ++i) {
+    ekf.predict(measurements[i].t, inputAt(model, inputs, ekf.time()));
+    ekf.update(measurements[i].y);
+    x.insert(Key::state(static_cast<std::int64_t>(i) + 1), ekf.mean().head(d.nc));
+  }
+  if (d.nb > 0) x.insert(Key::constants(), ekf.mean().tail(d.nb));
+  return x;
 }
 
 }  // namespace gssm
