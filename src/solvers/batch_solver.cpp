@@ -185,11 +185,20 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     return out;
   };
 
-  // LM leaves a damping bias of order λ in the last step, so once the cost
-  // has converged we finish with undamped Gauss–Newton steps for as long as
-  // they lower the cost ("polish"): on a linear problem this is exact.
-  bool polishing = false;
-  int polish_steps = 0;
+  // LM leaves a damping bias of order λ in its last steps, so whenever a
+  // convergence test passes while damped, the solver switches to undamped
+  // Gauss–Newton ("polish") and stops at the next convergence test: on a
+  // linear problem the result is the exact least-squares solution.
+  bool polishing = !lm;
+  auto converge = [&](T reason) {
+    if (!polishing) {
+      polishing = true;
+      lambda = 0.0;
+      return false;  // keep going, undamped
+    }
+    sum.termination = reason;
+    return true;
+  };
   bool done = false;
   if (g.lpNorm<Eigen::Infinity>() <= options_.gradient_tolerance) {
     sum.termination = T::GradientConverged;
@@ -205,6 +214,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     const Eigen::Index bad = s.chol.factorize();
     if (bad >= 0) {
       if (!lm || lambda >= options_.max_lambda) s.throwSingular(bad);
+      polishing = false;  // back to damped steps
       lambda = std::max(lambda * 10, 1e-6);
       ++sum.rejected_steps;
       continue;
@@ -213,27 +223,20 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     Eigen::VectorXd xflat(s.n);
     for (const auto& kv : x) xflat.segment(s.offset.at(kv.first), kv.second.size()) = kv.second;
     if (delta.norm() <= options_.step_tolerance * (xflat.norm() + options_.step_tolerance)) {
-      sum.termination = T::StepConverged;
-      break;
+      if (converge(T::StepConverged)) break;
+      continue;
     }
     Values candidate = applyStep(x, delta);
     const double new_cost = graph.cost(candidate);
-    if (polishing) {
-      // Near the minimum the cost change (∝ ‖δ‖²) is below rounding, so a
-      // polish step is kept unless it makes the cost clearly worse.
-      if (new_cost <= cost * (1 + 1e-10)) {
-        ++sum.iterations;
-        x = std::move(candidate);
-        cost = s.linearize(graph, x, g, diag, false);
-      } else {
-        ++sum.rejected_steps;
-      }
-      sum.termination = T::CostConverged;
-      if (++polish_steps >= 3) break;
-      continue;
-    }
-    if (lm && !(new_cost < cost)) {
+    // Near the minimum the cost change (∝ ‖δ‖²) is below rounding, so an
+    // undamped polish step is kept unless it makes the cost clearly worse.
+    const bool accept = polishing ? (lm ? new_cost <= cost * (1 + 1e-10) : true) : new_cost < cost;
+    if (!accept) {
       ++sum.rejected_steps;
+      if (polishing) {  // the damped solution was already converged
+        sum.termination = T::CostConverged;
+        break;
+      }
       lambda *= 10;
       if (lambda > options_.max_lambda) {
         sum.termination = T::NoProgress;
@@ -245,19 +248,11 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     x = std::move(candidate);
     const double old_cost = cost;
     cost = s.linearize(graph, x, g, diag, false);
-    if (lm && !polishing) lambda = std::max(lambda / 10, 1e-12);
+    if (!polishing) lambda = std::max(lambda / 10, 1e-12);
     if (g.lpNorm<Eigen::Infinity>() <= options_.gradient_tolerance) {
-      sum.termination = T::GradientConverged;
-      break;
-    }
-    if (old_cost - cost <= options_.relative_cost_tolerance * old_cost) {
-      if (lm && !polishing) {
-        polishing = true;
-        lambda = 0.0;
-        continue;
-      }
-      sum.termination = T::CostConverged;
-      break;
+      if (converge(T::GradientConverged)) break;
+    } else if (old_cost - cost <= options_.relative_cost_tolerance * old_cost) {
+      if (converge(T::CostConverged)) break;
     }
   }
   // Factor the undamped information matrix at the solution: it gives the

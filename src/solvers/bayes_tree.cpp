@@ -1,0 +1,630 @@
+#include "solvers/bayes_tree.h"
+
+#include <Eigen/Householder>
+#include <Eigen/QR>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <ccolamd.h>
+#include <sstream>
+#include <unordered_set>
+
+#include "gssm/error.h"
+
+namespace gssm::internal {
+
+namespace {
+Eigen::Index dimOf(const std::unordered_map<Key, Eigen::Index, KeyHash>& dims, const Key& k) {
+  return dims.at(k);
+}
+}  // namespace
+
+int BayesTreeEngine::allocClique() {
+  ++cliques_alive_;
+  if (!free_cliques_.empty()) {
+    const int c = free_cliques_.back();
+    free_cliques_.pop_back();
+    clique_alive_[static_cast<std::size_t>(c)] = true;
+    return c;
+  }
+  cliques_.emplace_back();
+  clique_alive_.push_back(true);
+  return static_cast<int>(cliques_.size()) - 1;
+}
+
+int BayesTreeEngine::allocSlot() {
+  ++slots_alive_;
+  if (!free_slots_.empty()) {
+    const int s = free_slots_.back();
+    free_slots_.pop_back();
+    return s;
+  }
+  slots_.emplace_back();
+  return static_cast<int>(slots_.size()) - 1;
+}
+
+Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {
+  const auto it = vars_.find(k);
+  if (it == vars_.end()) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
+  return it->second.anchor + it->second.delta;
+}
+
+// Linearizes f at the current estimate: r(x) ≈ r(x̂) + J (δ − δ̂), i.e.
+// A = J, b = J δ̂ − r(x̂). `extra` holds initial values of variables being added.
+LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) const {
+  Values x;
+  std::vector<Eigen::VectorXd> deltas;
+  for (const auto& k : f.keys()) {
+    const auto it = vars_.find(k);
+    if (it != vars_.end()) {
+      x.insert(k, it->second.anchor + it->second.delta);
+      deltas.push_back(it->second.delta);
+    } else {
+      x.insert(k, extra.at(k));
+      deltas.push_back(Eigen::VectorXd::Zero(extra.at(k).size()));
+    }
+  }
+  LinearFactor lf;
+  lf.keys = f.keys();
+  Eigen::VectorXd r;
+  f.linearize(x, r, &lf.A);
+  bool finite = r.allFinite();
+  for (const auto& a : lf.A) finite = finite && a.allFinite();
+  if (!finite)
+    throw NumericalError("factor '" + f.describe() +
+                         "' has a non-finite residual or Jacobian at the current estimate");
+  lf.b = -r;
+  for (std::size_t i = 0; i < lf.keys.size(); ++i) lf.b += lf.A[i] * deltas[i];
+  return lf;
+}
+
+std::vector<Key> BayesTreeEngine::order(const std::vector<Key>& keys,
+                                        const std::vector<const LinearFactor*>& factors,
+                                        const Values& new_vars) const {
+  std::vector<Key> out = keys;
+  if (mode_ == OrderingMode::TimeOrdered || keys.size() <= 2) {
+    std::sort(out.begin(), out.end());  // Key order: states by step, constants last
+    return out;
+  }
+  // CCOLAMD on the factor × variable incidence, with constraint groups:
+  // 0 = older variables, 1 = the newest variables, 2 = constants (root).
+  std::unordered_map<Key, int, KeyHash> col;
+  for (std::size_t i = 0; i < keys.size(); ++i) col[keys[i]] = static_cast<int>(i);
+  std::vector<std::vector<int>> rows_of_col(keys.size());
+  int nrow = 0;
+  for (const auto* f : factors) {
+    bool any = false;
+    for (const auto& k : f->keys) {
+      auto it = col.find(k);
+      if (it != col.end()) {
+        rows_of_col[static_cast<std::size_t>(it->second)].push_back(nrow);
+        any = true;
+      }
+    }
+    if (any) ++nrow;
+  }
+  const int ncol = static_cast<int>(keys.size());
+  std::vector<int> p(static_cast<std::size_t>(ncol) + 1, 0), A;
+  for (int j = 0; j < ncol; ++j) {
+    p[static_cast<std::size_t>(j) + 1] = p[static_cast<std::size_t>(j)] +
+                                         static_cast<int>(rows_of_col[static_cast<std::size_t>(j)].size());
+    for (int r : rows_of_col[static_cast<std::size_t>(j)]) A.push_back(r);
+  }
+  const std::size_t alen = ccolamd_recommended(static_cast<int>(A.size()), nrow, ncol);
+  A.resize(std::max<std::size_t>(alen, A.size()));
+  std::vector<int> cmember(static_cast<std::size_t>(ncol));
+  for (int j = 0; j < ncol; ++j) {
+    const Key& k = keys[static_cast<std::size_t>(j)];
+    cmember[static_cast<std::size_t>(j)] = k.isConstants() ? 2 : (new_vars.contains(k) ? 1 : 0);
+  }
+  double knobs[CCOLAMD_KNOBS];
+  int stats[CCOLAMD_STATS];
+  ccolamd_set_defaults(knobs);
+  if (!ccolamd(nrow, ncol, static_cast<int>(A.size()), A.data(), p.data(), knobs, stats,
+               cmember.data())) {
+    std::sort(out.begin(), out.end());  // CCOLAMD failed: fall back to time order
+    return out;
+  }
+  for (int i = 0; i < ncol; ++i) out[static_cast<std::size_t>(i)] = keys[static_cast<std::size_t>(p[static_cast<std::size_t>(i)])];
+  return out;
+}
+
+void BayesTreeEngine::update(const Values& new_variables, const std::vector<FactorPtr>& new_factors,
+                             const std::vector<LinearFactor>& new_linear,
+                             const std::vector<int>& relinearize, EngineCounts& counts,
+                             double damping) {
+  // ---- 1. validate and linearize (nothing modified yet) -------------------
+  for (const auto& kv : new_variables) {
+    if (vars_.count(kv.first))
+      throw InvalidArgument("variable " + kv.first.toString() + " already exists");
+    if (!kv.second.allFinite())
+      throw InvalidArgument("initial value of " + kv.first.toString() + " is not finite");
+  }
+  auto known = [&](const Key& k) { return vars_.count(k) || new_variables.contains(k); };
+  std::vector<LinearFactor> lin_new;
+  for (const auto& f : new_factors) {
+    for (const auto& k : f->keys())
+      if (!known(k))
+        throw InvalidArgument("factor '" + f->describe() + "' uses " + k.toString() +
+                              ", which is neither in the smoother nor added with it");
+    lin_new.push_back(linearize(*f, new_variables));
+  }
+  for (const auto& lf : new_linear)
+    for (const auto& k : lf.keys)
+      if (!known(k)) throw InvalidArgument("linear factor uses unknown variable " + k.toString());
+  std::unordered_map<int, LinearFactor> relin;
+  for (int s : relinearize) {
+    const Slot& slot = slots_.at(static_cast<std::size_t>(s));
+    if (slot.alive && slot.nonlinear) relin[s] = linearize(*slot.nonlinear, new_variables);
+  }
+
+  // ---- 2. the top of the tree to re-eliminate ------------------------------
+  std::unordered_set<int> removed;
+  std::vector<int> removed_order;
+  auto markUp = [&](const Key& k) {
+    auto it = vars_.find(k);
+    if (it == vars_.end()) return;
+    for (int c = it->second.clique; c >= 0 && !removed.count(c);
+         c = cliques_[static_cast<std::size_t>(c)].parent) {
+      removed.insert(c);
+      removed_order.push_back(c);
+    }
+  };
+  for (const auto& lf : lin_new)
+    for (const auto& k : lf.keys) markUp(k);
+  for (const auto& lf : new_linear)
+    for (const auto& k : lf.keys) markUp(k);
+  for (const auto& kv : relin)
+    for (const auto& k : kv.second.keys) markUp(k);
+
+  // Inputs: factors owned by removed cliques, new factors, orphans' marginals.
+  struct Input {
+    const LinearFactor* f;
+    int slot;  // >= 0: an existing slot; -1 - i: new nonlinear i; -1000000 - i: new linear i; orphan: INT_MIN
+  };
+  constexpr int kOrphan = std::numeric_limits<int>::min();
+  constexpr int kNewLinearBase = -1000000000;
+  std::vector<Input> inputs;
+  std::vector<Key> keys;
+  std::vector<int> orphans;
+  for (int c : removed_order) {
+    const Clique& cl = cliques_[static_cast<std::size_t>(c)];
+    keys.push_back(cl.frontal);
+    for (int s : cl.owned) {
+      auto it = relin.find(s);
+      inputs.push_back({it != relin.end() ? &it->second : &slots_[static_cast<std::size_t>(s)].linear, s});
+    }
+    for (int ch : cl.children)
+      if (!removed.count(ch)) orphans.push_back(ch);
+  }
+  for (const auto& kv : new_variables) keys.push_back(kv.first);
+  for (std::size_t i = 0; i < lin_new.size(); ++i) inputs.push_back({&lin_new[i], -1 - static_cast<int>(i)});
+  for (std::size_t i = 0; i < new_linear.size(); ++i)
+    inputs.push_back({&new_linear[i], kNewLinearBase + static_cast<int>(i)});
+  for (int o : orphans) inputs.push_back({&cliques_[static_cast<std::size_t>(o)].marginal, kOrphan});
+
+  std::vector<const LinearFactor*> fptrs;
+  for (const auto& in : inputs) fptrs.push_back(in.f);
+  const std::vector<Key> ordering = order(keys, fptrs, new_variables);
+  std::unordered_map<Key, std::size_t, KeyHash> pos;
+  for (std::size_t i = 0; i < ordering.size(); ++i) pos[ordering[i]] = i;
+  std::unordered_map<Key, Eigen::Index, KeyHash> dims;
+  for (const auto& k : ordering)
+    dims[k] = vars_.count(k) ? vars_.at(k).anchor.size() : new_variables.at(k).size();
+
+  // ---- 3. eliminate in order into new cliques (still nothing modified) ----
+  // Dense elimination of one variable at a time (the paper's window system
+  // A_w X_w = b_w, solved by QR clique by clique): stack the factors [A | b]
+  // with v first, triangularize, split R into the conditional on v and the
+  // marginal factor on its separator.
+  std::vector<std::vector<std::size_t>> pending_of(ordering.size());
+  std::vector<const LinearFactor*> pend;
+  std::vector<int> pend_slot;
+  std::vector<bool> used;
+  auto addPending = [&](const LinearFactor* f, int slot) {
+    const std::size_t id = pend.size();
+    pend.push_back(f);
+    pend_slot.push_back(slot);
+    used.push_back(false);
+    std::size_t first = ordering.size();
+    for (const auto& k : f->keys) first = std::min(first, pos.at(k));
+    if (first < ordering.size()) pending_of[first].push_back(id);
+  };
+  for (const auto& in : inputs) {
+    bool empty = true;
+    for (const auto& k : in.f->keys) empty = empty && !pos.count(k);
+    if (empty) continue;  // cannot happen for a consistent tree
+    addPending(in.f, in.slot);
+  }
+  std::vector<Clique> fresh(ordering.size());
+  for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
+    const Key& v = ordering[vi];
+    Clique& cl = fresh[vi];
+    cl.frontal = v;
+    // Union of keys, v first then by position.
+    std::vector<Key> sep;
+    Eigen::Index rows = 0;
+    for (std::size_t id : pending_of[vi]) {
+      rows += pend[id]->b.size();
+      for (const auto& k : pend[id]->keys)
+        if (k != v && std::find(sep.begin(), sep.end(), k) == sep.end()) sep.push_back(k);
+    }
+    std::sort(sep.begin(), sep.end(), [&](const Key& a, const Key& b) { return pos.at(a) < pos.at(b); });
+    const Eigen::Index dv = dims.at(v);
+    std::unordered_map<Key, Eigen::Index, KeyHash> colOf;
+    Eigen::Index ncols = dv;
+    colOf[v] = 0;
+    for (const auto& k : sep) {
+      colOf[k] = ncols;
+      ncols += dimOf(dims, k);
+    }
+    const Eigen::Index damp_rows = damping > 0 ? dv : 0;
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(rows + damp_rows, ncols + 1);
+    Eigen::Index r0 = 0;
+    for (std::size_t id : pending_of[vi]) {
+      const LinearFactor& f = *pend[id];
+      for (std::size_t i = 0; i < f.keys.size(); ++i)
+        M.block(r0, colOf.at(f.keys[i]), f.b.size(), f.A[i].cols()) = f.A[i];
+      M.block(r0, ncols, f.b.size(), 1) = f.b;
+      r0 += f.b.size();
+      if (pend_slot[id] != kOrphan) cl.owned.push_back(pend_slot[id]);
+    }
+    if (damp_rows > 0) {
+      // Marquardt rows pull δ_v toward its current value: √λ·D (δ_v − δ̂_v) = 0.
+      const Eigen::VectorXd& dhat = vars_.count(v) ? vars_.at(v).delta : Eigen::VectorXd(Eigen::VectorXd::Zero(dv));
+      for (Eigen::Index i = 0; i < dv; ++i) {
+        const double w = std::sqrt(damping) * std::max(M.col(i).head(rows).norm(), 1e-12);
+        M(rows + i, i) = w;
+        M(rows + i, ncols) = w * dhat[i];
+      }
+      rows += damp_rows;
+    }
+    if (rows < dv) {
+      std::ostringstream os;
+      os << "cannot determine " << v.toString() << (v.isConstants() ? " (constants)" : " (a time-series state)")
+         << ": the factors on it have " << rows << " rows for " << dv
+         << " unknowns (unobserved; add a prior or a measurement of it)";
+      throw NumericalError(os.str());
+    }
+    Eigen::HouseholderQR<Eigen::MatrixXd> qr(M);
+    const Eigen::Index rk = std::min(rows, ncols + 1);
+    Eigen::MatrixXd Rfull = qr.matrixQR().topRows(rk).triangularView<Eigen::Upper>();
+    const double scale = std::max(1e-300, M.leftCols(dv).cwiseAbs().maxCoeff());
+    for (Eigen::Index i = 0; i < dv; ++i)
+      if (!(std::abs(Rfull(i, i)) > 1e-10 * scale)) {
+        std::ostringstream os;
+        os << "the information on " << v.toString()
+           << (v.isConstants() ? " (constants)" : " (a time-series state)") << " component " << i
+           << " is zero or rank-deficient given the variables eliminated after it";
+        if (!sep.empty()) {
+          os << " (";
+          for (std::size_t j = 0; j < sep.size(); ++j) os << (j ? ", " : "") << sep[j].toString();
+          os << ")";
+        }
+        os << ": the data do not determine it (e.g. a range at x = h = 0, a constant nothing "
+              "observes); add a prior or check the model";
+        throw NumericalError(os.str());
+      }
+    cl.R = Rfull.topLeftCorner(dv, dv);
+    cl.S = Rfull.block(0, dv, dv, ncols - dv);
+    cl.d = Rfull.block(0, ncols, dv, 1);
+    cl.separator = sep;
+    // The remaining rows are the marginal factor on the separator.
+    LinearFactor& m = cl.marginal;
+    m.keys = sep;
+    const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
+    m.b = Rfull.block(dv, ncols, mrows, 1);
+    for (const auto& k : sep) m.A.push_back(Rfull.block(dv, colOf.at(k), mrows, dimOf(dims, k)));
+    if (!sep.empty() && mrows > 0) addPending(&m, kOrphan);
+  }
+
+  // ---- 4. commit ----------------------------------------------------------
+  for (auto& kv : relin) {
+    slots_[static_cast<std::size_t>(kv.first)].linear = std::move(kv.second);
+    ++counts.factors_relinearized;
+  }
+  for (int c : removed_order) {
+    clique_alive_[static_cast<std::size_t>(c)] = false;
+    cliques_[static_cast<std::size_t>(c)] = Clique{};
+    free_cliques_.push_back(c);
+    --cliques_alive_;
+  }
+  for (const auto& kv : new_variables) {
+    Var v;
+    v.anchor = kv.second;
+    v.delta = Eigen::VectorXd::Zero(kv.second.size());
+    vars_[kv.first] = std::move(v);
+  }
+  auto registerSlot = [&](int s) {
+    const Slot& slot = slots_[static_cast<std::size_t>(s)];
+    bool only_constants = true;
+    for (const auto& k : slot.linear.keys)
+      if (!k.isConstants()) {
+        slots_by_key_[k].push_back(s);
+        only_constants = false;
+      }
+    if (only_constants) constant_only_slots_.push_back(s);
+  };
+  std::vector<int> new_slot_of(lin_new.size()), new_lin_slot_of(new_linear.size());
+  for (std::size_t i = 0; i < lin_new.size(); ++i) {
+    const int s = allocSlot();
+    slots_[static_cast<std::size_t>(s)] = Slot{new_factors[i], std::move(lin_new[i]), -1, true};
+    new_slot_of[i] = s;
+    registerSlot(s);
+  }
+  for (std::size_t i = 0; i < new_linear.size(); ++i) {
+    const int s = allocSlot();
+    slots_[static_cast<std::size_t>(s)] = Slot{nullptr, new_linear[i], -1, true};
+    new_lin_slot_of[i] = s;
+    registerSlot(s);
+  }
+  std::vector<int> fresh_id(ordering.size());
+  for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
+    const int c = allocClique();
+    fresh_id[vi] = c;
+    for (int& s : fresh[vi].owned) {
+      if (s <= kNewLinearBase + static_cast<int>(new_linear.size()) && s >= kNewLinearBase)
+        s = new_lin_slot_of[static_cast<std::size_t>(s - kNewLinearBase)];
+      else if (s < 0)
+        s = new_slot_of[static_cast<std::size_t>(-1 - s)];
+      slots_[static_cast<std::size_t>(s)].owner = c;
+    }
+    Var& var = vars_.at(ordering[vi]);
+    var.clique = c;
+    var.rank = next_rank_++;
+  }
+  for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
+    Clique& cl = fresh[vi];
+    cl.parent = cl.separator.empty() ? -1 : vars_.at(cl.separator.front()).clique;
+    cliques_[static_cast<std::size_t>(fresh_id[vi])] = std::move(cl);
+  }
+  root_ = -1;
+  for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
+    const int c = fresh_id[vi];
+    const int p = cliques_[static_cast<std::size_t>(c)].parent;
+    if (p >= 0) cliques_[static_cast<std::size_t>(p)].children.push_back(c);
+    else root_ = c;
+  }
+  for (int o : orphans) {
+    Clique& oc = cliques_[static_cast<std::size_t>(o)];
+    int best = -1;
+    std::int64_t best_rank = 0;
+    for (const auto& k : oc.separator) {
+      const Var& v = vars_.at(k);
+      if (best < 0 || v.rank < best_rank) {
+        best = v.clique;
+        best_rank = v.rank;
+      }
+    }
+    oc.parent = best;
+    cliques_[static_cast<std::size_t>(best)].children.push_back(o);
+  }
+  if (root_ < 0)
+    for (std::size_t c = 0; c < cliques_.size(); ++c)
+      if (clique_alive_[c] && cliques_[c].parent < 0) root_ = static_cast<int>(c);
+  counts.cliques_reeliminated += static_cast<int>(ordering.size());
+  counts.top = ordering;
+  counts.orphans += static_cast<int>(orphans.size());
+
+  // ---- 5. back-substitution: the new top, then wildfire into orphans ------
+  std::unordered_set<int> changed;
+  for (std::size_t vi = ordering.size(); vi-- > 0;) {
+    backSubstitute(fresh_id[vi]);
+    ++counts.variables_backsubstituted;
+  }
+  // Wildfire: descend into subtrees while a separator variable moved more
+  // than the threshold since that subtree was last solved.
+  std::vector<int> stack(orphans.begin(), orphans.end());
+  while (!stack.empty()) {
+    const int c = stack.back();
+    stack.pop_back();
+    Var& v = vars_.at(cliques_[static_cast<std::size_t>(c)].frontal);
+    const Eigen::VectorXd old = v.delta;
+    backSubstitute(c);
+    ++counts.variables_backsubstituted;
+    if ((v.delta - old).lpNorm<Eigen::Infinity>() > wildfire_)
+      for (int ch : cliques_[static_cast<std::size_t>(c)].children) stack.push_back(ch);
+  }
+}
+
+void BayesTreeEngine::backSubstitute(int c) {
+  const Clique& cl = cliques_[static_cast<std::size_t>(c)];
+  Eigen::VectorXd rhs = cl.d;
+  Eigen::Index col = 0;
+  for (const auto& k : cl.separator) {
+    const Eigen::VectorXd& ds = vars_.at(k).delta;
+    rhs -= cl.S.middleCols(col, ds.size()) * ds;
+    col += ds.size();
+  }
+  vars_.at(cl.frontal).delta = cl.R.triangularView<Eigen::Upper>().solve(rhs);
+}
+
+void BayesTreeEngine::setEstimates(const Values& x) {
+  for (const auto& kv : x) {
+    Var& v = vars_.at(kv.first);
+    v.delta = kv.second - v.anchor;
+  }
+}
+
+Values BayesTreeEngine::allEstimates() const {
+  Values out;
+  for (const auto& kv : vars_) out.insert(kv.first, kv.second.anchor + kv.second.delta);
+  return out;
+}
+
+int BayesTreeEngine::solveAll() {
+  if (root_ < 0) return 0;
+  int n = 0;
+  std::vector<int> stack{root_};
+  while (!stack.empty()) {
+    const int c = stack.back();
+    stack.pop_back();
+    backSubstitute(c);
+    ++n;
+    for (int ch : cliques_[static_cast<std::size_t>(c)].children) stack.push_back(ch);
+  }
+  return n;
+}
+
+void BayesTreeEngine::solvePath(const Key& k) {
+  std::vector<int> path;
+  for (int c = vars_.at(k).clique; c >= 0; c = cliques_[static_cast<std::size_t>(c)].parent) path.push_back(c);
+  for (auto it = path.rbegin(); it != path.rend(); ++it) backSubstitute(*it);
+}
+
+Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& keys) const {
+  // The cliques from the lowest requested key to the root form a Bayes net
+  // on their frontal variables (each separator lies on the path above), so
+  // Σ_path = (R_pathᵀ R_path)⁻¹ with R_path block upper triangular.
+  const Key* lowest = nullptr;
+  for (const auto& k : keys) {
+    if (!vars_.count(k)) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
+    if (!lowest || vars_.at(k).rank < vars_.at(*lowest).rank) lowest = &k;
+  }
+  std::vector<int> path;
+  for (int c = vars_.at(*lowest).clique; c >= 0; c = cliques_[static_cast<std::size_t>(c)].parent)
+    path.push_back(c);
+  std::unordered_map<Key, Eigen::Index, KeyHash> off;
+  Eigen::Index n = 0;
+  for (int c : path) {
+    const Key& f = cliques_[static_cast<std::size_t>(c)].frontal;
+    off[f] = n;
+    n += vars_.at(f).anchor.size();
+  }
+  for (const auto& k : keys)
+    if (!off.count(k))
+      throw InvalidArgument("pathMarginalCovariance: " + k.toString() + " is not on the root path of " +
+                            lowest->toString());
+  std::vector<Eigen::Triplet<double>> trip;
+  for (int c : path) {
+    const Clique& cl = cliques_[static_cast<std::size_t>(c)];
+    const Eigen::Index r0 = off.at(cl.frontal);
+    for (Eigen::Index i = 0; i < cl.R.rows(); ++i)
+      for (Eigen::Index j = i; j < cl.R.cols(); ++j) trip.emplace_back(r0 + i, r0 + j, cl.R(i, j));
+    Eigen::Index col = 0;
+    for (const auto& k : cl.separator) {
+      const Eigen::Index dk = vars_.at(k).anchor.size();
+      const Eigen::Index c0 = off.at(k);
+      for (Eigen::Index i = 0; i < cl.S.rows(); ++i)
+        for (Eigen::Index j = 0; j < dk; ++j) trip.emplace_back(r0 + i, c0 + j, cl.S(i, col + j));
+      col += dk;
+    }
+  }
+  Eigen::SparseMatrix<double> R(n, n);
+  R.setFromTriplets(trip.begin(), trip.end());
+  Eigen::Index m = 0;
+  for (const auto& k : keys) m += vars_.at(k).anchor.size();
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, m);
+  Eigen::Index c = 0;
+  for (const auto& k : keys)
+    for (Eigen::Index j = 0; j < vars_.at(k).anchor.size(); ++j) E(off.at(k) + j, c++) = 1.0;
+  // Σ = R⁻¹ R⁻ᵀ, so Σ_req = Yᵀ Y with Y = R⁻ᵀ E.
+  const Eigen::MatrixXd Y = Eigen::SparseMatrix<double>(R.transpose()).triangularView<Eigen::Lower>().solve(E);
+  const Eigen::MatrixXd S = Y.transpose() * Y;
+  return 0.5 * (S + S.transpose());
+}
+
+double BayesTreeEngine::linearizationError(int slot) const {
+  const Slot& s = slots_.at(static_cast<std::size_t>(slot));
+  if (!s.nonlinear) return 0.0;
+  Values x;
+  Eigen::VectorXd rlin = -s.linear.b;
+  for (std::size_t i = 0; i < s.linear.keys.size(); ++i) {
+    const Var& v = vars_.at(s.linear.keys[i]);
+    x.insert(s.linear.keys[i], v.anchor + v.delta);
+    rlin += s.linear.A[i] * v.delta;
+  }
+  Eigen::VectorXd r;
+  s.nonlinear->linearize(x, r, nullptr);
+  return (r - rlin).norm();
+}
+
+std::vector<int> BayesTreeEngine::nonlinearSlots() const {
+  std::vector<int> out;
+  for (std::size_t i = 0; i < slots_.size(); ++i)
+    if (slots_[i].alive && slots_[i].nonlinear) out.push_back(static_cast<int>(i));
+  return out;
+}
+
+std::vector<int> BayesTreeEngine::slotsOf(const Key& k) const {
+  std::vector<int> out;
+  const std::vector<int>* list = nullptr;
+  if (k.isConstants()) return nonlinearSlots();
+  auto it = slots_by_key_.find(k);
+  if (it != slots_by_key_.end()) list = &it->second;
+  if (list)
+    for (int s : *list)
+      if (slots_[static_cast<std::size_t>(s)].alive && slots_[static_cast<std::size_t>(s)].nonlinear) out.push_back(s);
+  return out;
+}
+
+double BayesTreeEngine::cost() const {
+  double c = 0;
+  for (const auto& s : slots_) {
+    if (!s.alive) continue;
+    if (s.nonlinear) {
+      Values x;
+      for (const auto& k : s.linear.keys) x.insert(k, vars_.at(k).anchor + vars_.at(k).delta);
+      c += s.nonlinear->cost(x);
+    } else {
+      Eigen::VectorXd r = -s.linear.b;
+      for (std::size_t i = 0; i < s.linear.keys.size(); ++i) r += s.linear.A[i] * vars_.at(s.linear.keys[i]).delta;
+      c += 0.5 * r.squaredNorm();
+    }
+  }
+  return c;
+}
+
+void BayesTreeEngine::marginalizeLeaf(const Key& key) {
+  auto vit = vars_.find(key);
+  if (vit == vars_.end()) throw InvalidArgument("marginalize: no variable " + key.toString());
+  const int c = vit->second.clique;
+  Clique& cl = cliques_[static_cast<std::size_t>(c)];
+  if (!cl.children.empty())
+    throw NumericalError("marginalize: " + key.toString() +
+                         " is not a leaf of the Bayes tree (internal ordering error)");
+  const int parent = cl.parent;
+  // Drop the factors this clique consumed; they are summarized by its marginal.
+  for (int s : cl.owned) {
+    Slot& slot = slots_[static_cast<std::size_t>(s)];
+    for (const auto& k : slot.linear.keys) {
+      if (k.isConstants()) continue;
+      auto it = slots_by_key_.find(k);
+      if (it == slots_by_key_.end()) continue;
+      auto& v = it->second;
+      v.erase(std::remove(v.begin(), v.end(), s), v.end());
+    }
+    constant_only_slots_.erase(std::remove(constant_only_slots_.begin(), constant_only_slots_.end(), s),
+                               constant_only_slots_.end());
+    slot = Slot{};
+    free_slots_.push_back(s);
+    --slots_alive_;
+  }
+  slots_by_key_.erase(key);
+  // Its marginal on the separator becomes a fixed linear prior (first-estimate
+  // Jacobians), owned by the parent, which consumed it when it was eliminated.
+  if (parent >= 0 && cl.marginal.b.size() > 0) {
+    const int s = allocSlot();
+    slots_[static_cast<std::size_t>(s)] = Slot{nullptr, std::move(cl.marginal), parent, true};
+    bool only_constants = true;
+    for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys)
+      if (!k.isConstants()) {
+        slots_by_key_[k].push_back(s);
+        only_constants = false;
+      }
+    if (only_constants) constant_only_slots_.push_back(s);
+    cliques_[static_cast<std::size_t>(parent)].owned.push_back(s);
+  }
+  if (parent >= 0) {
+    auto& ch = cliques_[static_cast<std::size_t>(parent)].children;
+    ch.erase(std::remove(ch.begin(), ch.end(), c), ch.end());
+  } else {
+    root_ = -1;
+  }
+  cliques_[static_cast<std::size_t>(c)] = Clique{};
+  clique_alive_[static_cast<std::size_t>(c)] = false;
+  free_cliques_.push_back(c);
+  --cliques_alive_;
+  vars_.erase(vit);
+}
+
+}  // namespace gssm::internal

@@ -1,0 +1,142 @@
+#pragma once
+// Internal: the incremental elimination engine behind IncrementalSmoother and
+// FixedLagSmoother (iSAM2 class). A Bayes tree of single-frontal cliques, each
+// holding a dense Gaussian conditional R δ_f + S δ_sep = d, obtained by QR
+// elimination of the whitened linearized factors in δ coordinates
+// (x = anchor + δ). Updates re-eliminate only the top of the tree that new or
+// relinearized factors touch, and are transactional: on any exception the
+// engine is left exactly as before.
+//
+// Each nonlinear factor keeps its own linearization (per-factor, not
+// per-variable, relinearization: DESIGN.md §5). Anchors never move, so
+// relinearizing one factor changes only that factor's rows.
+#include <Eigen/Core>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "gssm/factors.h"
+
+namespace gssm::internal {
+
+/// Whitened linear factor in δ coordinates: r(δ) = Σ_i A_i δ_{keys[i]} − b.
+struct LinearFactor {
+  std::vector<Key> keys;
+  std::vector<Eigen::MatrixXd> A;
+  Eigen::VectorXd b;
+};
+
+struct Clique {
+  Key frontal;
+  std::vector<Key> separator;
+  Eigen::MatrixXd R, S;  // R upper triangular (d_f × d_f), S (d_f × Σ d_sep)
+  Eigen::VectorXd d;
+  LinearFactor marginal;  // what this subtree passes to its parent (on the separator)
+  std::vector<int> owned;  // factor slots consumed by this clique's elimination
+  int parent = -1;
+  std::vector<int> children;
+};
+
+enum class OrderingMode {
+  TimeOrdered,        ///< states by step, constants last (oldest state always a leaf)
+  ConstrainedColamd,  ///< CCOLAMD with constants last and the newest variables next to them
+};
+
+struct EngineCounts {
+  std::vector<Key> top;  // variables re-eliminated by the last engine update
+  int cliques_reeliminated = 0;
+  int orphans = 0;
+  int factors_relinearized = 0;
+  int variables_backsubstituted = 0;
+};
+
+class BayesTreeEngine {
+ public:
+  explicit BayesTreeEngine(OrderingMode mode, double wildfire_threshold)
+      : mode_(mode), wildfire_(wildfire_threshold) {}
+
+  /// Adds variables (initial values become their anchors), nonlinear and
+  /// fixed linear factors, and relinearizes the given factor slots at the
+  /// current estimate; re-eliminates the affected top of the tree and
+  /// back-substitutes. Strong exception guarantee.
+  /// `damping` λ > 0 adds Levenberg–Marquardt rows √λ·diag(‖A_v‖)(δ_v − δ̂_v)
+  /// to every variable eliminated (used by the iterate-to-convergence mode).
+  void update(const Values& new_variables, const std::vector<FactorPtr>& new_factors,
+              const std::vector<LinearFactor>& new_linear, const std::vector<int>& relinearize,
+              EngineCounts& counts, double damping = 0.0);
+
+
+  /// Removes a variable whose clique is a leaf; its subtree's marginal on the
+  /// separator becomes a fixed linear factor (exact marginalization).
+  void marginalizeLeaf(const Key& key);
+
+  bool hasVariable(const Key& k) const { return vars_.count(k) != 0; }
+  std::size_t numVariables() const { return vars_.size(); }
+  std::size_t numFactors() const { return slots_alive_; }
+  std::size_t numCliques() const { return cliques_alive_; }
+
+  /// Current estimate anchor + δ (δ as of the last back-substitution that
+  /// reached this variable; see solveAll()).
+  Eigen::VectorXd estimate(const Key& k) const;
+  /// Sets δ so that the estimate of every variable in `x` is x (used by
+  /// line searches; the next elimination must relinearize there).
+  void setEstimates(const Values& x);
+  /// anchor + δ of every variable.
+  Values allEstimates() const;
+  /// Back-substitutes the whole tree (δ of every variable up to date).
+  int solveAll();
+  /// Back-substitutes the path from the root to `k` only.
+  void solvePath(const Key& k);
+
+  /// Joint marginal covariance of keys that all lie on one root path (e.g. a
+  /// state and the constants), from the conditionals on that path.
+  Eigen::MatrixXd pathMarginalCovariance(const std::vector<Key>& keys) const;
+
+  /// Whitened nonlinearity error ‖r(x̂) − r_lin(δ̂)‖ of a nonlinear slot at
+  /// the current estimate; 0 for linear slots.
+  double linearizationError(int slot) const;
+  /// Slots of nonlinear factors (alive).
+  std::vector<int> nonlinearSlots() const;
+  /// Alive nonlinear slots whose keys include k.
+  std::vector<int> slotsOf(const Key& k) const;
+  const FactorPtr& factorOf(int slot) const { return slots_[static_cast<std::size_t>(slot)].nonlinear; }
+  /// ½‖r‖² of every alive factor at the current estimate (nonlinear factors
+  /// exactly, linear ones by their linear model).
+  double cost() const;
+
+ private:
+  struct Var {
+    Eigen::VectorXd anchor, delta;
+    int clique = -1;
+    std::int64_t rank = 0;  // elimination rank: larger = closer to the root
+  };
+  struct Slot {
+    FactorPtr nonlinear;  // null: a fixed linear factor
+    LinearFactor linear;
+    int owner = -1;
+    bool alive = false;
+  };
+
+  LinearFactor linearize(const Factor& f, const Values& extra) const;
+  std::vector<Key> order(const std::vector<Key>& keys, const std::vector<const LinearFactor*>& factors,
+                         const Values& new_vars) const;
+  void backSubstitute(int c);
+  int allocClique();
+  int allocSlot();
+
+  OrderingMode mode_;
+  double wildfire_;
+  std::unordered_map<Key, Var, KeyHash> vars_;
+  std::vector<Clique> cliques_;
+  std::vector<bool> clique_alive_;
+  std::vector<int> free_cliques_;
+  std::vector<Slot> slots_;
+  std::vector<int> free_slots_;
+  std::unordered_map<Key, std::vector<int>, KeyHash> slots_by_key_;  // non-constant keys only
+  std::vector<int> constant_only_slots_;
+  std::size_t slots_alive_ = 0, cliques_alive_ = 0;
+  std::int64_t next_rank_ = 0;
+  int root_ = -1;
+};
+
+}  // namespace gssm::internal

@@ -1,0 +1,30 @@
+#pragma once
+// Internal: the relinearization policy and reporting shared by
+// IncrementalSmoother and FixedLagSmoother, over the Bayes tree engine.
+#include "gssm/smoothers.h"
+#include "solvers/bayes_tree.h"
+
+namespace gssm {
+
+class SmootherCore {
+ public:
+  SmootherCore(const SmootherOptions& options, internal::OrderingMode mode);
+
+  /// One update: add, then relinearize the top (start-up), then a full check
+  /// when the constants moved, or iterate to convergence. Strong guarantee for
+  /// the add; a failed relinearization is skipped and noted in the report.
+  UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values);
+  void fillSizes(UpdateReport& r) const;
+
+  internal::BayesTreeEngine engine;
+  SmootherOptions options;
+  UpdateReport last;
+
+ private:
+  void relinearize(const std::vector<int>& candidates, double threshold, UpdateReport& rep,
+                   internal::EngineCounts& counts);
+  void iterateToConvergence(UpdateReport& rep, internal::EngineCounts& counts);
+  Eigen::VectorXd constants_at_last_check_;
+};
+
+}  // namespace gssm

@@ -1,0 +1,280 @@
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+#include "gssm/error.h"
+#include "gssm/smoothers.h"
+#include "solvers/smoother_core.h"
+
+namespace gssm {
+
+std::string UpdateReport::toString() const {
+  std::ostringstream os;
+  os << "update: +" << new_factors << " factors, +" << new_variables << " variables; "
+     << cliques_reeliminated << " cliques re-eliminated (" << orphans << " orphans), "
+     << factors_relinearized << "/" << factors_checked << " factors relinearized/checked"
+     << (relinearization_pass ? " [full pass]" : "") << ", " << iterations << " iterations, "
+     << variables_backsubstituted << " back-substituted, " << variables_marginalized
+     << " marginalized; now " << num_variables << " variables, " << num_factors << " factors, "
+     << num_cliques << " cliques; " << seconds * 1e6 << " us";
+  if (!note.empty()) os << "; " << note;
+  return os.str();
+}
+
+bool SmootherOptions::validate(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = "SmootherOptions: " + m;
+    return false;
+  };
+  if (!(relinearize_threshold > 0)) return fail("relinearize_threshold must be > 0");
+  if (!(constants_check_sigmas > 0)) return fail("constants_check_sigmas must be > 0");
+  if (max_local_iterations < 0) return fail("max_local_iterations must be >= 0");
+  if (!(wildfire_threshold >= 0)) return fail("wildfire_threshold must be >= 0");
+  if (!(convergence_tolerance > 0)) return fail("convergence_tolerance must be > 0");
+  if (max_iterations < 1) return fail("max_iterations must be >= 1");
+  return true;
+}
+
+bool FixedLagSmootherOptions::validate(std::string* why) const {
+  if (window < 1) {
+    if (why) *why = "FixedLagSmootherOptions: window must be >= 1 (got " + std::to_string(window) + ")";
+    return false;
+  }
+  return smoother.validate(why);
+}
+
+namespace {
+internal::OrderingMode toMode(EliminationOrdering o) {
+  return o == EliminationOrdering::TimeOrdered ? internal::OrderingMode::TimeOrdered
+                                               : internal::OrderingMode::ConstrainedColamd;
+}
+const SmootherOptions& validated(const SmootherOptions& o) {
+  std::string why;
+  if (!o.validate(&why)) throw InvalidArgument(why);
+  return o;
+}
+}  // namespace
+
+SmootherCore::SmootherCore(const SmootherOptions& o, internal::OrderingMode mode)
+    : engine(mode, validated(o).wildfire_threshold), options(o) {}
+
+void SmootherCore::fillSizes(UpdateReport& r) const {
+  r.num_variables = engine.numVariables();
+  r.num_factors = engine.numFactors();
+  r.num_cliques = engine.numCliques();
+}
+
+void SmootherCore::relinearize(const std::vector<int>& candidates, double threshold,
+                               UpdateReport& rep, internal::EngineCounts& counts) {
+  std::vector<int> stale;
+  for (int s : candidates)
+    if (engine.linearizationError(s) > threshold) stale.push_back(s);
+  rep.factors_checked += static_cast<int>(candidates.size());
+  if (stale.empty()) return;
+  try {
+    engine.update(Values{}, {}, {}, stale, counts);
+    ++rep.iterations;
+  } catch (const NumericalError& e) {
+    // The engine is unchanged: keep the previous linearization and say so.
+    rep.note = "relinearization of " + std::to_string(stale.size()) + " factors skipped: " + e.what();
+  }
+}
+
+// Levenberg–Marquardt over the whole tree, as the batch solver does: every
+// iteration relinearizes every nonlinear factor at the current estimate
+// (not only those with a large residual error: that error is O(Δ²) while the
+// Jacobian, which sets the fixed point, changes O(Δ)) and re-eliminates with
+// Marquardt damping; a step that raises the cost is undone from a snapshot.
+// Undamped Gauss–Newton cycles on the radar start-up (prior 143σ off), where
+// x is determined only to ±5 m along a flat valley.
+void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCounts& counts) {
+  auto relChange = [](const Values& a, const Values& b) {
+    double change = 0;
+    for (const auto& kv : a) {
+      const Eigen::VectorXd& old = b.at(kv.first);
+      change = std::max(change, ((kv.second - old).array().abs() / (1.0 + old.array().abs())).maxCoeff());
+    }
+    return change;
+  };
+  counts.variables_backsubstituted += engine.solveAll();
+  Values previous = engine.allEstimates();
+  double previous_cost = engine.cost();
+  double lambda = 1e-4;
+  bool polishing = false;  // as in BatchSolver: converged while damped → finish undamped
+  for (int it = 0; it < options.max_iterations; ++it) {
+    const std::vector<int> all = engine.nonlinearSlots();
+    if (all.empty()) break;
+    internal::BayesTreeEngine snapshot = engine;
+    internal::EngineCounts trial = counts;
+    try {
+      engine.update(Values{}, {}, {}, all, trial, polishing ? 0.0 : lambda);
+    } catch (const NumericalError& e) {
+      engine = std::move(snapshot);
+      if (polishing || lambda > 1e10) {
+        rep.note = std::string("iteration stopped: ") + e.what();
+        break;
+      }
+      lambda *= 10;
+      continue;
+    }
+    ++rep.iterations;
+    rep.factors_checked += static_cast<int>(all.size());
+    trial.variables_backsubstituted += engine.solveAll();
+    const double cost = engine.cost();
+    if (!(cost <= previous_cost * (1 + (polishing ? 1e-10 : 0.0)))) {
+      engine = std::move(snapshot);  // worse: undo, damp more
+      if (polishing) break;
+      lambda *= 10;
+      if (lambda > 1e10) break;
+      continue;
+    }
+    counts = trial;
+    Values now = engine.allEstimates();
+    const double change = relChange(now, previous);
+    previous = std::move(now);
+    previous_cost = cost;
+    if (!polishing) lambda = std::max(lambda / 10, 1e-12);
+    if (change <= options.convergence_tolerance) {
+      if (polishing) break;
+      polishing = true;
+    }
+  }
+}
+
+UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, const Values& new_values) {
+  const auto start = std::chrono::steady_clock::now();
+  UpdateReport rep;
+  rep.new_factors = static_cast<int>(new_factors.size());
+  rep.new_variables = static_cast<int>(new_values.size());
+  internal::EngineCounts counts;
+  engine.update(new_values, new_factors, {}, {}, counts);  // may throw: nothing changed
+  rep.iterations = 1;
+
+  if (options.iterate_to_convergence) {
+    iterateToConvergence(rep, counts);
+    rep.relinearization_pass = true;
+  } else {
+    // Start-up nonlinearity: relinearize the factors of the top, which is
+    // being re-eliminated anyway.
+    for (int it = 0; it < options.max_local_iterations; ++it) {
+      std::vector<int> local;
+      for (const auto& k : counts.top)
+        if (!k.isConstants())
+          for (int s : engine.slotsOf(k)) local.push_back(s);
+      std::sort(local.begin(), local.end());
+      local.erase(std::unique(local.begin(), local.end()), local.end());
+      const int before = rep.iterations;
+      relinearize(local, options.relinearize_threshold, rep, counts);
+      if (rep.iterations == before) break;
+    }
+    // Old factors all touch the constants: check them all, in one bounded
+    // pass, only when the constants moved enough to matter.
+    if (engine.hasVariable(Key::constants())) {
+      const Eigen::VectorXd xb = engine.estimate(Key::constants());
+      if (constants_at_last_check_.size() != xb.size()) {
+        constants_at_last_check_ = xb;
+      } else {
+        const Eigen::VectorXd sd =
+            engine.pathMarginalCovariance({Key::constants()}).diagonal().cwiseSqrt();
+        const double moved = ((xb - constants_at_last_check_).cwiseAbs().array() / sd.array()).maxCoeff();
+        if (moved > options.constants_check_sigmas) {
+          counts.variables_backsubstituted += engine.solveAll();
+          relinearize(engine.nonlinearSlots(), options.relinearize_threshold, rep, counts);
+          rep.relinearization_pass = true;
+          constants_at_last_check_ = engine.estimate(Key::constants());
+        }
+      }
+    }
+  }
+  rep.cliques_reeliminated = counts.cliques_reeliminated;
+  rep.orphans = counts.orphans;
+  rep.factors_relinearized = counts.factors_relinearized;
+  rep.variables_backsubstituted = counts.variables_backsubstituted;
+  fillSizes(rep);
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  last = rep;
+  return rep;
+}
+
+// ---- IncrementalSmoother -------------------------------------------------------
+IncrementalSmoother::IncrementalSmoother(SmootherOptions options)
+    : core_(std::make_unique<SmootherCore>(options, toMode(options.ordering))) {}
+IncrementalSmoother::~IncrementalSmoother() = default;
+
+UpdateReport IncrementalSmoother::update(const std::vector<FactorPtr>& f, const Values& v) {
+  return core_->update(f, v);
+}
+bool IncrementalSmoother::contains(const Key& k) const { return core_->engine.hasVariable(k); }
+Eigen::VectorXd IncrementalSmoother::estimate(const Key& k) {
+  if (!contains(k)) throw InvalidArgument("IncrementalSmoother: no variable " + k.toString());
+  core_->engine.solvePath(k);
+  return core_->engine.estimate(k);
+}
+Values IncrementalSmoother::calculateEstimate() {
+  core_->engine.solveAll();
+  return core_->engine.allEstimates();
+}
+Eigen::MatrixXd IncrementalSmoother::jointMarginalCovariance(const std::vector<Key>& keys) const {
+  return core_->engine.pathMarginalCovariance(keys);
+}
+const UpdateReport& IncrementalSmoother::lastReport() const { return core_->last; }
+std::size_t IncrementalSmoother::numVariables() const { return core_->engine.numVariables(); }
+std::size_t IncrementalSmoother::numFactors() const { return core_->engine.numFactors(); }
+const SmootherOptions& IncrementalSmoother::options() const { return core_->options; }
+
+// ---- FixedLagSmoother ----------------------------------------------------------
+namespace {
+FixedLagSmootherOptions fixedLag(FixedLagSmootherOptions o) {
+  std::string why;
+  if (!o.validate(&why)) throw InvalidArgument(why);
+  o.smoother.ordering = EliminationOrdering::TimeOrdered;
+  return o;
+}
+}  // namespace
+
+FixedLagSmoother::FixedLagSmoother(FixedLagSmootherOptions options)
+    : options_(fixedLag(std::move(options))),
+      core_(std::make_unique<SmootherCore>(options_.smoother, internal::OrderingMode::TimeOrdered)) {}
+FixedLagSmoother::~FixedLagSmoother() = default;
+
+UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Values& v) {
+  std::int64_t newest = newest_, oldest = oldest_;
+  for (const auto& kv : v)
+    if (!kv.first.isConstants()) {
+      newest = std::max(newest, kv.first.step);
+      if (oldest_ < 0) oldest = oldest < 0 ? kv.first.step : std::min(oldest, kv.first.step);
+    }
+  UpdateReport rep = core_->update(f, v);
+  newest_ = newest;
+  oldest_ = oldest;
+  const auto start = std::chrono::steady_clock::now();
+  while (oldest_ >= 0 && oldest_ < newest_ - options_.window + 1) {
+    core_->engine.marginalizeLeaf(Key::state(oldest_));
+    ++oldest_;
+    ++rep.variables_marginalized;
+  }
+  core_->fillSizes(rep);
+  rep.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  core_->last = rep;
+  return rep;
+}
+
+bool FixedLagSmoother::contains(const Key& k) const { return core_->engine.hasVariable(k); }
+Eigen::VectorXd FixedLagSmoother::estimate(const Key& k) {
+  if (!contains(k)) throw InvalidArgument("FixedLagSmoother: no variable " + k.toString() + " (outside the window?)");
+  core_->engine.solvePath(k);
+  return core_->engine.estimate(k);
+}
+Values FixedLagSmoother::calculateEstimate() {
+  core_->engine.solveAll();
+  return core_->engine.allEstimates();
+}
+Eigen::MatrixXd FixedLagSmoother::jointMarginalCovariance(const std::vector<Key>& keys) const {
+  return core_->engine.pathMarginalCovariance(keys);
+}
+const UpdateReport& FixedLagSmoother::lastReport() const { return core_->last; }
+std::size_t FixedLagSmoother::numVariables() const { return core_->engine.numVariables(); }
+std::size_t FixedLagSmoother::numFactors() const { return core_->engine.numFactors(); }
+std::int64_t FixedLagSmoother::oldestStep() const { return oldest_; }
+
+}  // namespace gssm

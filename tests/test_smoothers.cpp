@@ -1,0 +1,152 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "gssm/batch_solver.h"
+#include "gssm/error.h"
+#include "gssm/models/linear.h"
+#include "gssm/models/radar2d.h"
+#include "gssm/problem.h"
+#include "gssm/simulation.h"
+#include "gssm/smoothers.h"
+#include "reference_kalman.h"
+#include "smoother_driver.h"
+
+using namespace gssm;
+using gssm::testing::relativeError;
+
+namespace {
+NormalSampler normalSampler(unsigned seed) {
+  auto rng = std::make_shared<std::mt19937>(seed);
+  auto dist = std::make_shared<std::normal_distribution<double>>(0.0, 1.0);
+  return [rng, dist] { return (*dist)(*rng); };
+}
+
+models::LinearModel randomLinear(unsigned seed) {
+  std::mt19937 rng(seed);
+  return models::LinearModel(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1));
+}
+
+Eigen::VectorXd stacked(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) {
+  Eigen::VectorXd z(xc.size() + xb.size());
+  z << xc, xb;
+  return z;
+}
+}  // namespace
+
+TEST(IncrementalSmoother, LinearModelEqualsBatchAfterEveryStep) {
+  for (auto ordering : {EliminationOrdering::ConstrainedColamd, EliminationOrdering::TimeOrdered}) {
+    const auto model = randomLinear(31);
+    SimulationSpec spec;
+    spec.steps = 40;
+    const SimulatedRun run = simulate(model, spec, normalSampler(6));
+    SmootherOptions o;
+    o.ordering = ordering;
+    IncrementalSmoother smoother(o);
+    auto [f0, v0] = gssm::testing::initialStep(model);
+    smoother.update(f0, v0);
+    for (int k = 1; k <= spec.steps; ++k) {
+      auto [f, v] = gssm::testing::nextStep(model, smoother, k, run.measurements[k - 1].y, 0.1);
+      smoother.update(f, v);
+      const std::vector<Measurement> upto(run.measurements.begin(), run.measurements.begin() + k);
+      Problem p = buildProblem(model, upto);
+      Values x = p.initial;
+      BatchSolver batch;
+      ASSERT_TRUE(batch.solve(p.graph, x).converged);
+      const Values inc = smoother.calculateEstimate();
+      for (const auto& kv : x)
+        EXPECT_LT(relativeError(inc.at(kv.first), kv.second), 1e-9) << kv.first.toString() << " at step " << k;
+      const std::vector<Key> top{Key::state(k), Key::constants()};
+      EXPECT_LT(relativeError(smoother.jointMarginalCovariance(top), batch.jointMarginalCovariance(top)), 1e-9)
+          << "step " << k;
+      const std::vector<Key> old{Key::state(k / 2), Key::constants()};
+      EXPECT_LT(relativeError(smoother.jointMarginalCovariance(old), batch.jointMarginalCovariance(old)), 1e-9)
+          << "step " << k;
+    }
+  }
+}
+
+class FixedLagVsKalman : public ::testing::TestWithParam<int> {};
+
+TEST_P(FixedLagVsKalman, NewestStateEqualsKalmanFilterAndWindowEqualsRts) {
+  const int w = GetParam();
+  const auto model = randomLinear(32);
+  SimulationSpec spec;
+  spec.steps = 30;
+  const SimulatedRun run = simulate(model, spec, normalSampler(7));
+  FixedLagSmootherOptions o;
+  o.window = w;
+  FixedLagSmoother smoother(o);
+  auto [f0, v0] = gssm::testing::initialStep(model);
+  smoother.update(f0, v0);
+  const auto stackedModel = gssm::testing::stack(model, 0.1);
+  for (int k = 1; k <= spec.steps; ++k) {
+    auto [f, v] = gssm::testing::nextStep(model, smoother, k, run.measurements[k - 1].y, 0.1);
+    const UpdateReport rep = smoother.update(f, v);
+    const std::vector<Measurement> upto(run.measurements.begin(), run.measurements.begin() + k);
+    const auto ref = gssm::testing::kalmanAndRts(stackedModel, upto);
+    const Eigen::VectorXd z = stacked(smoother.estimate(Key::state(k)), smoother.estimate(Key::constants()));
+    EXPECT_LT(relativeError(z, ref.zf[k]), 1e-9) << "w " << w << " step " << k;
+    EXPECT_LT(relativeError(smoother.jointMarginalCovariance({Key::state(k), Key::constants()}), ref.Pf[k]), 1e-9)
+        << "w " << w << " step " << k;
+    // States inside the window equal the RTS smoother over data 1..k.
+    const Values all = smoother.calculateEstimate();
+    for (std::int64_t j = smoother.oldestStep(); j <= k; ++j) {
+      EXPECT_LT(relativeError(stacked(all.at(Key::state(j)), all.at(Key::constants())), ref.zs[j]), 1e-9)
+          << "w " << w << " step " << k << " state " << j;
+      EXPECT_LT(relativeError(smoother.jointMarginalCovariance({Key::state(j), Key::constants()}), ref.Ps[j]), 1e-9)
+          << "w " << w << " step " << k << " state " << j;
+    }
+    // Bounded: window states + constants, and factors stay bounded too.
+    EXPECT_EQ(smoother.numVariables(), static_cast<std::size_t>(std::min(k + 1, w) + 1));
+    EXPECT_EQ(rep.num_variables, smoother.numVariables());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Windows, FixedLagVsKalman, ::testing::Values(1, 3, 10));
+
+TEST(IncrementalSmoother, RadarPaperEqualsBatchAfterEveryUpdateWhenIterated) {
+  const models::Radar2D radar;
+  SimulationSpec spec;
+  spec.steps = 300;
+  spec.x0 = Eigen::VectorXd::Constant(1, 0.0);
+  spec.xb = Eigen::Vector2d(100, 1000);
+  spec.process_noise = false;
+  const SimulatedRun run = simulate(radar, spec, normalSampler(1));
+  SmootherOptions o;
+  o.iterate_to_convergence = true;
+  o.convergence_tolerance = 1e-12;
+  IncrementalSmoother smoother(o);
+  auto [f0, v0] = gssm::testing::initialStep(radar);
+  smoother.update(f0, v0);
+  Values warm;  // the batch starts from its previous solution (as the smoother does)
+  for (int k = 1; k <= spec.steps; ++k) {
+    auto [f, v] = gssm::testing::nextStep(radar, smoother, k, run.measurements[k - 1].y,
+                                          run.times[k] - run.times[k - 1]);
+    const UpdateReport rep = smoother.update(f, v);
+    const std::vector<Measurement> upto(run.measurements.begin(), run.measurements.begin() + k);
+    Problem p = buildProblem(radar, upto);
+    Values x = p.initial;
+    for (const auto& kv : warm) x.at(kv.first) = kv.second;
+    // Equally strict batch: stop on the step size only (the cost change is
+    // below rounding long before the slow start-up steps have converged).
+    BatchSolverOptions bo;
+    bo.max_iterations = 5000;
+    bo.relative_cost_tolerance = 0;
+    bo.gradient_tolerance = 0;
+    bo.step_tolerance = 1e-13;
+    BatchSolver batch(bo);
+    const auto sum = batch.solve(p.graph, x);
+    ASSERT_TRUE(sum.converged) << sum.toString();
+    warm = x;
+    // Steps 1-9: the MAP has a 50σ range residual (the prior forces h > 1150
+    // while the range is ~1000) and x is determined only to ±5 m along a
+    // valley where the cost changes by 3e-7 over 4e-3 m; iterated LM in the
+    // tree and the batch LM stop up to 4e-6 apart there (open: issue 3 note).
+    const double tol = k <= 9 ? 1e-5 : 1e-6;
+    EXPECT_LT(relativeError(smoother.estimate(Key::state(k)), x.at(Key::state(k))), tol)
+        << "step " << k << ": " << rep.toString();
+    EXPECT_LT(relativeError(smoother.estimate(Key::constants()), x.at(Key::constants())), tol)
+        << "step " << k << ": " << rep.toString();
+  }
+}
