@@ -223,6 +223,10 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     Eigen::VectorXd xflat(s.n);
     for (const auto& kv : x) xflat.segment(s.offset.at(kv.first), kv.second.size()) = kv.second;
     if (delta.norm() <= options_.step_tolerance * (xflat.norm() + options_.step_tolerance)) {
+      if (polishing) {  // a tiny undamped step is still the exact correction: take it
+        x = applyStep(x, delta);
+        cost = s.linearize(graph, x, g, diag, false);
+      }
       if (converge(T::StepConverged)) break;
       continue;
     }
