@@ -1,6 +1,7 @@
 // gssm-process: the offline dataset processor. Reads a dataset folder, runs
 // the chosen estimators in streaming order and writes estimates, metrics.json
 // and a summary.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -41,16 +42,21 @@ int main(int argc, char** argv) {
                                 "scenario.ini, optional truth.csv) and writes "
                                 "estimates-<method>.csv and metrics.json to OUTDIR.");
     cli.option("data", "DIR", "dataset folder");
-    cli.option("method", "ekf|batch|all", "estimator to run", "all");
+    cli.option("method", "ekf|batch|incremental|fixed-lag|paper-window|all", "estimator to run", "all");
+    cli.option("window", "W", "states kept by fixed-lag and paper-window", "10");
     cli.option("config", "FILE", "INI file to use instead of DIR/scenario.ini");
     cli.option("out", "OUTDIR", "output folder");
     cli.parse(argc, argv);
     const std::string data = cli.require("data"), out = cli.require("out");
     const std::string method = cli.get("method");
-    std::vector<std::string> methods;
-    if (method == "all") methods = {"ekf", "batch"};
-    else if (method == "ekf" || method == "batch") methods = {method};
-    else throw std::invalid_argument("option --method = '" + method + "': expected ekf, batch or all");
+    std::vector<std::string> methods{"ekf", "batch", "incremental", "fixed-lag", "paper-window"};
+    if (method != "all") {
+      if (std::find(methods.begin(), methods.end(), method) == methods.end())
+        throw std::invalid_argument("option --method = '" + method +
+                                    "': expected ekf, batch, incremental, fixed-lag, paper-window or all");
+      methods = {method};
+    }
+    const int window = static_cast<int>(cli.getInt("window", 1, 1000000));
 
     const gssm::io::IniDocument config = gssm::io::readScenario(data, cli.get("config"));
     const auto model = gssm::io::makeModel(config);
@@ -60,9 +66,13 @@ int main(int argc, char** argv) {
 
     std::vector<gssm::RunMetrics> metrics;
     for (const auto& m : methods) {
-      gssm::OfflineRun run = m == "ekf"
-          ? gssm::runEkf(*model, gssm::io::ekfOptions(config, *model), ds.measurements)
-          : gssm::runBatch(*model, gssm::BatchSolverOptions{}, ds.measurements);
+      gssm::EstimatorOptions eo;
+      eo.method = m;
+      eo.window = window;
+      eo.ekf = gssm::io::ekfOptions(config, *model);
+      gssm::OfflineRun run = m == "batch"
+          ? gssm::runBatch(*model, gssm::BatchSolverOptions{}, ds.measurements)
+          : gssm::runStreaming(*model, eo, ds.measurements);
       writeEstimates((fs::path(out) / ("estimates-" + m + ".csv")).string(), *model, run);
       metrics.push_back(gssm::computeMetrics(*model, run, ds.truth ? &*ds.truth : nullptr));
       const auto& last = run.rows.back();

@@ -9,6 +9,7 @@
 #include "gssm/batch_solver.h"
 #include "gssm/data.h"
 #include "gssm/ekf.h"
+#include "gssm/estimator.h"
 #include "gssm/model.h"
 
 namespace gssm {
@@ -29,9 +30,12 @@ struct OfflineRun {
   std::string summary;                 ///< the solver's own report line
 };
 
-OfflineRun runEkf(const Model& model, const ExtendedKalmanFilterOptions& options,
-                  const std::vector<Measurement>& measurements,
-                  const std::vector<Input>& inputs = {});
+/// Streams the measurements (and inputs, in time order) through a streaming
+/// estimator made by makeEstimator(model, options); rows hold current()
+/// after each measurement.
+OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
+                        const std::vector<Measurement>& measurements,
+                        const std::vector<Input>& inputs = {});
 
 /// The batch MAP of the whole run; rows hold the smoothed estimate at each
 /// measurement time with its marginal covariance.

@@ -1,5 +1,6 @@
 #include "gssm/offline.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "gssm/problem.h"
@@ -13,21 +14,28 @@ double since(Clock::time_point t0) {
 }
 }  // namespace
 
-OfflineRun runEkf(const Model& model, const ExtendedKalmanFilterOptions& options,
-                  const std::vector<Measurement>& measurements, const std::vector<Input>& inputs) {
+OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
+                        const std::vector<Measurement>& measurements,
+                        const std::vector<Input>& inputs) {
   OfflineRun out;
-  out.method = "ekf";
+  out.method = options.method;
   const auto start = Clock::now();
-  ExtendedKalmanFilter ekf(model, options);
+  auto est = makeEstimator(model, options);
+  std::size_t next_input = 0;
+  out.rows.reserve(measurements.size());
+  out.update_seconds.reserve(measurements.size());
   for (const auto& m : measurements) {
+    for (; next_input < inputs.size() && inputs[next_input].t < m.t; ++next_input)
+      est->addInput(std::max(inputs[next_input].t, est->time()), inputs[next_input].u);
     const auto t0 = Clock::now();
-    ekf.predict(m.t, inputAt(model, inputs, ekf.time()));
-    ekf.update(m.y);
+    est->addMeasurement(m.t, m.y);
     out.update_seconds.push_back(since(t0));
-    out.rows.push_back({m.t, ekf.mean(), ekf.covariance()});
+    const StateEstimate e = est->current();
+    out.rows.push_back({e.t, e.mean, e.covariance});
+    out.iterations = std::max(out.iterations, est->report().iterations);
   }
   out.total_seconds = since(start);
-  out.summary = "ExtendedKalmanFilter: " + std::to_string(measurements.size()) + " updates";
+  out.summary = est->report().detail;
   return out;
 }
 

@@ -452,9 +452,11 @@ Values BayesTreeEngine::allEstimates() const {
 }
 
 int BayesTreeEngine::solveAll() {
-  if (root_ < 0) return 0;
+  // The tree can be a forest (e.g. x_c(0) and x_b before any measurement).
+  std::vector<int> stack;
+  for (std::size_t c = 0; c < cliques_.size(); ++c)
+    if (clique_alive_[c] && cliques_[c].parent < 0) stack.push_back(static_cast<int>(c));
   int n = 0;
-  std::vector<int> stack{root_};
   while (!stack.empty()) {
     const int c = stack.back();
     stack.pop_back();
@@ -472,17 +474,22 @@ void BayesTreeEngine::solvePath(const Key& k) {
 }
 
 Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& keys) const {
-  // The cliques from the lowest requested key to the root form a Bayes net
-  // on their frontal variables (each separator lies on the path above), so
-  // Σ_path = (R_pathᵀ R_path)⁻¹ with R_path block upper triangular.
-  const Key* lowest = nullptr;
+  // The union of the requested keys' root paths is closed under parents, so
+  // its conditionals form a Bayes net on its frontal variables (every
+  // separator lies above): Σ = (RᵀR)⁻¹ with R block upper triangular in
+  // elimination order.
+  std::unordered_set<int> on_path;
+  std::vector<int> path;
   for (const auto& k : keys) {
     if (!vars_.count(k)) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
-    if (!lowest || vars_.at(k).rank < vars_.at(*lowest).rank) lowest = &k;
+    for (int c = vars_.at(k).clique; c >= 0 && on_path.insert(c).second;
+         c = cliques_[static_cast<std::size_t>(c)].parent)
+      path.push_back(c);
   }
-  std::vector<int> path;
-  for (int c = vars_.at(*lowest).clique; c >= 0; c = cliques_[static_cast<std::size_t>(c)].parent)
-    path.push_back(c);
+  std::sort(path.begin(), path.end(), [&](int a, int b) {
+    return vars_.at(cliques_[static_cast<std::size_t>(a)].frontal).rank <
+           vars_.at(cliques_[static_cast<std::size_t>(b)].frontal).rank;
+  });
   std::unordered_map<Key, Eigen::Index, KeyHash> off;
   Eigen::Index n = 0;
   for (int c : path) {
@@ -490,10 +497,6 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
     off[f] = n;
     n += vars_.at(f).anchor.size();
   }
-  for (const auto& k : keys)
-    if (!off.count(k))
-      throw InvalidArgument("pathMarginalCovariance: " + k.toString() + " is not on the root path of " +
-                            lowest->toString());
   std::vector<Eigen::Triplet<double>> trip;
   for (int c : path) {
     const Clique& cl = cliques_[static_cast<std::size_t>(c)];

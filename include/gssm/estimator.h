@@ -1,0 +1,103 @@
+#pragma once
+// The streaming estimator API (DESIGN.md §3, layer 6): feed inputs and
+// measurements as they arrive, read the current estimate at any time. One
+// interface over the EKF, the IncrementalSmoother, the FixedLagSmoother and
+// the paper's window re-solve, so applications switch by name.
+//
+//   gssm::models::Radar2D radar;
+//   auto est = gssm::makeEstimator(radar, {"fixed-lag"});
+//   for (const auto& m : measurements) est->addMeasurement(m.t, m.y);
+//   std::cout << est->current().mean.transpose() << "\n";
+//
+// Every call has the strong exception guarantee: one that throws (wrong
+// dimension, NaN, time not increasing, a singular system) leaves the
+// estimator exactly as it was, and the message names the input at fault.
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gssm/ekf.h"
+#include "gssm/model.h"
+#include "gssm/smoothers.h"
+
+namespace gssm {
+
+/// Estimate of the stacked state [x_c(k); x_b] at step k (time t).
+struct StateEstimate {
+  double t = 0;
+  std::int64_t step = 0;
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd covariance;
+};
+
+struct EstimatorReport {
+  std::string method;
+  std::int64_t steps = 0;     ///< measurements processed
+  double seconds = 0;         ///< wall time of the last addMeasurement
+  int iterations = 0;         ///< solver iterations of the last update (1 for the EKF)
+  UpdateReport smoother;      ///< the smoother's report (incremental, fixed-lag; zeros otherwise)
+  std::string detail;         ///< one line from the underlying estimator
+};
+
+struct EstimatorOptions {
+  /// ekf | incremental | fixed-lag | paper-window
+  std::string method = "fixed-lag";
+  int window = 10;            ///< fixed-lag and paper-window: states kept
+  ExtendedKalmanFilterOptions ekf;
+  SmootherOptions smoother;
+  double t0 = 0.0;            ///< time of x_c(0)
+  bool validate(const Model& model, std::string* why = nullptr) const;
+};
+
+/// Names accepted by makeEstimator.
+std::vector<std::string> estimatorMethods();
+
+class Estimator {
+ public:
+  virtual ~Estimator() = default;
+  const std::string& method() const { return report_.method; }
+
+  /// Input u held from time t on (zero-order hold); t must not be before the
+  /// newest state's time.
+  void addInput(double t, const Eigen::VectorXd& u);
+  /// A measurement y at time t (> the previous one): one new step.
+  void addMeasurement(double t, const Eigen::VectorXd& y);
+
+  /// Newest state and constants with their joint covariance.
+  virtual StateEstimate current() = 0;
+  /// The estimate of x_c(k) given all data so far, when the method keeps it
+  /// (incremental: any k; fixed-lag/paper-window: inside the window; EKF: the
+  /// newest only). nullopt otherwise.
+  virtual std::optional<StateEstimate> smoothed(std::int64_t k) = 0;
+
+  const EstimatorReport& report() const { return report_; }
+  double time() const { return t_; }
+  std::int64_t step() const { return k_; }
+  const Model& model() const { return model_; }
+
+ protected:
+  Estimator(const Model& model, const std::string& method, double t0);
+  /// Processes a validated step k−1 → k; must be strongly exception safe.
+  virtual void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u,
+                      const Eigen::VectorXd& y) = 0;
+
+  const Model& model_;
+  EstimatorReport report_;
+
+ private:
+  double t_;            // time of the newest state
+  std::int64_t k_ = 0;  // its step
+  struct HeldInput {
+    double t;
+    Eigen::VectorXd u;
+  };
+  std::vector<HeldInput> inputs_;  // from the newest state's time on
+};
+
+/// Builds the estimator named by options.method; the model must outlive it.
+/// Throws InvalidArgument naming the option at fault.
+std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOptions& options = {});
+
+}  // namespace gssm

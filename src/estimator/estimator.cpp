@@ -1,0 +1,321 @@
+#include "gssm/estimator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <deque>
+#include <sstream>
+
+#include "gssm/batch_solver.h"
+#include "gssm/error.h"
+#include "gssm/problem.h"
+
+namespace gssm {
+
+std::vector<std::string> estimatorMethods() {
+  return {"ekf", "incremental", "fixed-lag", "paper-window"};
+}
+
+bool EstimatorOptions::validate(const Model& model, std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = "EstimatorOptions: " + m;
+    return false;
+  };
+  const auto methods = estimatorMethods();
+  if (std::find(methods.begin(), methods.end(), method) == methods.end())
+    return fail("unknown method '" + method + "' (known: ekf, incremental, fixed-lag, paper-window)");
+  if (window < 1) return fail("window must be >= 1, got " + std::to_string(window));
+  if (!std::isfinite(t0)) return fail("t0 must be finite");
+  if (!ekf.validate(model.dims().nb, why)) return false;
+  return smoother.validate(why);
+}
+
+Estimator::Estimator(const Model& model, const std::string& method, double t0)
+    : model_(model), t_(t0) {
+  report_.method = method;
+}
+
+void Estimator::addInput(double t, const Eigen::VectorXd& u) {
+  requireVector(u, model_.dims().nu, method() + ": input u at t = " + std::to_string(t));
+  if (!std::isfinite(t) || t < t_ || (!inputs_.empty() && !(t > inputs_.back().t))) {
+    std::ostringstream os;
+    os << method() << ": input at t = " << t << " must be at or after the newest state (t = " << t_
+       << ") and after the previous input";
+    throw InvalidArgument(os.str());
+  }
+  inputs_.push_back({t, u});
+}
+
+void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!std::isfinite(t) || !(t > t_)) {
+    std::ostringstream os;
+    os << method() << ": measurement time " << t << " must be after the previous one (" << t_
+       << ")";
+    throw InvalidArgument(os.str());
+  }
+  requireVector(y, model_.dims().ny, method() + ": measurement y at t = " + std::to_string(t));
+  // The input in force at the start of the interval (zero-order hold).
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(model_.dims().nu);
+  std::size_t used = 0;
+  for (std::size_t i = 0; i < inputs_.size() && inputs_[i].t <= t_; ++i) {
+    u = inputs_[i].u;
+    used = i;
+  }
+  doStep(k_ + 1, t - t_, u, y);  // strong guarantee: throws before changing anything
+  // Keep the input in force at t and any later ones.
+  std::size_t keep = 0;
+  for (std::size_t i = used; i < inputs_.size(); ++i)
+    if (inputs_[i].t <= t) keep = i;
+  if (!inputs_.empty()) inputs_.erase(inputs_.begin(), inputs_.begin() + static_cast<long>(keep));
+  t_ = t;
+  ++k_;
+  report_.steps = k_;
+  report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+namespace {
+
+Eigen::VectorXd stack(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) {
+  Eigen::VectorXd z(xc.size() + xb.size());
+  z << xc, xb;
+  return z;
+}
+
+// ---- EKF ----------------------------------------------------------------------
+class EkfEstimator final : public Estimator {
+ public:
+  EkfEstimator(const Model& m, const EstimatorOptions& o)
+      : Estimator(m, "ekf", o.t0), ekf_(m, o.ekf, o.t0) {}
+
+  StateEstimate current() override { return {time(), step(), ekf_.mean(), ekf_.covariance()}; }
+  std::optional<StateEstimate> smoothed(std::int64_t k) override {
+    if (k == step()) return current();
+    return std::nullopt;
+  }
+
+ protected:
+  void doStep(std::int64_t, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
+    ExtendedKalmanFilter next = ekf_;  // commit only if both halves succeed
+    next.predict(ekf_.time() + dt, u);
+    next.update(y);
+    ekf_ = std::move(next);
+    report_.iterations = 1;
+    report_.detail = "EKF update, NIS " + std::to_string(ekf_.lastNis());
+  }
+
+ private:
+  ExtendedKalmanFilter ekf_;
+};
+
+// ---- IncrementalSmoother / FixedLagSmoother --------------------------------------
+// The factors one GSSM step adds: process x_c(k−1) → x_c(k) (touching x_b)
+// and the measurement at x_c(k); x_c(k) starts at its prediction.
+std::vector<FactorPtr> stepFactors(const Model& m, std::int64_t k, double dt,
+                                   const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
+  return {std::make_shared<ProcessFactor>(m, k - 1, u, dt),
+          std::make_shared<MeasurementFactor>(m, k, y)};
+}
+
+// x_c(k) starts at the model's prediction; a non-finite one is a numerical
+// failure of the model, reported before anything changes.
+Eigen::VectorXd predictState(const Model& m, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                             const Eigen::VectorXd& u, double dt, std::int64_t k) {
+  Eigen::VectorXd x = m.f(xc, xb, u, dt);
+  if (!x.allFinite()) {
+    std::ostringstream os;
+    os << m.name() << ": the prediction f(x_c(" << k - 1 << "), x_b, u, dt = " << dt << ") of x_c(" << k
+       << ") is not finite; estimator unchanged";
+    throw NumericalError(os.str());
+  }
+  return x;
+}
+
+std::vector<FactorPtr> priorFactors(const Model& m, Values& initial) {
+  std::vector<FactorPtr> f{std::make_shared<PriorFactor>(Key::state(0), m.priorState())};
+  initial.insert(Key::state(0), m.priorState().mean);
+  if (m.dims().nb > 0) {
+    f.push_back(std::make_shared<PriorFactor>(Key::constants(), m.priorConstants()));
+    initial.insert(Key::constants(), m.priorConstants().mean);
+  }
+  return f;
+}
+
+template <class Smoother>
+class SmootherEstimator final : public Estimator {
+ public:
+  template <class Options>
+  SmootherEstimator(const Model& m, const std::string& name, const Options& o, double t0,
+                    std::size_t keep_times)
+      : Estimator(m, name, t0), smoother_(o), keep_times_(keep_times) {
+    Values initial;
+    const auto priors = priorFactors(m, initial);
+    report_.smoother = smoother_.update(priors, initial);
+    times_.push_back(t0);
+  }
+
+  StateEstimate current() override { return *smoothed(step()); }
+
+  std::optional<StateEstimate> smoothed(std::int64_t k) override {
+    if (k < 0 || k > step() || !smoother_.contains(Key::state(k))) return std::nullopt;
+    const bool nb = model_.dims().nb > 0;
+    StateEstimate e;
+    e.step = k;
+    e.t = times_[times_.size() - 1 - static_cast<std::size_t>(step() - k)];
+    const Eigen::VectorXd xb = nb ? smoother_.estimate(Key::constants()) : Eigen::VectorXd();
+    e.mean = stack(smoother_.estimate(Key::state(k)), xb);
+    e.covariance = nb ? smoother_.jointMarginalCovariance({Key::state(k), Key::constants()})
+                      : smoother_.marginalCovariance(Key::state(k));
+    return e;
+  }
+
+ protected:
+  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
+    const auto factors = stepFactors(model_, k, dt, u, y);
+    const Eigen::VectorXd xb = model_.dims().nb ? smoother_.estimate(Key::constants())
+                                                : Eigen::VectorXd(Eigen::VectorXd::Zero(0));
+    Values initial;
+    initial.insert(Key::state(k), predictState(model_, smoother_.estimate(Key::state(k - 1)), xb, u, dt, k));
+    report_.smoother = smoother_.update(factors, initial);  // transactional
+    report_.iterations = report_.smoother.iterations;
+    report_.detail = report_.smoother.toString();
+    times_.push_back(times_.back() + dt);
+    while (keep_times_ > 0 && times_.size() > keep_times_) times_.pop_front();
+  }
+
+ private:
+  Smoother smoother_;
+  std::size_t keep_times_;   // 0: keep all
+  std::deque<double> times_; // times of the states still held
+};
+
+// ---- The paper's window re-solve (reproduction mode) -----------------------------
+// What the paper's reference implementation does: re-solve the whole window by
+// Gauss–Newton at every step; once the window is full, drop the oldest state
+// and replace all priors by independent 1-D priors (mean = current estimate,
+// variance = marginal variance from the current window) on the oldest
+// remaining x_c and on each constant. This counts the window's measurements
+// again at every step, so it is over-confident; it exists to reproduce the
+// paper's figures, not as an estimator to deploy.
+class PaperWindowEstimator final : public Estimator {
+ public:
+  PaperWindowEstimator(const Model& m, const EstimatorOptions& o)
+      : Estimator(m, "paper-window", o.t0), window_(o.window) {
+    values_.insert(Key::state(0), m.priorState().mean);
+    prior_state_ = m.priorState();
+    if (m.dims().nb > 0) {
+      values_.insert(Key::constants(), m.priorConstants().mean);
+      prior_constants_ = m.priorConstants();
+    }
+    times_.push_back(o.t0);
+    solve(values_, solver_);
+  }
+
+  StateEstimate current() override { return *smoothed(step()); }
+  std::optional<StateEstimate> smoothed(std::int64_t k) override {
+    if (k < oldest_ || k > step()) return std::nullopt;
+    const bool nb = model_.dims().nb > 0;
+    StateEstimate e;
+    e.step = k;
+    e.t = times_[static_cast<std::size_t>(k - oldest_)];
+    e.mean = stack(values_.at(Key::state(k)), nb ? values_.at(Key::constants()) : Eigen::VectorXd());
+    e.covariance = nb ? solver_.jointMarginalCovariance({Key::state(k), Key::constants()})
+                      : solver_.marginalCovariance(Key::state(k));
+    return e;
+  }
+
+ protected:
+  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
+    // Work on copies; commit at the end.
+    auto steps = steps_;
+    auto times = times_;
+    Values values = values_;
+    Gaussian prior_state = prior_state_, prior_constants = prior_constants_;
+    std::int64_t oldest = oldest_;
+    steps.push_back(stepFactors(model_, k, dt, u, y));
+    const Eigen::VectorXd xb = model_.dims().nb ? values.at(Key::constants()) : Eigen::VectorXd();
+    values.insert(Key::state(k), predictState(model_, values.at(Key::state(k - 1)), xb, u, dt, k));
+    times.push_back(times.back() + dt);
+    BatchSolver solver(gaussNewton());
+    const BatchSolverSummary sum = solve(values, solver, &steps, &prior_state, &prior_constants, oldest);
+    if (static_cast<int>(steps.size()) + 1 > window_) {
+      // Window full: drop the oldest state, new 1-D priors from this solve.
+      const Key next = Key::state(oldest + 1);
+      prior_state = diagonalPrior(values.at(next), solver.marginalCovariance(next));
+      if (model_.dims().nb > 0)
+        prior_constants = diagonalPrior(values.at(Key::constants()), solver.marginalCovariance(Key::constants()));
+      values.erase(Key::state(oldest));
+      steps.pop_front();
+      times.pop_front();
+      ++oldest;
+      // Re-solve so the reported covariances belong to the new window.
+      solve(values, solver, &steps, &prior_state, &prior_constants, oldest);
+    }
+    steps_ = std::move(steps);
+    times_ = std::move(times);
+    values_ = std::move(values);
+    prior_state_ = std::move(prior_state);
+    prior_constants_ = std::move(prior_constants);
+    oldest_ = oldest;
+    solver_ = std::move(solver);
+    report_.iterations = sum.iterations;
+    report_.detail = sum.toString();
+  }
+
+ private:
+  static BatchSolverOptions gaussNewton() {
+    BatchSolverOptions o;
+    o.method = BatchSolverOptions::Method::GaussNewton;
+    o.max_iterations = 20;
+    return o;
+  }
+  static Gaussian diagonalPrior(const Eigen::VectorXd& mean, const Eigen::MatrixXd& cov) {
+    return {mean, Eigen::MatrixXd(cov.diagonal().asDiagonal())};
+  }
+  BatchSolverSummary solve(Values& values, BatchSolver& solver,
+                           const std::deque<std::vector<FactorPtr>>* steps = nullptr,
+                           const Gaussian* ps = nullptr, const Gaussian* pb = nullptr,
+                           std::int64_t oldest = 0) {
+    if (!steps) {
+      steps = &steps_;
+      ps = &prior_state_;
+      pb = &prior_constants_;
+      oldest = oldest_;
+      solver = BatchSolver(gaussNewton());
+    }
+    FactorGraph g;
+    g.add(std::make_shared<PriorFactor>(Key::state(oldest), *ps));
+    if (model_.dims().nb > 0) g.add(std::make_shared<PriorFactor>(Key::constants(), *pb));
+    for (const auto& s : *steps)
+      for (const auto& f : s) g.add(f);
+    return solver.solve(g, values);
+  }
+
+  int window_;
+  std::deque<std::vector<FactorPtr>> steps_;  // factors of each step in the window
+  std::deque<double> times_;
+  Values values_;
+  Gaussian prior_state_, prior_constants_;
+  std::int64_t oldest_ = 0;
+  BatchSolver solver_{gaussNewton()};
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOptions& options) {
+  std::string why;
+  if (!options.validate(model, &why)) throw InvalidArgument(why);
+  if (options.method == "ekf") return std::make_unique<EkfEstimator>(model, options);
+  if (options.method == "incremental")
+    return std::make_unique<SmootherEstimator<IncrementalSmoother>>(model, "incremental",
+                                                                     options.smoother, options.t0, 0);
+  if (options.method == "fixed-lag") {
+    FixedLagSmootherOptions o;
+    o.window = options.window;
+    o.smoother = options.smoother;
+    return std::make_unique<SmootherEstimator<FixedLagSmoother>>(
+        model, "fixed-lag", o, options.t0, static_cast<std::size_t>(options.window));
+  }
+  return std::make_unique<PaperWindowEstimator>(model, options);
+}
+
+}  // namespace gssm
