@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <map>
 #include <random>
 
 #include "gssm/batch_solver.h"
@@ -149,4 +150,56 @@ TEST(IncrementalSmoother, RadarPaperEqualsBatchAfterEveryUpdateWhenIterated) {
     EXPECT_LT(relativeError(smoother.estimate(Key::constants()), x.at(Key::constants())), tol)
         << "step " << k << ": " << rep.toString();
   }
+}
+
+namespace {
+// Streams `steps` radar paper-scenario measurements through a smoother and
+// returns the reports at the requested steps.
+template <class Smoother>
+std::map<int, UpdateReport> radarReports(Smoother& smoother, int steps, const std::vector<int>& at) {
+  const models::Radar2D radar;
+  SimulationSpec spec;
+  spec.steps = steps;
+  spec.x0 = Eigen::VectorXd::Constant(1, 0.0);
+  spec.xb = Eigen::Vector2d(100, 1000);
+  spec.process_noise = false;
+  static std::map<int, SimulatedRun> cache;
+  if (!cache.count(steps)) cache[steps] = simulate(radar, spec, normalSampler(3));
+  const SimulatedRun& run = cache[steps];
+  auto [f0, v0] = gssm::testing::initialStep(radar);
+  smoother.update(f0, v0);
+  std::map<int, UpdateReport> out;
+  for (int k = 1; k <= steps; ++k) {
+    auto [f, v] = gssm::testing::nextStep(radar, smoother, k, run.measurements[k - 1].y, 0.05);
+    const UpdateReport rep = smoother.update(f, v);
+    if (std::find(at.begin(), at.end(), k) != at.end()) out[k] = rep;
+  }
+  return out;
+}
+}  // namespace
+
+TEST(IncrementalSmoother, CliquesReeliminatedPerUpdateDoNotGrowWithHistory) {
+  SmootherOptions o;
+  o.relinearize = false;
+  IncrementalSmoother smoother(o);
+  const auto reps = radarReports(smoother, 100000, {1000, 100000});
+  EXPECT_EQ(reps.at(1000).cliques_reeliminated, reps.at(100000).cliques_reeliminated);
+  EXPECT_EQ(reps.at(100000).cliques_reeliminated, 3);  // x_c(k−1), x_c(k), x_b
+  EXPECT_EQ(reps.at(1000).orphans, reps.at(100000).orphans);
+  EXPECT_EQ(reps.at(100000).num_variables, 100002u);
+}
+
+TEST(FixedLagSmoother, HundredThousandStepsKeepVariablesAndFactorsBounded) {
+  FixedLagSmootherOptions o;
+  o.window = 10;
+  FixedLagSmoother smoother(o);
+  const auto reps = radarReports(smoother, 100000, {1000, 100000});
+  for (const auto& [k, rep] : reps) {
+    EXPECT_EQ(rep.num_variables, 11u) << "step " << k;  // window + constants
+    EXPECT_EQ(rep.variables_marginalized, 1) << "step " << k;
+    EXPECT_EQ(rep.cliques_reeliminated, reps.at(1000).cliques_reeliminated) << "step " << k;
+  }
+  // window process+measurement factors, the x_b prior, one marginal prior
+  EXPECT_EQ(reps.at(100000).num_factors, reps.at(1000).num_factors);
+  EXPECT_LE(reps.at(100000).num_factors, 2u * 10 + 2);
 }

@@ -47,6 +47,9 @@ enum class EliminationOrdering {
 
 struct SmootherOptions {
   EliminationOrdering ordering = EliminationOrdering::ConstrainedColamd;
+  /// false: every factor keeps the linearization it was added with
+  /// (exact for linear models; the cheapest mode).
+  bool relinearize = true;
   /// A factor is relinearized when its whitened linearization error
   /// ‖r(x̂) − r_lin(x̂)‖ exceeds this (units of its noise sigma).
   double relinearize_threshold = 1e-2;

@@ -150,7 +150,9 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
   engine.update(new_values, new_factors, {}, {}, counts);  // may throw: nothing changed
   rep.iterations = 1;
 
-  if (options.iterate_to_convergence) {
+  if (!options.relinearize) {
+    // keep every linearization as added
+  } else if (options.iterate_to_convergence) {
     iterateToConvergence(rep, counts);
     rep.relinearization_pass = true;
   } else {
