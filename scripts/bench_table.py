@@ -1,0 +1,36 @@
+#!/usr/bin/env python3
+"""Formats Google Benchmark JSON from gssm_bench_latency as a Markdown table,
+each latency as a ratio to the EKF measured in the same run."""
+import json, sys, datetime, platform, os
+
+data = json.load(open(sys.argv[1]))
+cmd = sys.argv[2]
+cpu = "unknown"
+try:
+    for line in open("/proc/cpuinfo"):
+        if line.startswith("model name"):
+            cpu = line.split(":", 1)[1].strip()
+            break
+except OSError:
+    pass
+rows = {b["name"]: b for b in data["benchmarks"]}
+ekf = next(b for n, b in rows.items() if "/ekf/" in n)
+us = lambda s: f"{s * 1e6:.1f}"
+print("# Benchmark results\n")
+print(f"- machine: {cpu}, {os.cpu_count()} cores")
+print(f"- date: {datetime.date.today().isoformat()}")
+print(f"- command: `{cmd}` (via `scripts/bench`)")
+print("- scenario: radar paper scenario, 2000 steps of T = 0.05 s; per-update wall time of `addMeasurement`\n")
+print("| estimator | median (µs) | p99 (µs) | max (µs) | median / EKF | p99 / EKF |")
+print("| --- | --- | --- | --- | --- | --- |")
+for name, b in rows.items():
+    if "median_s" not in b:
+        continue
+    label = name.split("/")[1].replace("_", " ")
+    print(f"| {label} | {us(b['median_s'])} | {us(b['p99_s'])} | {us(b['max_s'])} | "
+          f"{b['median_s'] / ekf['median_s']:.1f}× | {b['p99_s'] / ekf['p99_s']:.1f}× |")
+for name, b in rows.items():
+    if name.startswith("BM_Batch"):
+        t = b["real_time"] / 1e3 if b["time_unit"] == "ms" else b["real_time"]
+        print(f"\nBatchSolver, whole 2000-step run once (EKF-initialized LM, incl. all marginals): "
+              f"{t * 1e3:.1f} ms, {int(b['iterations'])} LM iterations.")
