@@ -13,6 +13,7 @@
 #include "gssm/io/csv.h"
 #include "gssm/io/dataset.h"
 #include "gssm/metrics.h"
+#include "gssm/plot/run_figures.h"
 
 namespace fs = std::filesystem;
 
@@ -65,6 +66,7 @@ int main(int argc, char** argv) {
     fs::create_directories(out);
 
     std::vector<gssm::RunMetrics> metrics;
+    std::vector<gssm::OfflineRun> runs;
     for (const auto& m : methods) {
       gssm::EstimatorOptions eo;
       eo.method = m;
@@ -84,8 +86,12 @@ int main(int argc, char** argv) {
                   << " ± " << std::sqrt(last.covariance(j, j)) << std::defaultfloat;
       }
       std::cout << "\n        " << run.summary << "\n";
+      runs.push_back(std::move(run));
     }
     std::ofstream((fs::path(out) / "metrics.json").string()) << gssm::metricsJson(metrics, data);
+    const std::string label = config.getString("scenario", "name", fs::path(data).filename().string());
+    for (const auto& p : gssm::plot::writeRunFigures(*model, runs, ds.truth ? &*ds.truth : nullptr, out, label))
+      std::cout << "figure: " << p << "\n";
     std::cout << "gssm-process: wrote " << out << "/metrics.json and estimates-*.csv\n";
     return 0;
   });

@@ -32,7 +32,9 @@ for method, m in metrics["methods"].items():
         rmse = math.sqrt(sum(sq) / len(sq))
         assert abs(rmse - m["rmse"][n]) <= 1e-9 * max(1.0, rmse), (method, n, rmse, m["rmse"][n])
         assert all(r[4 + i] > 0 for r in rows)
-assert set(metrics["methods"]) >= {"ekf", "batch"}, metrics["methods"].keys()
+assert set(metrics["methods"]) == {"ekf", "batch", "incremental", "fixed-lag", "paper-window"}, metrics["methods"].keys()
+for fig in ["fig-xdot.png", "fig-h.png", "fig-x-error.png", "fig-latency.png"]:
+    assert os.path.getsize(os.path.join(out, fig)) > 10000, fig
 
 bad = subprocess.run([f"{bin_dir}/gssm-process", "--data", data, "--method", "kalman",
                       "--out", out], capture_output=True, text=True)

@@ -1,0 +1,61 @@
+#pragma once
+// Offscreen PNG figures drawn with MRPT's CImage canvas (no display, no window
+// system): title, axis labels, round-number ticks, grid, legend, line series,
+// shaded ±kσ bands, truth as a reference line, and an automatic y range that a
+// first-step outlier cannot squash.
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace gssm::plot {
+
+struct Color {
+  unsigned char r = 0, g = 0, b = 0;
+};
+
+/// A qualitative palette (Tableau 10), by index.
+Color paletteColor(std::size_t i);
+
+struct Series {
+  std::string label;
+  std::vector<double> x, y;
+  Color color;
+  int width = 2;
+  bool dashed = false;
+};
+
+/// A shaded band between lo(x) and hi(x), e.g. estimate ± 3σ.
+struct Band {
+  std::vector<double> x, lo, hi;
+  Color color;
+  double alpha = 0.18;
+};
+
+struct Bar {
+  double x0, x1, height;
+  Color color;
+};
+
+struct Figure {
+  std::string title, xlabel, ylabel;
+  std::vector<Band> bands;      ///< drawn first
+  std::vector<Bar> bars;
+  std::vector<Series> series;   ///< drawn in order, legend in order
+  std::optional<std::pair<double, double>> xlim, ylim;  ///< fixed ranges
+  /// Automatic y range from the [q, 1−q] quantiles of the series' values
+  /// (bands excluded), so a start-up transient does not squash the rest.
+  double robust_quantile = 0.01;
+  bool legend = true;
+};
+
+/// Draws the figure into a PNG of the given size; throws std::runtime_error
+/// if the file cannot be written.
+void savePng(const Figure& fig, const std::string& path, int width = 960, int height = 600);
+
+/// A histogram figure of `values` (e.g. latencies) with `bins` bins per group;
+/// each group is one labelled colour.
+Figure histogram(const std::vector<std::pair<std::string, std::vector<double>>>& groups, int bins,
+                 const std::string& title, const std::string& xlabel);
+
+}  // namespace gssm::plot

@@ -1,0 +1,258 @@
+#include "gssm/plot/figure.h"
+
+#include <mrpt/img/CImage.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "gssm/plot/ticks.h"
+
+namespace gssm::plot {
+
+namespace {
+using mrpt::img::TColor;
+TColor tc(Color c) { return TColor(c.r, c.g, c.b); }
+constexpr int kCharW = 6, kCharH = 13;  // the "6x13" bitmap font
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto i = static_cast<std::size_t>(pos);
+  const auto j = std::min(i + 1, v.size() - 1);
+  return v[i] + (pos - static_cast<double>(i)) * (v[j] - v[i]);
+}
+
+// Maps data to pixels inside the plot rectangle.
+struct Axes {
+  int left, top, right, bottom;
+  double x0, x1, y0, y1;
+  double px(double x) const { return left + (x - x0) / (x1 - x0) * (right - left); }
+  double py(double y) const { return bottom - (y - y0) / (y1 - y0) * (bottom - top); }
+};
+
+// Blends `c` into pixel (x, y) with opacity a.
+void blend(mrpt::img::CImage& img, int x, int y, Color c, double a) {
+  if (x < 0 || y < 0 || x >= static_cast<int>(img.getWidth()) || y >= static_cast<int>(img.getHeight())) return;
+  auto* p = img.ptr<uint8_t>(static_cast<unsigned>(x), static_cast<unsigned>(y));
+  // CImage stores BGR.
+  const unsigned char rgb[3] = {c.b, c.g, c.r};
+  for (int k = 0; k < 3; ++k) p[k] = static_cast<uint8_t>(std::lround((1 - a) * p[k] + a * rgb[k]));
+}
+
+// Clips segment to the axes rectangle (Liang–Barsky); false if outside.
+bool clip(const Axes& ax, double& xa, double& ya, double& xb, double& yb) {
+  double t0 = 0, t1 = 1;
+  const double dx = xb - xa, dy = yb - ya;
+  const double p[4] = {-dx, dx, -dy, dy};
+  const double q[4] = {xa - ax.left, ax.right - xa, ya - ax.top, ax.bottom - ya};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0) {
+      if (q[i] < 0) return false;
+    } else {
+      const double t = q[i] / p[i];
+      if (p[i] < 0) t0 = std::max(t0, t);
+      else t1 = std::min(t1, t);
+    }
+  }
+  if (t0 > t1) return false;
+  xb = xa + t1 * dx;
+  yb = ya + t1 * dy;
+  xa = xa + t0 * dx;
+  ya = ya + t0 * dy;
+  return true;
+}
+
+void drawSeries(mrpt::img::CImage& img, const Axes& ax, const Series& s) {
+  double dash_phase = 0;
+  for (std::size_t i = 1; i < s.x.size() && i < s.y.size(); ++i) {
+    if (!std::isfinite(s.y[i - 1]) || !std::isfinite(s.y[i])) continue;
+    double xa = ax.px(s.x[i - 1]), ya = ax.py(s.y[i - 1]), xb = ax.px(s.x[i]), yb = ax.py(s.y[i]);
+    if (!clip(ax, xa, ya, xb, yb)) continue;
+    if (!s.dashed) {
+      img.line(static_cast<int>(std::lround(xa)), static_cast<int>(std::lround(ya)),
+               static_cast<int>(std::lround(xb)), static_cast<int>(std::lround(yb)), tc(s.color),
+               static_cast<unsigned>(s.width));
+      continue;
+    }
+    const double len = std::hypot(xb - xa, yb - ya);
+    for (double d = 0; d < len; d += 1.0) {  // 8 px on, 5 px off
+      if (std::fmod(dash_phase + d, 13.0) < 8.0) {
+        const double f = len > 0 ? d / len : 0;
+        img.filledRectangle(static_cast<int>(xa + f * (xb - xa)), static_cast<int>(ya + f * (yb - ya)),
+                            static_cast<int>(xa + f * (xb - xa)) + s.width - 1,
+                            static_cast<int>(ya + f * (yb - ya)) + s.width - 1, tc(s.color));
+      }
+    }
+    dash_phase += len;
+  }
+}
+
+void drawBand(mrpt::img::CImage& img, const Axes& ax, const Band& b) {
+  // Column by column between consecutive samples: each pixel once.
+  int last_col = std::numeric_limits<int>::min();
+  for (std::size_t i = 1; i < b.x.size(); ++i) {
+    const double xa = ax.px(b.x[i - 1]), xb = ax.px(b.x[i]);
+    for (int col = std::max(static_cast<int>(std::ceil(xa)), ax.left);
+         col <= std::min(static_cast<int>(std::floor(xb)), ax.right); ++col) {
+      if (col <= last_col) continue;
+      last_col = col;
+      const double f = xb > xa ? (col - xa) / (xb - xa) : 0;
+      const double lo = b.lo[i - 1] + f * (b.lo[i] - b.lo[i - 1]);
+      const double hi = b.hi[i - 1] + f * (b.hi[i] - b.hi[i - 1]);
+      if (!std::isfinite(lo) || !std::isfinite(hi)) continue;
+      const int r0 = std::max(ax.top, static_cast<int>(std::lround(ax.py(hi))));
+      const int r1 = std::min(ax.bottom, static_cast<int>(std::lround(ax.py(lo))));
+      for (int row = r0; row <= r1; ++row) blend(img, col, row, b.color, b.alpha);
+    }
+  }
+}
+
+void centeredText(mrpt::img::CImage& img, int cx, int y, const std::string& s, TColor c,
+                  int char_w = kCharW) {
+  img.textOut(cx - static_cast<int>(s.size()) * char_w / 2, y, s, c);
+}
+}  // namespace
+
+Color paletteColor(std::size_t i) {
+  static const Color p[] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
+                            {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {127, 127, 127},
+                            {188, 189, 34},  {23, 190, 207}};
+  return p[i % 10];
+}
+
+void savePng(const Figure& fig, const std::string& path, int width, int height) {
+  mrpt::img::CImage img(width, height, mrpt::img::CH_RGB);
+  img.filledRectangle(0, 0, width - 1, height - 1, TColor(255, 255, 255));
+  img.selectTextFont("6x13");
+
+  // ---- ranges --------------------------------------------------------------
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
+  std::vector<double> ys;
+  for (const auto& s : fig.series)
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i)
+      if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) {
+        xmin = std::min(xmin, s.x[i]);
+        xmax = std::max(xmax, s.x[i]);
+        ys.push_back(s.y[i]);
+      }
+  for (const auto& b : fig.bars) {
+    xmin = std::min(xmin, b.x0);
+    xmax = std::max(xmax, b.x1);
+    ys.push_back(0);
+    ys.push_back(b.height);
+  }
+  if (ys.empty()) xmin = 0, xmax = 1, ys = {0, 1};
+  double ylo = fig.bars.empty() ? quantile(ys, fig.robust_quantile) : 0.0;
+  double yhi = quantile(ys, fig.bars.empty() ? 1 - fig.robust_quantile : 1.0);
+  const double pad = 0.06 * std::max(yhi - ylo, 1e-9 * std::max(1.0, std::abs(yhi)));
+  if (fig.bars.empty()) ylo -= pad;
+  yhi += pad;
+  if (fig.xlim) xmin = fig.xlim->first, xmax = fig.xlim->second;
+  if (fig.ylim) ylo = fig.ylim->first, yhi = fig.ylim->second;
+  const Ticks xt = niceTicks(xmin, xmax, 9), yt = niceTicks(ylo, yhi, 8);
+  const bool x_tight = !fig.bars.empty() || fig.xlim.has_value();
+  Axes ax{0, 0, 0, 0, x_tight ? xmin : xt.lo, x_tight ? xmax : xt.hi, fig.ylim ? ylo : yt.lo,
+          fig.ylim ? yhi : yt.hi};
+
+  // ---- layout ---------------------------------------------------------------
+  int label_w = 0;
+  for (double v : yt.values) label_w = std::max(label_w, static_cast<int>(formatTick(v, yt.step).size()));
+  ax.left = 24 + (label_w + 1) * kCharW;
+  ax.top = 48;
+  ax.right = width - 24;
+  ax.bottom = height - 56;
+
+  // ---- grid and ticks -------------------------------------------------------
+  const TColor grid(225, 225, 225), axis(60, 60, 60), text(30, 30, 30);
+  for (double v : xt.values) {
+    if (v < ax.x0 - 1e-12 || v > ax.x1 + 1e-12) continue;
+    const int x = static_cast<int>(std::lround(ax.px(v)));
+    img.line(x, ax.top, x, ax.bottom, grid);
+    img.line(x, ax.bottom, x, ax.bottom + 5, axis);
+    centeredText(img, x, ax.bottom + 9, formatTick(v, xt.step), text);
+  }
+  for (double v : yt.values) {
+    if (v < ax.y0 - 1e-12 || v > ax.y1 + 1e-12) continue;
+    const int y = static_cast<int>(std::lround(ax.py(v)));
+    img.line(ax.left, y, ax.right, y, grid);
+    img.line(ax.left - 5, y, ax.left, y, axis);
+    const std::string s = formatTick(v, yt.step);
+    img.textOut(ax.left - 8 - static_cast<int>(s.size()) * kCharW, y - kCharH / 2, s, text);
+  }
+
+  // ---- data -----------------------------------------------------------------
+  for (const auto& b : fig.bands) drawBand(img, ax, b);
+  for (const auto& b : fig.bars) {
+    const int x0 = static_cast<int>(std::lround(ax.px(b.x0))), x1 = static_cast<int>(std::lround(ax.px(b.x1)));
+    const int y = std::max(ax.top, static_cast<int>(std::lround(ax.py(b.height))));
+    for (int col = std::max(x0, ax.left); col < std::min(x1, ax.right); ++col)
+      for (int row = y; row < ax.bottom; ++row) blend(img, col, row, b.color, 0.55);
+  }
+  for (const auto& s : fig.series) drawSeries(img, ax, s);
+  img.rectangle(ax.left, ax.top, ax.right, ax.bottom, axis);
+
+  // ---- text -----------------------------------------------------------------
+  img.selectTextFont("10x20");
+  centeredText(img, (ax.left + ax.right) / 2, 14, fig.title, text, 10);
+  img.selectTextFont("6x13");
+  centeredText(img, (ax.left + ax.right) / 2, height - 26, fig.xlabel, text);
+  img.textOut(ax.left, ax.top - 20, fig.ylabel, text);
+
+  if (fig.legend && !fig.series.empty()) {
+    int w = 0;
+    for (const auto& s : fig.series) w = std::max(w, static_cast<int>(s.label.size()));
+    const int lw = 44 + w * kCharW, lh = 8 + 18 * static_cast<int>(fig.series.size());
+    const int x0 = ax.right - lw - 10, y0 = ax.top + 10;
+    img.filledRectangle(x0, y0, x0 + lw, y0 + lh, TColor(255, 255, 255));
+    img.rectangle(x0, y0, x0 + lw, y0 + lh, TColor(170, 170, 170));
+    for (std::size_t i = 0; i < fig.series.size(); ++i) {
+      const int y = y0 + 12 + 18 * static_cast<int>(i);
+      Series sample = fig.series[i];
+      Axes lax{x0, y0, x0 + lw, y0 + lh, 0, 1, 0, 1};
+      sample.x = {static_cast<double>(x0 + 8 - x0) / lw, static_cast<double>(x0 + 34 - x0) / lw};
+      const double yy = 1.0 - static_cast<double>(y - y0) / lh;
+      sample.y = {yy, yy};
+      drawSeries(img, lax, sample);
+      img.textOut(x0 + 40, y - kCharH / 2, fig.series[i].label, text);
+    }
+  }
+  if (!img.saveToFile(path)) throw std::runtime_error(path + ": cannot write the PNG");
+}
+
+Figure histogram(const std::vector<std::pair<std::string, std::vector<double>>>& groups, int bins,
+                 const std::string& title, const std::string& xlabel) {
+  Figure f;
+  f.title = title;
+  f.xlabel = xlabel;
+  f.ylabel = "fraction of updates";
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& g : groups)
+    if (!g.second.empty()) {
+      lo = std::min(lo, quantile(g.second, 0.0));
+      hi = std::max(hi, quantile(g.second, 0.99));  // the slowest 1% would squash the rest
+    }
+  if (!(hi > lo)) hi = lo + 1;
+  const double w = (hi - lo) / bins;
+  const double gw = w / static_cast<double>(std::max<std::size_t>(groups.size(), 1));
+  for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+    const auto& vals = groups[gi].second;
+    std::vector<double> count(static_cast<std::size_t>(bins), 0.0);
+    for (double v : vals) {
+      const int b = std::clamp(static_cast<int>((v - lo) / w), 0, bins - 1);
+      count[static_cast<std::size_t>(b)] += 1.0 / static_cast<double>(vals.size());
+    }
+    const Color c = paletteColor(gi);
+    for (int b = 0; b < bins; ++b) {
+      const double x0 = lo + b * w + static_cast<double>(gi) * gw;
+      f.bars.push_back({x0, x0 + gw, count[static_cast<std::size_t>(b)], c});
+    }
+    f.series.push_back({groups[gi].first, {}, {}, c, 6, false});  // legend entry
+  }
+  f.xlim = std::make_pair(lo, hi);
+  return f;
+}
+
+}  // namespace gssm::plot

@@ -1,0 +1,88 @@
+#include "gssm/plot/run_figures.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "gssm/plot/figure.h"
+
+namespace gssm::plot {
+
+namespace {
+std::string display(const std::string& method) {
+  if (method == "batch") return "batch MAP (smoother)";
+  if (method == "incremental") return "GSSM incremental";
+  if (method == "fixed-lag") return "GSSM fixed-lag";
+  if (method == "paper-window") return "paper window";
+  if (method == "ekf") return "EKF";
+  return method;
+}
+}  // namespace
+
+std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
+                                         const io::Truth* truth, const std::string& dir,
+                                         const std::string& scenario_label) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> written;
+  const auto names = model.stackedStateNames();
+  const int nc = model.dims().nc;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto idx = static_cast<Eigen::Index>(i);
+    const bool constant = static_cast<int>(i) >= nc;
+    if (!constant && !truth) continue;
+    Figure f;
+    f.title = constant ? names[i] + ": estimate and 3-sigma band (" + scenario_label + ")"
+                       : names[i] + " error: estimate - truth, with 3-sigma band (" + scenario_label + ")";
+    f.xlabel = "time t (s)";
+    f.ylabel = constant ? names[i] : names[i] + " error";
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      const Color c = paletteColor(r);
+      Series s{display(runs[r].method), {}, {}, c, 2, false};
+      Band b{{}, {}, {}, c, 0.15};
+      std::size_t j = 0;
+      for (const auto& row : runs[r].rows) {
+        double ref = 0;
+        if (!constant) {
+          while (j < truth->times.size() && truth->times[j] < row.t - 1e-9) ++j;
+          if (j == truth->times.size()) break;
+          ref = truth->states[j][idx];
+        }
+        const double v = row.mean[idx] - ref, sd = std::sqrt(row.covariance(idx, idx));
+        s.x.push_back(row.t);
+        s.y.push_back(v);
+        b.x.push_back(row.t);
+        b.lo.push_back(v - 3 * sd);
+        b.hi.push_back(v + 3 * sd);
+      }
+      f.bands.push_back(std::move(b));
+      f.series.push_back(std::move(s));
+    }
+    if (truth && constant) {
+      Series t{"truth", truth->times, {}, Color{0, 0, 0}, 1, true};
+      for (const auto& z : truth->states) t.y.push_back(z[idx]);
+      f.series.push_back(std::move(t));
+    } else if (!constant) {
+      f.series.push_back({"zero error", {runs.front().rows.front().t, runs.front().rows.back().t}, {0, 0},
+                          Color{0, 0, 0}, 1, true});
+    }
+    const std::string path = (fs::path(dir) / ("fig-" + names[i] + (constant ? "" : "-error") + ".png")).string();
+    savePng(f, path);
+    written.push_back(path);
+  }
+  std::vector<std::pair<std::string, std::vector<double>>> lat;
+  for (const auto& r : runs)
+    if (r.update_seconds.size() > 1) {
+      std::vector<double> us;
+      for (double s : r.update_seconds) us.push_back(std::log10(std::max(s * 1e6, 1e-3)));
+      lat.emplace_back(display(r.method), us);
+    }
+  if (!lat.empty()) {
+    Figure h = histogram(lat, 40, "per-update latency (" + scenario_label + ")",
+                         "log10 of latency in microseconds (1 = 10 us, 2 = 100 us); slowest 1% not shown");
+    const std::string path = (fs::path(dir) / "fig-latency.png").string();
+    savePng(h, path);
+    written.push_back(path);
+  }
+  return written;
+}
+
+}  // namespace gssm::plot

@@ -1,0 +1,78 @@
+#include <gtest/gtest.h>
+#include <mrpt/img/CImage.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "gssm/plot/figure.h"
+#include "gssm/plot/ticks.h"
+
+using namespace gssm::plot;
+
+TEST(Ticks, RoundNumbersCoveringTheRange) {
+  struct Case {
+    double lo, hi;
+  };
+  for (const Case c : {Case{0, 20}, Case{-47.3, 212.9}, Case{995.2, 1025.4}, Case{0.0012, 0.0093},
+                       Case{-3e6, 7e6}, Case{5, 5}, Case{-0.5, 0.49}}) {
+    const Ticks t = niceTicks(c.lo, c.hi, 8);
+    ASSERT_GE(t.values.size(), 2u);
+    EXPECT_LE(t.values.size(), 8u) << c.lo << " " << c.hi;
+    EXPECT_LE(t.lo, c.lo);
+    EXPECT_GE(t.hi, c.hi);
+    // step is 1, 2, 2.5 or 5 times a power of ten
+    const double mant = t.step / std::pow(10.0, std::floor(std::log10(t.step)));
+    EXPECT_TRUE(std::abs(mant - 1) < 1e-9 || std::abs(mant - 2) < 1e-9 || std::abs(mant - 2.5) < 1e-9 ||
+                std::abs(mant - 5) < 1e-9)
+        << "step " << t.step;
+    for (double v : t.values) EXPECT_NEAR(v / t.step, std::round(v / t.step), 1e-9) << v;
+    // the range is not wildly larger than the data
+    if (c.hi > c.lo) {
+      EXPECT_LT(t.hi - t.lo, 3 * (c.hi - c.lo));
+    }
+  }
+  EXPECT_EQ(niceTicks(0, 20, 9).step, 2.5);
+  EXPECT_EQ(formatTick(2.5, 2.5), "2.5");
+  EXPECT_EQ(formatTick(1000, 5), "1000");
+  EXPECT_EQ(formatTick(0.05, 0.05), "0.05");
+  EXPECT_EQ(formatTick(0, 0.5), "0.0");
+}
+
+TEST(Figure, WritesAPngOfTheRequestedSizeThatIsNotBlank) {
+  Figure f;
+  f.title = "test";
+  f.xlabel = "t";
+  f.ylabel = "y";
+  Series s{"sin", {}, {}, paletteColor(0), 2, false};
+  Band b{{}, {}, {}, paletteColor(0), 0.2};
+  for (int i = 0; i <= 100; ++i) {
+    const double x = i * 0.1, y = std::sin(x);
+    s.x.push_back(x);
+    s.y.push_back(y);
+    b.x.push_back(x);
+    b.lo.push_back(y - 0.2);
+    b.hi.push_back(y + 0.2);
+  }
+  s.y[0] = 1e6;  // a first-step outlier must not squash the rest
+  f.series.push_back(s);
+  f.bands.push_back(b);
+  const std::string path = (std::filesystem::temp_directory_path() / "gssm_plot_test.png").string();
+  savePng(f, path, 640, 400);
+  mrpt::img::CImage img;
+  ASSERT_TRUE(img.loadFromFile(path));
+  EXPECT_EQ(img.getWidth(), 640u);
+  EXPECT_EQ(img.getHeight(), 400u);
+  // Count pixels of the series colour (the curve), and non-white pixels.
+  std::size_t curve = 0, ink = 0;
+  const Color c = paletteColor(0);
+  for (unsigned y = 0; y < 400; ++y)
+    for (unsigned x = 0; x < 640; ++x) {
+      const uint8_t* p = img.ptr<uint8_t>(x, y);
+      if (p[0] != 255 || p[1] != 255 || p[2] != 255) ++ink;
+      if (p[2] == c.r && p[1] == c.g && p[0] == c.b) ++curve;
+    }
+  EXPECT_GT(ink, 640u * 400u / 50);
+  // the sine spans most of the plot height: its curve has many pixels, which
+  // it would not if the 1e6 outlier had set the range
+  EXPECT_GT(curve, 800u);
+}
