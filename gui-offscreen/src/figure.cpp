@@ -148,7 +148,9 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
   double ylo = fig.bars.empty() ? quantile(ys, fig.robust_quantile) : 0.0;
   double yhi = quantile(ys, fig.bars.empty() ? 1 - fig.robust_quantile : 1.0);
   const double pad = 0.06 * std::max(yhi - ylo, 1e-9 * std::max(1.0, std::abs(yhi)));
+  const bool non_negative = *std::min_element(ys.begin(), ys.end()) >= 0;
   if (fig.bars.empty()) ylo -= pad;
+  if (non_negative) ylo = std::max(ylo, 0.0);  // e.g. an RMSE axis starts at 0
   yhi += pad;
   if (fig.xlim) xmin = fig.xlim->first, xmax = fig.xlim->second;
   if (fig.ylim) ylo = fig.ylim->first, yhi = fig.ylim->second;

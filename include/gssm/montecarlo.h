@@ -1,0 +1,58 @@
+#pragma once
+// Monte Carlo comparison of estimators on a scenario over many seeds
+// (the paper's claim, tested honestly).
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "gssm/io/ini.h"
+#include "gssm/simulation.h"
+
+namespace gssm {
+
+struct MonteCarloOptions {
+  int seeds = 100;
+  unsigned first_seed = 1;
+  int threads = 2;
+  int window = 10;
+  std::vector<std::string> methods{"ekf", "fixed-lag", "incremental", "paper-window", "batch"};
+  /// Called from worker threads after each seed (done, total); may be empty.
+  std::function<void(int, int)> progress;
+  bool validate(std::string* why = nullptr) const;
+};
+
+struct MethodSummary {
+  std::string method;
+  Eigen::VectorXd mean_rmse;        ///< per stacked state, mean over seeds of the run's RMSE
+  Eigen::VectorXd rms_final_error;  ///< per stacked state, RMS over seeds of the last error
+  double mean_nees = 0;             ///< average over seeds and steps
+  double nees_step_in_interval = 0; ///< fraction of steps whose seed-average NEES is inside the 95% interval
+  Eigen::VectorXd beats_ekf;        ///< per stacked state: fraction of seeds with RMSE below the EKF's
+  std::vector<double> times;        ///< measurement times
+  std::vector<Eigen::VectorXd> rmse_over_time;  ///< per step: sqrt(mean over seeds of e²)
+  int failures = 0;                 ///< seeds where the estimator threw (excluded)
+  std::string first_failure;
+};
+
+struct MonteCarloResult {
+  std::string scenario;
+  int seeds = 0, steps = 0, dof = 0;
+  double nees_lo = 0, nees_hi = 0;  ///< 95% interval of a seed-average NEES at one step
+  std::vector<std::string> state_names;
+  std::vector<MethodSummary> methods;
+  double seconds = 0;
+  /// The Markdown table (one row per method).
+  std::string markdown() const;
+};
+
+/// Runs the scenario described by `scenario` (as builtinScenario or a
+/// dataset's scenario.ini) for seeds first_seed.. with every method.
+/// `sampler_for_seed` makes the N(0, 1) source of one seed.
+MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarloOptions& options,
+                               const std::function<NormalSampler(unsigned)>& sampler_for_seed);
+
+/// χ²_k quantile (Wilson–Hilferty; accurate to ~1% for k ≥ 10).
+double chiSquareQuantile(double p, int k);
+
+}  // namespace gssm

@@ -1,0 +1,218 @@
+#include "gssm/montecarlo.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "gssm/error.h"
+#include "gssm/estimator.h"
+#include "gssm/io/config.h"
+#include "gssm/offline.h"
+
+namespace gssm {
+
+bool MonteCarloOptions::validate(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = "MonteCarloOptions: " + m;
+    return false;
+  };
+  if (seeds < 1) return fail("seeds must be >= 1");
+  if (threads < 1) return fail("threads must be >= 1");
+  if (window < 1) return fail("window must be >= 1");
+  if (methods.empty()) return fail("no methods");
+  if (std::find(methods.begin(), methods.end(), "ekf") == methods.end())
+    return fail("methods must include ekf (the baseline every method is compared with)");
+  return true;
+}
+
+double chiSquareQuantile(double p, int k) {
+  // Inverse normal by Acklam's rational approximation (|error| < 1.2e-9).
+  auto probit = [](double q) {
+    static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                               1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
+    static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                               6.680131188771972e+01, -1.328068155288572e+01};
+    static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                               -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
+    static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                               3.754408661907416e+00};
+    if (q < 0.02425) {
+      const double t = std::sqrt(-2 * std::log(q));
+      return (((((c[0] * t + c[1]) * t + c[2]) * t + c[3]) * t + c[4]) * t + c[5]) /
+             ((((d[0] * t + d[1]) * t + d[2]) * t + d[3]) * t + 1);
+    }
+    if (q > 1 - 0.02425) {
+      const double t = std::sqrt(-2 * std::log(1 - q));
+      return -(((((c[0] * t + c[1]) * t + c[2]) * t + c[3]) * t + c[4]) * t + c[5]) /
+             ((((d[0] * t + d[1]) * t + d[2]) * t + d[3]) * t + 1);
+    }
+    const double t = q - 0.5, r = t * t;
+    return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * t /
+           (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
+  };
+  const double z = probit(p), h = 2.0 / (9.0 * k);
+  return k * std::pow(1 - h + z * std::sqrt(h), 3);
+}
+
+namespace {
+// Per seed and method: squared errors and NEES at every step.
+struct SeedResult {
+  bool ok = false;
+  std::string error;
+  std::vector<Eigen::VectorXd> sq;  // per step
+  std::vector<double> nees;
+  Eigen::VectorXd rmse, final_error;
+};
+}  // namespace
+
+MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarloOptions& options,
+                               const std::function<NormalSampler(unsigned)>& sampler_for_seed) {
+  std::string why;
+  if (!options.validate(&why)) throw InvalidArgument(why);
+  const auto start = std::chrono::steady_clock::now();
+  const auto model = io::makeModel(scenario);
+  const SimulationSpec spec = io::simulationSpec(scenario, *model);
+  const std::size_t M = options.methods.size(), S = static_cast<std::size_t>(options.seeds);
+  const int n = model->dims().nc + model->dims().nb;
+  std::vector<std::vector<SeedResult>> results(M, std::vector<SeedResult>(S));
+  std::vector<double> times;
+  std::mutex times_mutex;
+  std::atomic<int> next{0}, done{0};
+
+  auto worker = [&] {
+    for (int s = next++; s < options.seeds; s = next++) {
+      const unsigned seed = options.first_seed + static_cast<unsigned>(s);
+      const SimulatedRun run = simulate(*model, spec, sampler_for_seed(seed));
+      {
+        std::lock_guard<std::mutex> lock(times_mutex);
+        if (times.empty())
+          for (const auto& m : run.measurements) times.push_back(m.t);
+      }
+      for (std::size_t mi = 0; mi < M; ++mi) {
+        SeedResult& r = results[mi][static_cast<std::size_t>(s)];
+        try {
+          OfflineRun out;
+          if (options.methods[mi] == "batch") {
+            out = runBatch(*model, BatchSolverOptions{}, run.measurements);
+          } else {
+            EstimatorOptions eo;
+            eo.method = options.methods[mi];
+            eo.window = options.window;
+            eo.ekf = io::ekfOptions(scenario, *model);
+            out = runStreaming(*model, eo, run.measurements);
+          }
+          Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
+          for (std::size_t k = 0; k < out.rows.size(); ++k) {
+            Eigen::VectorXd truth(n);
+            truth << run.states[k + 1], run.constants;
+            const Eigen::VectorXd e = out.rows[k].mean - truth;
+            r.sq.push_back(e.cwiseAbs2());
+            r.nees.push_back(e.dot(out.rows[k].covariance.ldlt().solve(e)));
+            sum += e.cwiseAbs2();
+            r.final_error = e;
+          }
+          r.rmse = (sum / static_cast<double>(out.rows.size())).cwiseSqrt();
+          r.ok = true;
+        } catch (const std::exception& e) {
+          r.error = e.what();
+        }
+      }
+      if (options.progress) options.progress(++done, options.seeds);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < std::min(options.threads, options.seeds); ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+
+  MonteCarloResult res;
+  res.scenario = scenario.getString("scenario", "name", "?");
+  res.seeds = options.seeds;
+  res.steps = spec.steps;
+  res.dof = n;
+  res.state_names = model->stackedStateNames();
+  res.nees_lo = chiSquareQuantile(0.025, n * options.seeds) / options.seeds;
+  res.nees_hi = chiSquareQuantile(0.975, n * options.seeds) / options.seeds;
+  const std::size_t ekf = static_cast<std::size_t>(
+      std::find(options.methods.begin(), options.methods.end(), "ekf") - options.methods.begin());
+  for (std::size_t mi = 0; mi < M; ++mi) {
+    MethodSummary m;
+    m.method = options.methods[mi];
+    m.times = times;
+    m.mean_rmse = m.rms_final_error = m.beats_ekf = Eigen::VectorXd::Zero(n);
+    std::vector<Eigen::VectorXd> sq_t(static_cast<std::size_t>(spec.steps), Eigen::VectorXd::Zero(n));
+    std::vector<double> nees_t(static_cast<std::size_t>(spec.steps), 0.0);
+    int ok = 0;
+    for (std::size_t s = 0; s < S; ++s) {
+      const SeedResult& r = results[mi][s];
+      if (!r.ok) {
+        if (m.failures++ == 0) m.first_failure = "seed " + std::to_string(options.first_seed + s) + ": " + r.error;
+        continue;
+      }
+      ++ok;
+      m.mean_rmse += r.rmse;
+      m.rms_final_error += r.final_error.cwiseAbs2();
+      if (results[ekf][s].ok)
+        for (int i = 0; i < n; ++i) m.beats_ekf[i] += r.rmse[i] < results[ekf][s].rmse[i] ? 1.0 : 0.0;
+      for (std::size_t k = 0; k < r.sq.size() && k < sq_t.size(); ++k) {
+        sq_t[k] += r.sq[k];
+        nees_t[k] += r.nees[k];
+      }
+    }
+    if (ok > 0) {
+      m.mean_rmse /= ok;
+      m.rms_final_error = (m.rms_final_error / ok).cwiseSqrt();
+      m.beats_ekf /= ok;
+      int inside = 0;
+      for (std::size_t k = 0; k < sq_t.size(); ++k) {
+        m.rmse_over_time.push_back((sq_t[k] / ok).cwiseSqrt());
+        const double avg = nees_t[k] / ok;
+        m.mean_nees += avg / static_cast<double>(sq_t.size());
+        inside += (avg >= res.nees_lo && avg <= res.nees_hi) ? 1 : 0;
+      }
+      m.nees_step_in_interval = static_cast<double>(inside) / static_cast<double>(sq_t.size());
+    }
+    res.methods.push_back(std::move(m));
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return res;
+}
+
+std::string MonteCarloResult::markdown() const {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  auto perState = [&](const Eigen::VectorXd& v, int prec) {
+    std::ostringstream o;
+    o.setf(std::ios::fixed);
+    o.precision(prec);
+    for (Eigen::Index i = 0; i < v.size(); ++i) o << (i ? " / " : "") << v[i];
+    return o.str();
+  };
+  std::string names;
+  for (const auto& s : state_names) names += (names.empty() ? "" : " / ") + s;
+  os.precision(2);
+  os << "Scenario `" << scenario << "`, " << seeds << " seeds × " << steps << " steps; NEES has " << dof
+     << " dof, 95% interval of a " << seeds << "-seed average at one step: [" << nees_lo << ", " << nees_hi
+     << "].\n\n";
+  os << "| method | mean RMSE (" << names << ") | RMS final error (" << names << ") | mean NEES | steps with NEES in 95% interval | seeds beating the EKF (" << names << ") | failures |\n";
+  os << "| --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& m : methods) {
+    os << "| " << m.method << (m.method == "batch" ? " (smoother, uses future data)" : "") << " | "
+       << perState(m.mean_rmse, 3) << " | " << perState(m.rms_final_error, 3) << " | ";
+    os.precision(2);
+    os << m.mean_nees << " | " << std::lround(100 * m.nees_step_in_interval) << "% | ";
+    if (m.method == "ekf") os << "— | ";
+    else {
+      Eigen::VectorXd pct = 100 * m.beats_ekf;
+      os << perState(pct, 0) << " % | ";
+    }
+    os << m.failures << " |\n";
+  }
+  return os.str();
+}
+
+}  // namespace gssm
