@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <functional>
 #include <iostream>
+#include <unistd.h>
 
 #include "cli.h"
 #include "gssm/io/config.h"
@@ -65,6 +67,15 @@ int main(int argc, char** argv) {
     gssm::io::readDatasetData(data, *model, ds);
     fs::create_directories(out);
 
+    // Progress on stderr, only when it is a terminal and the run is long.
+    const bool tty = isatty(STDERR_FILENO) && ds.measurements.size() >= 20000;
+    auto progress = [tty](const std::string& m) -> std::function<void(std::size_t, std::size_t)> {
+      if (!tty) return {};
+      return [m](std::size_t done, std::size_t total) {
+        std::cerr << "\r" << m << ": " << 100 * done / total << "% (" << done << "/" << total << ")"
+                  << (done == total ? "\n" : "") << std::flush;
+      };
+    };
     std::vector<gssm::RunMetrics> metrics;
     std::vector<gssm::OfflineRun> runs;
     for (const auto& m : methods) {
@@ -74,7 +85,7 @@ int main(int argc, char** argv) {
       eo.ekf = gssm::io::ekfOptions(config, *model);
       gssm::OfflineRun run = m == "batch"
           ? gssm::runBatch(*model, gssm::BatchSolverOptions{}, ds.measurements)
-          : gssm::runStreaming(*model, eo, ds.measurements);
+          : gssm::runStreaming(*model, eo, ds.measurements, {}, progress(m));
       writeEstimates((fs::path(out) / ("estimates-" + m + ".csv")).string(), *model, run);
       metrics.push_back(gssm::computeMetrics(*model, run, ds.truth ? &*ds.truth : nullptr));
       const auto& last = run.rows.back();

@@ -3,6 +3,7 @@
 // order and collects what it reports after each one: the common back end of
 // the dataset processor and the Monte Carlo runner.
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,9 +34,11 @@ struct OfflineRun {
 /// Streams the measurements (and inputs, in time order) through a streaming
 /// estimator made by makeEstimator(model, options); rows hold current()
 /// after each measurement.
+/// `progress(done, total)`, if set, is called every 1% of the measurements.
 OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::vector<Measurement>& measurements,
-                        const std::vector<Input>& inputs = {});
+                        const std::vector<Input>& inputs = {},
+                        const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 /// The batch MAP of the whole run; rows hold the smoothed estimate at each
 /// measurement time with its marginal covariance.

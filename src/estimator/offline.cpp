@@ -16,9 +16,11 @@ double since(Clock::time_point t0) {
 
 OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::vector<Measurement>& measurements,
-                        const std::vector<Input>& inputs) {
+                        const std::vector<Input>& inputs,
+                        const std::function<void(std::size_t, std::size_t)>& progress) {
   OfflineRun out;
   out.method = options.method;
+  const std::size_t every = std::max<std::size_t>(1, measurements.size() / 100);
   const auto start = Clock::now();
   auto est = makeEstimator(model, options);
   std::size_t next_input = 0;
@@ -33,6 +35,8 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
     const StateEstimate e = est->current();
     out.rows.push_back({e.t, e.mean, e.covariance});
     out.iterations = std::max(out.iterations, est->report().iterations);
+    if (progress && (out.rows.size() % every == 0 || out.rows.size() == measurements.size()))
+      progress(out.rows.size(), measurements.size());
   }
   out.total_seconds = since(start);
   out.summary = est->report().detail;
