@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
                                 "estimates-<method>.csv and metrics.json to OUTDIR.");
     cli.option("data", "DIR", "dataset folder");
     cli.option("method", "ekf|batch|incremental|fixed-lag|paper-window|all", "estimator to run", "all");
-    cli.option("window", "W", "states kept by fixed-lag and paper-window", "10");
+    cli.option("window", "W", "states kept by fixed-lag and paper-window (overrides [fixed_lag] / [paper_window] window)");
     cli.option("config", "FILE", "INI file to use instead of DIR/scenario.ini");
     cli.option("out", "OUTDIR", "output folder");
     cli.parse(argc, argv);
@@ -59,7 +59,6 @@ int main(int argc, char** argv) {
                                     "': expected ekf, batch, incremental, fixed-lag, paper-window or all");
       methods = {method};
     }
-    const int window = static_cast<int>(cli.getInt("window", 1, 1000000));
 
     const gssm::io::IniDocument config = gssm::io::readScenario(data, cli.get("config"));
     const auto model = gssm::io::makeModel(config);
@@ -81,8 +80,11 @@ int main(int argc, char** argv) {
     for (const auto& m : methods) {
       gssm::EstimatorOptions eo;
       eo.method = m;
-      eo.window = window;
+      const std::string section = m == "paper-window" ? "paper_window" : "fixed_lag";
+      eo.window = cli.given("window") ? static_cast<int>(cli.getInt("window", 1, 1000000))
+                                      : gssm::io::windowOption(config, section, 10);
       eo.ekf = gssm::io::ekfOptions(config, *model);
+      eo.smoother = gssm::io::smootherOptions(config);
       gssm::OfflineRun run = m == "batch"
           ? gssm::runBatch(*model, gssm::BatchSolverOptions{}, ds.measurements)
           : gssm::runStreaming(*model, eo, ds.measurements, {}, progress(m));

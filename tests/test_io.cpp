@@ -104,3 +104,23 @@ TEST(Csv, ParsesAndReportsLineColumnValue) {
   expectInputError([] { parseCsv("0.05,1000\n", "m.csv"); }, {"m.csv:1", "header"});
   expectInputError([] { parseCsv("", "m.csv"); }, {"m.csv", "empty"});
 }
+
+TEST(Config, EstimatorSectionsAreReadAndChecked) {
+  auto ini = builtinScenario("paper", 1, 10);
+  ini.set("smoother", "ordering", "time");
+  ini.set("smoother", "relinearize_threshold", 0.5);
+  ini.set("fixed_lag", "window", "25");
+  const auto parsed = IniDocument::parse(ini.toString(), "s.ini");
+  const SmootherOptions o = smootherOptions(parsed);
+  EXPECT_EQ(o.ordering, EliminationOrdering::TimeOrdered);
+  EXPECT_EQ(o.relinearize_threshold, 0.5);
+  EXPECT_EQ(windowOption(parsed, "fixed_lag", 10), 25);
+  EXPECT_EQ(windowOption(parsed, "paper_window", 10), 10);
+  ini.set("smoother", "wildfire", "1");
+  expectInputError([&] { smootherOptions(IniDocument::parse(ini.toString(), "s.ini")); },
+                   {"s.ini", "unknown key 'wildfire'", "[smoother]"});
+  ini = builtinScenario("paper", 1, 10);
+  ini.set("fixed_lag", "window", "0");
+  expectInputError([&] { windowOption(IniDocument::parse(ini.toString(), "s.ini"), "fixed_lag", 10); },
+                   {"s.ini", "window"});
+}

@@ -102,6 +102,33 @@ ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& mode
   return o;
 }
 
+SmootherOptions smootherOptions(const IniDocument& ini) {
+  ini.requireOnlyKeys("smoother", {"relinearize", "relinearize_threshold", "constants_check_sigmas",
+                                   "max_local_iterations", "wildfire_threshold", "ordering"});
+  SmootherOptions o;
+  o.relinearize = ini.getBool("smoother", "relinearize", o.relinearize);
+  o.relinearize_threshold = ini.getDouble("smoother", "relinearize_threshold", o.relinearize_threshold);
+  o.constants_check_sigmas = ini.getDouble("smoother", "constants_check_sigmas", o.constants_check_sigmas);
+  o.max_local_iterations =
+      static_cast<int>(ini.getInt("smoother", "max_local_iterations", o.max_local_iterations));
+  o.wildfire_threshold = ini.getDouble("smoother", "wildfire_threshold", o.wildfire_threshold);
+  const std::string ordering = ini.getString("smoother", "ordering", "colamd");
+  if (ordering != "colamd" && ordering != "time")
+    throw InputError(ini.source() + ": [smoother] ordering = '" + ordering + "': expected colamd or time");
+  o.ordering = ordering == "time" ? EliminationOrdering::TimeOrdered : EliminationOrdering::ConstrainedColamd;
+  std::string why;
+  if (!o.validate(&why)) throw InputError(ini.source() + ": [smoother] " + why);
+  return o;
+}
+
+int windowOption(const IniDocument& ini, const std::string& section, int fallback) {
+  ini.requireOnlyKeys(section, {"window"});
+  const long long w = ini.getInt(section, "window", fallback);
+  if (w < 1 || w > 10000000)
+    throw InputError(ini.source() + ": [" + section + "] window = " + std::to_string(w) + ": expected >= 1");
+  return static_cast<int>(w);
+}
+
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {
   SimulationSpec s;
   s.steps = static_cast<int>(ini.getInt("scenario", "steps"));

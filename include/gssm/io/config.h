@@ -7,7 +7,8 @@
 //   [truth]  state0, constants (absent: drawn from the prior), process_noise,
 //            measurement_noise
 //   [scenario] name, seed, steps
-//   [ekf]    constant_process_noise
+//   [ekf]    constant_process_noise, joseph_form
+//   [smoother], [fixed_lag], [paper_window]  estimator settings (below)
 #include <memory>
 #include <string>
 
@@ -15,6 +16,7 @@
 #include "gssm/io/ini.h"
 #include "gssm/model.h"
 #include "gssm/simulation.h"
+#include "gssm/smoothers.h"
 
 namespace gssm::io {
 
@@ -25,6 +27,11 @@ std::unique_ptr<Model> makeModel(const IniDocument& ini);
 void writeModel(const Model& model, IniDocument& ini);
 
 ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& model);
+/// [smoother]: relinearize, relinearize_threshold, constants_check_sigmas,
+/// max_local_iterations, wildfire_threshold, ordering (colamd | time);
+/// [fixed_lag] / [paper_window]: window. Absent keys keep the defaults.
+SmootherOptions smootherOptions(const IniDocument& ini);
+int windowOption(const IniDocument& ini, const std::string& section, int fallback);
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model);
 
 /// Names of the built-in scenarios ("paper", "consistent").
