@@ -2,7 +2,9 @@
 
 #include <random>
 
+#include "gssm/batch_solver.h"
 #include "gssm/error.h"
+#include "gssm/problem.h"
 #include "gssm/estimator.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
@@ -157,6 +159,19 @@ TEST(Estimator, FixedLagNewestStateEqualsKalmanFilterThroughTheStreamingApi) {
       const auto s = est->smoothed(3);
       ASSERT_TRUE(s.has_value());
       EXPECT_LT(relativeError(s->mean, ref.zs[3]), 1e-8);
+      // any pair of variables: compare with the batch solution of the same data
+      Problem p = buildProblem(model, run.measurements);
+      Values x = p.initial;
+      BatchSolver batch;
+      ASSERT_TRUE(batch.solve(p.graph, x).converged);
+      const std::vector<Key> pair{Key::state(2), Key::state(20)};
+      const auto cov = est->marginalCovariance(pair);
+      ASSERT_TRUE(cov.has_value());
+      EXPECT_LT(relativeError(*cov, batch.jointMarginalCovariance(pair)), 1e-8);
+    }
+    if (method == "ekf") {
+      EXPECT_FALSE(est->marginalCovariance({Key::state(3)}).has_value());
+      EXPECT_LT(relativeError(*est->marginalCovariance({Key::constants()}), ref.Pf.back().bottomRightCorner(2, 2)), 1e-8);
     }
     if (method == "fixed-lag") {
       EXPECT_FALSE(est->smoothed(3).has_value());  // left the window

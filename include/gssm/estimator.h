@@ -72,6 +72,10 @@ class Estimator {
   /// newest only). nullopt otherwise.
   virtual std::optional<StateEstimate> smoothed(std::int64_t k) = 0;
 
+  /// Joint marginal covariance of the given variables (blocks in order), when
+  /// the method holds them all (EKF: the newest state and the constants).
+  virtual std::optional<Eigen::MatrixXd> marginalCovariance(const std::vector<Key>& keys) = 0;
+
   const EstimatorReport& report() const { return report_; }
   double time() const { return t_; }
   std::int64_t step() const { return k_; }

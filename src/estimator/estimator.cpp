@@ -92,6 +92,24 @@ class EkfEstimator final : public Estimator {
     if (k == step()) return current();
     return std::nullopt;
   }
+  std::optional<Eigen::MatrixXd> marginalCovariance(const std::vector<Key>& keys) override {
+    // Rows of the stacked state [x_c; x_b] that each key occupies.
+    const int nc = model_.dims().nc, nb = model_.dims().nb;
+    std::vector<Eigen::Index> idx;
+    for (const auto& k : keys) {
+      if (k.isConstants()) {
+        for (int i = 0; i < nb; ++i) idx.push_back(nc + i);
+      } else if (k.step == step()) {
+        for (int i = 0; i < nc; ++i) idx.push_back(i);
+      } else {
+        return std::nullopt;
+      }
+    }
+    Eigen::MatrixXd out(idx.size(), idx.size());
+    for (std::size_t a = 0; a < idx.size(); ++a)
+      for (std::size_t b = 0; b < idx.size(); ++b) out(a, b) = ekf_.covariance()(idx[a], idx[b]);
+    return out;
+  }
 
  protected:
   void doStep(std::int64_t, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
@@ -168,6 +186,12 @@ class SmootherEstimator final : public Estimator {
     return e;
   }
 
+  std::optional<Eigen::MatrixXd> marginalCovariance(const std::vector<Key>& keys) override {
+    for (const auto& k : keys)
+      if (!smoother_.contains(k)) return std::nullopt;
+    return smoother_.jointMarginalCovariance(keys);
+  }
+
  protected:
   void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
     const auto factors = stepFactors(model_, k, dt, u, y);
@@ -221,6 +245,11 @@ class PaperWindowEstimator final : public Estimator {
     e.covariance = nb ? solver_.jointMarginalCovariance({Key::state(k), Key::constants()})
                       : solver_.marginalCovariance(Key::state(k));
     return e;
+  }
+  std::optional<Eigen::MatrixXd> marginalCovariance(const std::vector<Key>& keys) override {
+    for (const auto& k : keys)
+      if (!values_.contains(k)) return std::nullopt;
+    return solver_.jointMarginalCovariance(keys);
   }
 
  protected:
