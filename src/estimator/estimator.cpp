@@ -36,6 +36,9 @@ Estimator::Estimator(const Model& model, const std::string& method, double t0)
 
 void Estimator::addInput(double t, const Eigen::VectorXd& u) {
   requireVector(u, model_.dims().nu, method() + ": input u at t = " + std::to_string(t));
+  // A time stamp within rounding of the newest state's (k·T computed two
+  // ways) means "now".
+  if (std::isfinite(t) && t < t_ && t_ - t <= 1e-9 * std::max(1.0, std::abs(t_))) t = t_;
   if (!std::isfinite(t) || t < t_ || (!inputs_.empty() && !(t > inputs_.back().t))) {
     std::ostringstream os;
     os << method() << ": input at t = " << t << " must be at or after the newest state (t = " << t_
