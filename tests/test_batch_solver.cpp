@@ -226,26 +226,18 @@ TEST(BatchSolverOptions, ValidateExplainsWhatIsWrong) {
   EXPECT_THROW(BatchSolver{o}, InvalidArgument);
 }
 
-TEST(Problem, RejectsTimesThatDoNotIncrease) {
+TEST(Problem, RejectsTimesGoingBackwardsAndGroupsEqualTimesIntoOneStep) {
   const models::Radar2D radar;
   std::vector<Measurement> ms{{0.05, Eigen::VectorXd::Constant(1, 1000)},
-                              {0.05, Eigen::VectorXd::Constant(1, 1000)}};
+                              {0.04, Eigen::VectorXd::Constant(1, 1000)}};
   try {
     buildProblem(radar, ms);
     FAIL();
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("measurement 1"), std::string::npos) << e.what();
   }
-}
-
-TEST(BatchSolver, EkfAndDeadReckoningInitialGuessesReachTheSameMap) {
-  const models::Radar2D radar;
-  const SimulatedRun run = radarPaperRun(radar, 400, 4);
-  Problem p = buildProblem(radar, run.measurements);
-  Values a = p.initial;
-  Values b = ekfInitialGuess(radar, ExtendedKalmanFilterOptions{}, run.measurements);
-  BatchSolver solver;
-  ASSERT_TRUE(solver.solve(p.graph, a).converged);
-  ASSERT_TRUE(solver.solve(p.graph, b).converged);
-  for (const auto& kv : a) EXPECT_LT(relativeError(kv.second, b.at(kv.first)), 1e-7) << kv.first.toString();
+  ms[1].t = 0.05;  // two measurements at one time: one step, two measurement factors
+  const Problem p = buildProblem(radar, ms);
+  EXPECT_EQ(p.times.size(), 2u);
+  EXPECT_EQ(p.graph.size(), 5u);  // 2 priors, 1 process, 2 measurements
 }

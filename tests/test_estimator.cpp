@@ -66,7 +66,7 @@ TEST(Estimator, EveryThrowingPathLeavesTheEstimatorUnchanged) {
     for (int k = 0; k < 12; ++k) est->addMeasurement(run.measurements[k].t, run.measurements[k].y);
     const Snapshot before(*est);
     const double t = run.measurements[12].t;
-    expectThrowsNaming([&] { est->addMeasurement(run.measurements[11].t, run.measurements[12].y); }, "must be after");
+    expectThrowsNaming([&] { est->addMeasurement(run.measurements[10].t, run.measurements[12].y); }, "must be after");
     expectThrowsNaming([&] { est->addMeasurement(t, Eigen::VectorXd::Constant(1, NAN)); }, "measurement y");
     expectThrowsNaming([&] { est->addMeasurement(t, Eigen::VectorXd::Constant(2, 1.0)); }, "expected 1 entries");
     expectThrowsNaming([&] { est->addMeasurement(NAN, run.measurements[12].y); }, "measurement time");

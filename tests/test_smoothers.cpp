@@ -4,6 +4,7 @@
 #include <random>
 
 #include "gssm/batch_solver.h"
+#include "gssm/estimator.h"
 #include "gssm/error.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
@@ -202,4 +203,52 @@ TEST(FixedLagSmoother, HundredThousandStepsKeepVariablesAndFactorsBounded) {
   // window process+measurement factors, the x_b prior, one marginal prior
   EXPECT_EQ(reps.at(100000).num_factors, reps.at(1000).num_factors);
   EXPECT_LE(reps.at(100000).num_factors, 2u * 10 + 2);
+}
+
+TEST(MultiRate, RangesEveryFifthStepBatchEqualsIncrementalAfterEveryUpdate) {
+  // Inputs every step define the steps; measurements arrive every 5th step.
+  std::mt19937 rng(12);
+  models::LinearSystem sys = gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1);
+  sys.B = Eigen::MatrixXd::Random(3, 1);
+  const models::LinearModel model(sys);
+  SimulationSpec spec;
+  spec.steps = 40;
+  const SimulatedRun run = simulate(model, spec, normalSampler(13));
+  std::vector<Input> inputs;
+  std::vector<Measurement> ms;
+  for (int k = 0; k < spec.steps; ++k) {
+    inputs.push_back({run.times[k], Eigen::VectorXd::Constant(1, std::cos(0.3 * k))});
+    if ((k + 1) % 5 == 0) ms.push_back(run.measurements[static_cast<std::size_t>(k)]);
+  }
+  for (const std::string method : {"incremental", "fixed-lag", "ekf", "paper-window"}) {
+    EstimatorOptions o;
+    o.method = method;
+    o.window = 30;  // longer than the run: fixed-lag then equals incremental
+    auto est = makeEstimator(model, o);
+    std::size_t next_m = 0;
+    for (int k = 0; k < spec.steps; ++k) {
+      est->addInput(inputs[static_cast<std::size_t>(k)].t, inputs[static_cast<std::size_t>(k)].u);
+      if (next_m < ms.size() && std::abs(ms[next_m].t - run.times[k + 1]) < 1e-12) {
+        est->addMeasurement(ms[next_m].t, ms[next_m].y);
+        ++next_m;
+        if (method == "paper-window") continue;  // runs, but is not exact
+        const std::vector<Measurement> upto(ms.begin(), ms.begin() + static_cast<long>(next_m));
+        const std::vector<Input> in_upto(inputs.begin(), inputs.begin() + k + 1);
+        Problem p = buildProblem(model, upto, in_upto);
+        Values x = p.initial;
+        BatchSolver batch;
+        ASSERT_TRUE(batch.solve(p.graph, x).converged);
+        const auto kk = static_cast<std::int64_t>(p.times.size()) - 1;
+        ASSERT_EQ(est->step(), kk) << method;
+        Eigen::VectorXd z(5);
+        z << x.at(Key::state(kk)), x.at(Key::constants());
+        EXPECT_LT(relativeError(est->current().mean, z), 1e-8) << method << " step " << kk;
+        EXPECT_LT(relativeError(est->current().covariance,
+                                batch.jointMarginalCovariance({Key::state(kk), Key::constants()})),
+                  1e-8)
+            << method << " step " << kk;
+      }
+    }
+    EXPECT_EQ(next_m, ms.size());
+  }
 }

@@ -59,10 +59,14 @@ class Estimator {
   virtual ~Estimator() = default;
   const std::string& method() const { return report_.method; }
 
-  /// Input u held from time t on (zero-order hold); t must not be before the
-  /// newest state's time.
+  /// Input u held from time t on (zero-order hold). A t after the newest
+  /// state first advances the state to t (a step with no measurement, under
+  /// the input in force until then): inputs at a high rate (an IMU) define
+  /// the steps. t before the newest state is an error.
   void addInput(double t, const Eigen::VectorXd& u);
-  /// A measurement y at time t (> the previous one): one new step.
+  /// A measurement y at time t. After the newest state: a new step to t. At
+  /// the newest state's time (after t0): attached to that state (multi-rate
+  /// sensors, several measurements per step).
   void addMeasurement(double t, const Eigen::VectorXd& y);
 
   /// Newest state and constants with their joint covariance.
@@ -83,21 +87,22 @@ class Estimator {
 
  protected:
   Estimator(const Model& model, const std::string& method, double t0);
-  /// Processes a validated step k−1 → k; must be strongly exception safe.
+  /// Processes a validated step k−1 → k under input u, with the measurement
+  /// y at x_c(k) when y is non-empty; must be strongly exception safe.
   virtual void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u,
                       const Eigen::VectorXd& y) = 0;
+  /// Adds a measurement at the newest state x_c(k), k ≥ 1; strongly safe.
+  virtual void doMeasurement(std::int64_t k, const Eigen::VectorXd& y) = 0;
 
   const Model& model_;
   EstimatorReport report_;
 
  private:
+  void advance(double t);  // process-only step to t
+  Eigen::VectorXd inputInForce() const;
   double t_;            // time of the newest state
   std::int64_t k_ = 0;  // its step
-  struct HeldInput {
-    double t;
-    Eigen::VectorXd u;
-  };
-  std::vector<HeldInput> inputs_;  // from the newest state's time on
+  Eigen::VectorXd input_;  // in force from the newest state on (empty: zeros)
 };
 
 /// Builds the estimator named by options.method; the model must outlive it.

@@ -39,39 +39,44 @@ void Estimator::addInput(double t, const Eigen::VectorXd& u) {
   // A time stamp within rounding of the newest state's (k·T computed two
   // ways) means "now".
   if (std::isfinite(t) && t < t_ && t_ - t <= 1e-9 * std::max(1.0, std::abs(t_))) t = t_;
-  if (!std::isfinite(t) || t < t_ || (!inputs_.empty() && !(t > inputs_.back().t))) {
+  if (!std::isfinite(t) || t < t_) {
     std::ostringstream os;
-    os << method() << ": input at t = " << t << " must be at or after the newest state (t = " << t_
-       << ") and after the previous input";
+    os << method() << ": input at t = " << t << " must be at or after the newest state (t = " << t_ << ")";
     throw InvalidArgument(os.str());
   }
-  inputs_.push_back({t, u});
+  if (t > t_) advance(t);  // strong guarantee: throws before changing anything
+  input_ = u;
+}
+
+Eigen::VectorXd Estimator::inputInForce() const {
+  return input_.size() ? input_ : Eigen::VectorXd(Eigen::VectorXd::Zero(model_.dims().nu));
+}
+
+void Estimator::advance(double t) {
+  const auto start = std::chrono::steady_clock::now();
+  doStep(k_ + 1, t - t_, inputInForce(), Eigen::VectorXd());
+  t_ = t;
+  ++k_;
+  report_.steps = k_;
+  report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
   const auto start = std::chrono::steady_clock::now();
-  if (!std::isfinite(t) || !(t > t_)) {
+  if (!std::isfinite(t) || t < t_ || (t == t_ && k_ == 0)) {
     std::ostringstream os;
-    os << method() << ": measurement time " << t << " must be after the previous one (" << t_
-       << ")";
+    os << method() << ": measurement time " << t << " must be after the previous state (" << t_ << ")"
+       << (k_ == 0 ? ", the start t0" : "");
     throw InvalidArgument(os.str());
   }
   requireVector(y, model_.dims().ny, method() + ": measurement y at t = " + std::to_string(t));
-  // The input in force at the start of the interval (zero-order hold).
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(model_.dims().nu);
-  std::size_t used = 0;
-  for (std::size_t i = 0; i < inputs_.size() && inputs_[i].t <= t_; ++i) {
-    u = inputs_[i].u;
-    used = i;
+  if (t == t_) {
+    doMeasurement(k_, y);  // at the newest state
+  } else {
+    doStep(k_ + 1, t - t_, inputInForce(), y);  // strong guarantee: throws before changing anything
+    t_ = t;
+    ++k_;
   }
-  doStep(k_ + 1, t - t_, u, y);  // strong guarantee: throws before changing anything
-  // Keep the input in force at t and any later ones.
-  std::size_t keep = 0;
-  for (std::size_t i = used; i < inputs_.size(); ++i)
-    if (inputs_[i].t <= t) keep = i;
-  if (!inputs_.empty()) inputs_.erase(inputs_.begin(), inputs_.begin() + static_cast<long>(keep));
-  t_ = t;
-  ++k_;
   report_.steps = k_;
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -118,9 +123,15 @@ class EkfEstimator final : public Estimator {
   void doStep(std::int64_t, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
     ExtendedKalmanFilter next = ekf_;  // commit only if both halves succeed
     next.predict(ekf_.time() + dt, u);
-    next.update(y);
+    if (y.size()) next.update(y);
     ekf_ = std::move(next);
     report_.iterations = 1;
+    report_.detail = y.size() ? "EKF update, NIS " + std::to_string(ekf_.lastNis()) : "EKF prediction";
+  }
+  void doMeasurement(std::int64_t, const Eigen::VectorXd& y) override {
+    ExtendedKalmanFilter next = ekf_;
+    next.update(y);
+    ekf_ = std::move(next);
     report_.detail = "EKF update, NIS " + std::to_string(ekf_.lastNis());
   }
 
@@ -133,8 +144,9 @@ class EkfEstimator final : public Estimator {
 // and the measurement at x_c(k); x_c(k) starts at its prediction.
 std::vector<FactorPtr> stepFactors(const Model& m, std::int64_t k, double dt,
                                    const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
-  return {std::make_shared<ProcessFactor>(m, k - 1, u, dt),
-          std::make_shared<MeasurementFactor>(m, k, y)};
+  std::vector<FactorPtr> f{std::make_shared<ProcessFactor>(m, k - 1, u, dt)};
+  if (y.size()) f.push_back(std::make_shared<MeasurementFactor>(m, k, y));
+  return f;
 }
 
 // x_c(k) starts at the model's prediction; a non-finite one is a numerical
@@ -207,6 +219,11 @@ class SmootherEstimator final : public Estimator {
     report_.detail = report_.smoother.toString();
     times_.push_back(times_.back() + dt);
     while (keep_times_ > 0 && times_.size() > keep_times_) times_.pop_front();
+  }
+  void doMeasurement(std::int64_t k, const Eigen::VectorXd& y) override {
+    report_.smoother = smoother_.update({std::make_shared<MeasurementFactor>(model_, k, y)}, Values{});
+    report_.iterations = report_.smoother.iterations;
+    report_.detail = report_.smoother.toString();
   }
 
  private:
@@ -294,6 +311,18 @@ class PaperWindowEstimator final : public Estimator {
   }
 
  private:
+  void doMeasurement(std::int64_t k, const Eigen::VectorXd& y) override {
+    auto steps = steps_;
+    Values values = values_;
+    steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, y));
+    BatchSolver solver(gaussNewton());
+    const BatchSolverSummary sum = solve(values, solver, &steps, &prior_state_, &prior_constants_, oldest_);
+    steps_ = std::move(steps);
+    values_ = std::move(values);
+    solver_ = std::move(solver);
+    report_.iterations = sum.iterations;
+    report_.detail = sum.toString();
+  }
   static BatchSolverOptions gaussNewton() {
     BatchSolverOptions o;
     o.method = BatchSolverOptions::Method::GaussNewton;

@@ -1,6 +1,7 @@
 #include "gssm/problem.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "gssm/error.h"
@@ -18,9 +19,19 @@ Problem buildProblem(const Model& model, const std::vector<Measurement>& measure
                      const std::vector<Input>& inputs, double t0) {
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     requireVector(inputs[i].u, model.dims().nu, "input " + std::to_string(i));
-    if (i > 0 && !(inputs[i].t > inputs[i - 1].t))
-      throw InvalidArgument("input " + std::to_string(i) + ": time " +
-                            std::to_string(inputs[i].t) + " is not after the previous input");
+    if (!std::isfinite(inputs[i].t) || (i > 0 && !(inputs[i].t > inputs[i - 1].t)))
+      throw InvalidArgument("input " + std::to_string(i) + ": time " + std::to_string(inputs[i].t) +
+                            " is not after the previous input");
+  }
+  for (std::size_t i = 0; i < measurements.size(); ++i) {
+    const double t = measurements[i].t;
+    const double prev = i ? measurements[i - 1].t : t0;
+    if (!std::isfinite(t) || !(t > t0) || t < prev) {
+      std::ostringstream os;
+      os << "measurement " << i << ": time " << t << " must be after t0 = " << t0
+         << " and not before the previous measurement (" << prev << ")";
+      throw InvalidArgument(os.str());
+    }
   }
   Problem p;
   p.times.push_back(t0);
@@ -31,24 +42,27 @@ Problem buildProblem(const Model& model, const std::vector<Measurement>& measure
     p.graph.add(std::make_shared<PriorFactor>(Key::constants(), model.priorConstants()));
     p.initial.insert(Key::constants(), model.priorConstants().mean);
   }
-  const Eigen::VectorXd xb0 =
-      has_constants ? model.priorConstants().mean : Eigen::VectorXd();
-  for (std::size_t i = 0; i < measurements.size(); ++i) {
-    const Measurement& m = measurements[i];
+  const Eigen::VectorXd xb0 = has_constants ? model.priorConstants().mean : Eigen::VectorXd();
+  // Steps at every input time after t0 and every measurement time (as the
+  // streaming estimators make them); measurements attach at their time.
+  std::size_t mi = 0, ii = 0;
+  while (ii < inputs.size() && inputs[ii].t <= t0) ++ii;
+  while (mi < measurements.size() || ii < inputs.size()) {
+    const double t = std::min(mi < measurements.size() ? measurements[mi].t : INFINITY,
+                              ii < inputs.size() ? inputs[ii].t : INFINITY);
     const double prev = p.times.back();
-    if (!std::isfinite(m.t) || !(m.t > prev)) {
-      std::ostringstream os;
-      os << "measurement " << i << ": time " << m.t << " must be after " << prev
-         << " (times must increase strictly)";
-      throw InvalidArgument(os.str());
+    if (t > prev) {
+      const auto k = static_cast<std::int64_t>(p.times.size()) - 1;
+      const Eigen::VectorXd u = inputAt(model, inputs, prev);
+      p.graph.add(std::make_shared<ProcessFactor>(model, k, u, t - prev));
+      p.initial.insert(Key::state(k + 1), model.f(p.initial.at(Key::state(k)), xb0, u, t - prev));
+      p.times.push_back(t);
     }
     const auto k = static_cast<std::int64_t>(p.times.size()) - 1;
-    const Eigen::VectorXd u = inputAt(model, inputs, prev);
-    const double dt = m.t - prev;
-    p.graph.add(std::make_shared<ProcessFactor>(model, k, u, dt));
-    p.graph.add(std::make_shared<MeasurementFactor>(model, k + 1, m.y));
-    p.initial.insert(Key::state(k + 1), model.f(p.initial.at(Key::state(k)), xb0, u, dt));
-    p.times.push_back(m.t);
+    for (; mi < measurements.size() && measurements[mi].t == t; ++mi)
+      p.graph.add(std::make_shared<MeasurementFactor>(model, k, measurements[mi].y));
+    for (; ii < inputs.size() && inputs[ii].t == t; ++ii) {
+    }
   }
   return p;
 }
