@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+
 #include "gssm/error.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
@@ -80,4 +82,33 @@ TEST(Model, RejectsBadDimensionsAndCovariances) {
   models::LinearSystem sys = gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1);
   sys.C_b = Eigen::MatrixXd::Zero(2, 3);
   EXPECT_THROW(models::LinearModel{sys}, InvalidArgument);
+}
+
+#include "gssm/models/nav2d.h"
+
+TEST(Nav2D, AnalyticJacobiansMatchCentralDifferences) {
+  models::Nav2D nav;
+  gssm::testing::expectJacobiansMatchDifferences(nav, [](std::mt19937& rng) {
+    JacobianPoint p;
+    p.xc = uniformVector(rng, 4, -50, 250);
+    p.xc.tail<2>() = uniformVector(rng, 2, -10, 10);
+    p.xb = uniformVector(rng, 3, -1, 1);
+    p.u = uniformVector(rng, 2, -3, 3);
+    p.dt = 0.1;
+    return p;
+  });
+}
+
+TEST(Nav2D, ProcessNoiseIsTheWhiteAccelerationModel) {
+  models::Nav2D nav;
+  const Eigen::MatrixXd Q = nav.processNoise(0.2);
+  EXPECT_NEAR(Q(0, 0), 0.05 * 0.05 * 0.008 / 3, 1e-15);
+  EXPECT_NEAR(Q(0, 2), 0.05 * 0.05 * 0.02, 1e-15);
+  EXPECT_NEAR(Q(2, 2), 0.05 * 0.05 * 0.2, 1e-15);
+  EXPECT_EQ(Q(0, 1), 0.0);
+  EXPECT_GT(Eigen::LLT<Eigen::MatrixXd>(Q).info() == Eigen::Success, 0);
+  // constant acceleration integrates exactly: u − b_a = (1, 0) over 1 s
+  const Eigen::VectorXd x = nav.f(Eigen::Vector4d(0, 0, 0, 0), Eigen::Vector3d(0.5, 0, 0), Eigen::Vector2d(1.5, 0), 1.0);
+  EXPECT_DOUBLE_EQ(x[0], 0.5);
+  EXPECT_DOUBLE_EQ(x[2], 1.0);
 }

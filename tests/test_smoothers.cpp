@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <map>
 #include <random>
 
@@ -250,5 +251,70 @@ TEST(MultiRate, RangesEveryFifthStepBatchEqualsIncrementalAfterEveryUpdate) {
       }
     }
     EXPECT_EQ(next_m, ms.size());
+  }
+}
+
+#include "gssm/models/nav2d.h"
+
+namespace {
+// A Nav2D run: a curving trajectory from measured accelerations (bias
+// included), ranges to 4 beacons every `every` steps.
+SimulatedRun navRun(const models::Nav2D& nav, int steps, int every, unsigned seed) {
+  SimulationSpec spec;
+  spec.steps = steps;
+  spec.measure_every = every;
+  spec.xb = Eigen::Vector3d(0.05, -0.03, 2.0);
+  spec.input = [](double t) { return Eigen::VectorXd(Eigen::Vector2d(0.5 * std::cos(0.2 * t), 0.5 * std::sin(0.2 * t))); };
+  return simulate(nav, spec, normalSampler(seed));
+}
+
+// Streams a run (inputs at every step, measurements as they come).
+void stream(Estimator& est, const SimulatedRun& run, const std::function<void(int)>& after_measurement) {
+  std::size_t m = 0;
+  for (std::size_t k = 0; k < run.inputs.size(); ++k) {
+    est.addInput(run.inputs[k].t, run.inputs[k].u);
+    for (; m < run.measurements.size() && run.measurements[m].t <= run.times[k + 1] + 1e-12; ++m) {
+      est.addMeasurement(run.measurements[m].t, run.measurements[m].y);
+      after_measurement(static_cast<int>(m) + 1);
+    }
+  }
+}
+}  // namespace
+
+TEST(Nav2D, BatchEqualsIncrementalAfterEveryUpdateAndFixedLagEqualsIncremental) {
+  const models::Nav2D nav;
+  for (int every : {1, 5}) {
+    const SimulatedRun run = navRun(nav, 150, every, 21);
+    EstimatorOptions inc_o, fl_o;
+    inc_o.method = "incremental";
+    inc_o.smoother.iterate_to_convergence = true;
+    fl_o.method = "fixed-lag";
+    fl_o.window = 1000;  // longer than the run
+    fl_o.smoother.iterate_to_convergence = true;
+    auto inc = makeEstimator(nav, inc_o), fl = makeEstimator(nav, fl_o);
+    Values warm;
+    stream(*inc, run, [&](int nm) {
+      const std::vector<Measurement> ms(run.measurements.begin(), run.measurements.begin() + nm);
+      const auto k = inc->step();
+      const std::vector<Input> in(run.inputs.begin(), run.inputs.begin() + k);
+      Problem p = buildProblem(nav, ms, in);
+      Values x = p.initial;
+      for (const auto& kv : warm)
+        if (x.contains(kv.first)) x.at(kv.first) = kv.second;
+      BatchSolverOptions bo;
+      bo.relative_cost_tolerance = 0;
+      bo.gradient_tolerance = 0;
+      bo.step_tolerance = 1e-13;
+      BatchSolver batch(bo);
+      ASSERT_TRUE(batch.solve(p.graph, x).converged);
+      warm = x;
+      ASSERT_EQ(static_cast<std::int64_t>(p.times.size()) - 1, k);
+      Eigen::VectorXd z(7);
+      z << x.at(Key::state(k)), x.at(Key::constants());
+      EXPECT_LT(relativeError(inc->current().mean, z), 1e-6) << "every " << every << " step " << k;
+    });
+    stream(*fl, run, [](int) {});
+    EXPECT_LT(relativeError(fl->current().mean, inc->current().mean), 1e-6) << "every " << every;
+    EXPECT_LT(relativeError(fl->current().covariance, inc->current().covariance), 1e-6) << "every " << every;
   }
 }

@@ -118,3 +118,34 @@ TEST(LinearModel, ReadFromIniGivesTheSameEstimatesAsBuiltInCpp) {
     EXPECT_EQ(a->current().covariance, b->current().covariance) << method;
   }
 }
+
+#include "gssm/models/nav2d.h"
+
+TEST(FunctionModel, NumericJacobiansOnNav2DGiveTheSameEstimates) {
+  const models::Nav2D nav;
+  models::ModelFunctions fns;
+  fns.name = "nav2d-numeric";
+  fns.f = [&nav](const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u, double dt) {
+    return nav.f(xc, xb, u, dt);
+  };
+  fns.h = [&nav](const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) { return nav.h(xc, xb); };
+  const models::FunctionModel numeric(nav.dims(), nav.names(), nav.noise(), fns);
+  SimulationSpec spec;
+  spec.steps = 200;
+  spec.measure_every = 2;
+  spec.input = [](double t) { return Eigen::VectorXd(Eigen::Vector2d(0.3 * std::cos(t), 0.2)); };
+  const SimulatedRun run = simulate(nav, spec, normalSampler(17));
+  for (const auto& method : estimatorMethods()) {
+    EstimatorOptions o;
+    o.method = method;
+    auto a = makeEstimator(nav, o), n = makeEstimator(numeric, o);
+    std::size_t m = 0;
+    for (std::size_t k = 0; k < run.inputs.size(); ++k) {
+      for (auto* e : {a.get(), n.get()}) e->addInput(run.inputs[k].t, run.inputs[k].u);
+      for (; m < run.measurements.size() && run.measurements[m].t <= run.times[k + 1] + 1e-12; ++m)
+        for (auto* e : {a.get(), n.get()}) e->addMeasurement(run.measurements[m].t, run.measurements[m].y);
+    }
+    EXPECT_LT(relativeError(n->current().mean, a->current().mean), 1e-6) << method;
+    EXPECT_LT(relativeError(n->current().covariance, a->current().covariance), 1e-6) << method;
+  }
+}

@@ -21,13 +21,17 @@ struct SimulationSpec {
   std::optional<Eigen::VectorXd> xb;  ///< true x_b; drawn from the prior if absent
   bool process_noise = true;          ///< draw q_c ~ N(0, Q) each step
   bool measurement_noise = true;      ///< draw r ~ N(0, R) each measurement
+  /// Input u(t) applied over [t_k, t_k+1) (zero-order hold); empty: zeros.
+  std::function<Eigen::VectorXd(double t)> input;
+  int measure_every = 1;              ///< a measurement every this many steps (multi-rate)
 };
 
 struct SimulatedRun {
   std::vector<double> times;             ///< t_k, k = 0..steps (t_0 = 0, step T)
   std::vector<Eigen::VectorXd> states;   ///< true x_c(k), k = 0..steps
   Eigen::VectorXd constants;             ///< true x_b
-  std::vector<Measurement> measurements; ///< y(k), k = 1..steps
+  std::vector<Measurement> measurements; ///< y(k) at every measure_every-th step
+  std::vector<Input> inputs;             ///< u at t_k, k = 0..steps−1 (empty without an input profile)
 };
 
 /// Draws x ~ N(mean, cov) with `draw`.

@@ -17,6 +17,7 @@ Eigen::VectorXd sampleGaussian(const Eigen::VectorXd& mean, const Eigen::MatrixX
 
 SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const NormalSampler& draw) {
   if (spec.steps < 0) throw InvalidArgument("simulate: steps must be >= 0");
+  if (spec.measure_every < 1) throw InvalidArgument("simulate: measure_every must be >= 1");
   const ModelDims& d = model.dims();
   SimulatedRun run;
   // Draw order is fixed (x0, xb, then per step q then r) so a seed gives one run.
@@ -29,18 +30,23 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
   requireVector(run.states[0], d.nc, "simulate: true x_c(0)");
   requireVector(run.constants, d.nb, "simulate: true x_b");
   const double T = model.nominalStep();
-  const Eigen::VectorXd u = Eigen::VectorXd::Zero(d.nu);
   const Eigen::VectorXd zc = Eigen::VectorXd::Zero(d.nc), zy = Eigen::VectorXd::Zero(d.ny);
   run.times.push_back(0.0);
   for (int k = 1; k <= spec.steps; ++k) {
+    const double t_prev = (k - 1) * T;
+    const Eigen::VectorXd u = spec.input ? spec.input(t_prev) : Eigen::VectorXd(Eigen::VectorXd::Zero(d.nu));
+    requireVector(u, d.nu, "simulate: input at t = " + std::to_string(t_prev));
+    if (spec.input) run.inputs.push_back({t_prev, u});
     Eigen::VectorXd x = model.f(run.states.back(), run.constants, u, T);
     if (spec.process_noise) x += sampleGaussian(zc, model.processNoise(T), draw);
-    Eigen::VectorXd y = model.h(x, run.constants);
-    if (spec.measurement_noise) y += sampleGaussian(zy, model.measurementNoise(), draw);
     const double t = k * T;
+    if (k % spec.measure_every == 0) {
+      Eigen::VectorXd y = model.h(x, run.constants);
+      if (spec.measurement_noise) y += sampleGaussian(zy, model.measurementNoise(), draw);
+      run.measurements.push_back({t, std::move(y)});
+    }
     run.times.push_back(t);
     run.states.push_back(std::move(x));
-    run.measurements.push_back({t, std::move(y)});
   }
   return run;
 }
