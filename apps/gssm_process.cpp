@@ -86,8 +86,8 @@ int main(int argc, char** argv) {
       eo.ekf = gssm::io::ekfOptions(config, *model);
       eo.smoother = gssm::io::smootherOptions(config);
       gssm::OfflineRun run = m == "batch"
-          ? gssm::runBatch(*model, gssm::BatchSolverOptions{}, ds.measurements)
-          : gssm::runStreaming(*model, eo, ds.measurements, {}, progress(m));
+          ? gssm::runBatch(*model, gssm::BatchSolverOptions{}, ds.measurements, ds.inputs)
+          : gssm::runStreaming(*model, eo, ds.measurements, ds.inputs, progress(m));
       writeEstimates((fs::path(out) / ("estimates-" + m + ".csv")).string(), *model, run);
       metrics.push_back(gssm::computeMetrics(*model, run, ds.truth ? &*ds.truth : nullptr));
       const auto& last = run.rows.back();

@@ -264,7 +264,7 @@ SimulatedRun navRun(const models::Nav2D& nav, int steps, int every, unsigned see
   spec.steps = steps;
   spec.measure_every = every;
   spec.xb = Eigen::Vector3d(0.05, -0.03, 2.0);
-  spec.input = [](double t) { return Eigen::VectorXd(Eigen::Vector2d(0.5 * std::cos(0.2 * t), 0.5 * std::sin(0.2 * t))); };
+  spec.input = [](double t, const Eigen::VectorXd&) { return Eigen::VectorXd(Eigen::Vector2d(0.5 * std::cos(0.2 * t), 0.5 * std::sin(0.2 * t))); };
   return simulate(nav, spec, normalSampler(seed));
 }
 

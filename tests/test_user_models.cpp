@@ -133,7 +133,7 @@ TEST(FunctionModel, NumericJacobiansOnNav2DGiveTheSameEstimates) {
   SimulationSpec spec;
   spec.steps = 200;
   spec.measure_every = 2;
-  spec.input = [](double t) { return Eigen::VectorXd(Eigen::Vector2d(0.3 * std::cos(t), 0.2)); };
+  spec.input = [](double t, const Eigen::VectorXd&) { return Eigen::VectorXd(Eigen::Vector2d(0.3 * std::cos(t), 0.2)); };
   const SimulatedRun run = simulate(nav, spec, normalSampler(17));
   for (const auto& method : estimatorMethods()) {
     EstimatorOptions o;

@@ -203,22 +203,25 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
   centeredText(img, (ax.left + ax.right) / 2, height - 26, fig.xlabel, text);
   img.textOut(ax.left, ax.top - 20, fig.ylabel, text);
 
-  if (fig.legend && !fig.series.empty()) {
+  std::vector<const Series*> labelled;
+  for (const auto& s : fig.series)
+    if (!s.label.empty()) labelled.push_back(&s);
+  if (fig.legend && !labelled.empty()) {
     int w = 0;
-    for (const auto& s : fig.series) w = std::max(w, static_cast<int>(s.label.size()));
-    const int lw = 44 + w * kCharW, lh = 8 + 18 * static_cast<int>(fig.series.size());
+    for (const auto* s : labelled) w = std::max(w, static_cast<int>(s->label.size()));
+    const int lw = 44 + w * kCharW, lh = 8 + 18 * static_cast<int>(labelled.size());
     const int x0 = ax.right - lw - 10, y0 = ax.top + 10;
     img.filledRectangle(x0, y0, x0 + lw, y0 + lh, TColor(255, 255, 255));
     img.rectangle(x0, y0, x0 + lw, y0 + lh, TColor(170, 170, 170));
-    for (std::size_t i = 0; i < fig.series.size(); ++i) {
+    for (std::size_t i = 0; i < labelled.size(); ++i) {
       const int y = y0 + 12 + 18 * static_cast<int>(i);
-      Series sample = fig.series[i];
+      Series sample = *labelled[i];
       Axes lax{x0, y0, x0 + lw, y0 + lh, 0, 1, 0, 1};
       sample.x = {static_cast<double>(x0 + 8 - x0) / lw, static_cast<double>(x0 + 34 - x0) / lw};
       const double yy = 1.0 - static_cast<double>(y - y0) / lh;
       sample.y = {yy, yy};
       drawSeries(img, lax, sample);
-      img.textOut(x0 + 40, y - kCharH / 2, fig.series[i].label, text);
+      img.textOut(x0 + 40, y - kCharH / 2, labelled[i]->label, text);
     }
   }
   if (!img.saveToFile(path)) throw std::runtime_error(path + ": cannot write the PNG");

@@ -1,8 +1,10 @@
 #include "gssm/plot/run_figures.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
+#include "gssm/models/nav2d.h"
 #include "gssm/plot/figure.h"
 
 namespace gssm::plot {
@@ -65,6 +67,49 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
                           Color{0, 0, 0}, 1, true});
     }
     const std::string path = (fs::path(dir) / ("fig-" + names[i] + (constant ? "" : "-error") + ".png")).string();
+    savePng(f, path);
+    written.push_back(path);
+  }
+  // A plan view for models with a 2-D position (px, py): truth, estimates, beacons.
+  const auto ipx = std::find(names.begin(), names.end(), "px"), ipy = std::find(names.begin(), names.end(), "py");
+  if (ipx != names.end() && ipy != names.end()) {
+    const auto ix = static_cast<Eigen::Index>(ipx - names.begin()), iy = static_cast<Eigen::Index>(ipy - names.begin());
+    Figure f;
+    f.title = "trajectory, plan view (" + scenario_label + ")";
+    f.xlabel = "px (m)";
+    f.ylabel = "py (m)";
+    f.robust_quantile = 0.0;
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      Series s{display(runs[r].method), {}, {}, paletteColor(r), 2, false};
+      for (const auto& row : runs[r].rows) {
+        s.x.push_back(row.mean[ix]);
+        s.y.push_back(row.mean[iy]);
+      }
+      f.series.push_back(std::move(s));
+    }
+    if (truth) {
+      Series t{"truth", {}, {}, Color{0, 0, 0}, 1, true};
+      for (const auto& z : truth->states) {
+        t.x.push_back(z[ix]);
+        t.y.push_back(z[iy]);
+      }
+      f.series.push_back(std::move(t));
+    }
+    if (const auto* nav = dynamic_cast<const models::Nav2D*>(&model)) {
+      for (std::size_t b = 0; b < nav->beacons().size(); ++b) {
+        // a small square marker per beacon, drawn as a closed series
+        const Eigen::Vector2d c = nav->beacons()[b];
+        Series m{b == 0 ? "beacons" : "", {c.x() - 3, c.x() + 3, c.x() + 3, c.x() - 3, c.x() - 3},
+                 {c.y() - 3, c.y() - 3, c.y() + 3, c.y() + 3, c.y() - 3}, Color{200, 0, 0}, 3, false};
+        f.series.push_back(std::move(m));
+      }
+    }
+    // Headroom above the data for the legend (it would hide a beacon).
+    double lo = INFINITY, hi = -INFINITY;
+    for (const auto& s : f.series)
+      for (double y : s.y) lo = std::min(lo, y), hi = std::max(hi, y);
+    if (hi > lo) f.ylim = std::make_pair(lo - 0.05 * (hi - lo), hi + 0.55 * (hi - lo));
+    const std::string path = (fs::path(dir) / "fig-trajectory.png").string();
     savePng(f, path);
     written.push_back(path);
   }

@@ -21,8 +21,9 @@ struct SimulationSpec {
   std::optional<Eigen::VectorXd> xb;  ///< true x_b; drawn from the prior if absent
   bool process_noise = true;          ///< draw q_c ~ N(0, Q) each step
   bool measurement_noise = true;      ///< draw r ~ N(0, R) each measurement
-  /// Input u(t) applied over [t_k, t_k+1) (zero-order hold); empty: zeros.
-  std::function<Eigen::VectorXd(double t)> input;
+  /// The measured input u over [t_k, t_k+1) (zero-order hold), given the
+  /// true constants x_b (a sensor reading includes its bias); empty: zeros.
+  std::function<Eigen::VectorXd(double t, const Eigen::VectorXd& xb)> input;
   int measure_every = 1;              ///< a measurement every this many steps (multi-rate)
 };
 

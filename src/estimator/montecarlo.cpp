@@ -98,18 +98,20 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
         try {
           OfflineRun out;
           if (options.methods[mi] == "batch") {
-            out = runBatch(*model, BatchSolverOptions{}, run.measurements);
+            out = runBatch(*model, BatchSolverOptions{}, run.measurements, run.inputs);
           } else {
             EstimatorOptions eo;
             eo.method = options.methods[mi];
             eo.window = options.window;
             eo.ekf = io::ekfOptions(scenario, *model);
-            out = runStreaming(*model, eo, run.measurements);
+            out = runStreaming(*model, eo, run.measurements, run.inputs);
           }
           Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
+          std::size_t j = 0;  // truth row at the estimate's time (multi-rate: not every step)
           for (std::size_t k = 0; k < out.rows.size(); ++k) {
+            while (j + 1 < run.times.size() && run.times[j] < out.rows[k].t - 1e-9) ++j;
             Eigen::VectorXd truth(n);
-            truth << run.states[k + 1], run.constants;
+            truth << run.states[j], run.constants;
             const Eigen::VectorXd e = out.rows[k].mean - truth;
             r.sq.push_back(e.cwiseAbs2());
             r.nees.push_back(e.dot(out.rows[k].covariance.ldlt().solve(e)));
@@ -144,8 +146,9 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
     m.method = options.methods[mi];
     m.times = times;
     m.mean_rmse = m.rms_final_error = m.beats_ekf = Eigen::VectorXd::Zero(n);
-    std::vector<Eigen::VectorXd> sq_t(static_cast<std::size_t>(spec.steps), Eigen::VectorXd::Zero(n));
-    std::vector<double> nees_t(static_cast<std::size_t>(spec.steps), 0.0);
+    const std::size_t rows = static_cast<std::size_t>(spec.steps / spec.measure_every);
+    std::vector<Eigen::VectorXd> sq_t(rows, Eigen::VectorXd::Zero(n));
+    std::vector<double> nees_t(rows, 0.0);
     int ok = 0;
     for (std::size_t s = 0; s < S; ++s) {
       const SeedResult& r = results[mi][s];

@@ -57,7 +57,12 @@ OfflineRun runBatch(const Model& model, const BatchSolverOptions& options,
   out.summary = sum.toString();
   out.update_seconds.push_back(sum.seconds);
   const int nc = model.dims().nc, nb = model.dims().nb;
+  // One row per measurement time (states between measurements, made by
+  // inputs, have no row), as the streaming runs report.
+  std::size_t mi = 0;
   for (std::size_t k = 1; k < p.times.size(); ++k) {
+    if (mi >= measurements.size() || measurements[mi].t != p.times[k]) continue;
+    while (mi < measurements.size() && measurements[mi].t == p.times[k]) ++mi;
     const Key key = Key::state(static_cast<std::int64_t>(k));
     EstimateRow row;
     row.t = p.times[k];

@@ -2,6 +2,7 @@
 
 #include "gssm/error.h"
 #include "gssm/models/linear.h"
+#include "gssm/models/nav2d.h"
 #include "gssm/models/radar2d.h"
 
 namespace gssm::io {
@@ -63,8 +64,29 @@ std::unique_ptr<Model> makeModel(const IniDocument& ini) {
           s, disc == "exact" ? models::Discretization::Exact : models::Discretization::Euler);
     });
   }
+  if (type == "nav2d") {
+    ini.requireOnlyKeys("model", {"type", "T", "R", "accel_noise", "beacons"});
+    const Eigen::MatrixXd B = ini.getMatrix("model", "beacons");
+    if (B.cols() != 2 || B.rows() < 1)
+      throw InputError(ini.source() + ": [model] beacons: expected rows of 'x y', one per beacon");
+    std::vector<Eigen::Vector2d> beacons;
+    for (Eigen::Index i = 0; i < B.rows(); ++i) beacons.emplace_back(B(i, 0), B(i, 1));
+    const double q = ini.getDouble("model", "accel_noise");
+    ModelNoise n;
+    n.T = ini.getDouble("model", "T");
+    n.R = ini.getMatrix("model", "R", B.rows(), B.rows());
+    n.prior_state.mean = ini.getVector("prior", "state_mean", 4);
+    n.prior_state.covariance = ini.getMatrix("prior", "state_cov", 4, 4);
+    n.prior_constants.mean = ini.getVector("prior", "constants_mean", 3);
+    n.prior_constants.covariance = ini.getMatrix("prior", "constants_cov", 3, 3);
+    return withSource(ini, [&] {
+      n.Q = Eigen::MatrixXd::Identity(4, 4);  // replaced by the white-acceleration model
+      auto m = std::make_unique<models::Nav2D>(n, beacons, q);
+      return std::unique_ptr<Model>(std::move(m));
+    });
+  }
   throw InputError(ini.source() + ": [model] type = '" + type +
-                   "': unknown model (known: radar2d, linear)");
+                   "': unknown model (known: radar2d, linear, nav2d)");
 }
 
 void writeModel(const Model& model, IniDocument& ini) {
@@ -78,11 +100,16 @@ void writeModel(const Model& model, IniDocument& ini) {
     ini.set("model", "C_b", s.C_b);
     ini.set("model", "discretization",
             lin->discretization() == models::Discretization::Exact ? "exact" : "euler");
+  } else if (const auto* nav = dynamic_cast<const models::Nav2D*>(&model)) {
+    Eigen::MatrixXd B(static_cast<Eigen::Index>(nav->beacons().size()), 2);
+    for (std::size_t i = 0; i < nav->beacons().size(); ++i) B.row(static_cast<Eigen::Index>(i)) = nav->beacons()[i].transpose();
+    ini.set("model", "beacons", B);
+    ini.set("model", "accel_noise", nav->accelNoise());
   } else if (model.name() != "radar2d") {
     throw InvalidArgument("writeModel: model '" + model.name() + "' has no INI form");
   }
   ini.set("model", "T", model.nominalStep());
-  ini.set("model", "Q", model.noise().Q);
+  if (!dynamic_cast<const models::Nav2D*>(&model)) ini.set("model", "Q", model.noise().Q);
   ini.set("model", "R", model.noise().R);
   ini.set("prior", "state_mean", Eigen::MatrixXd(model.priorState().mean.transpose()));
   ini.set("prior", "state_cov", model.priorState().covariance);
@@ -138,16 +165,62 @@ SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {
     s.xb = ini.getVector("truth", "constants", model.dims().nb);
   s.process_noise = ini.getBool("truth", "process_noise", true);
   s.measurement_noise = ini.getBool("truth", "measurement_noise", true);
+  s.measure_every = static_cast<int>(ini.getInt("scenario", "measure_every", 1));
+  if (s.measure_every < 1) throw InputError(ini.source() + ": [scenario] measure_every must be >= 1");
+  // Input profile: true acceleration a(t) = amplitude·(cos ωt, sin ωt) (a
+  // turning vehicle); an accelerometer measures a + b_a, the first n_u
+  // constants being its bias (Nav2D).
+  if (ini.has("truth", "input_amplitude")) {
+    const double amp = ini.getDouble("truth", "input_amplitude");
+    const double omega = ini.getDouble("truth", "input_omega");
+    const int nu = model.dims().nu;
+    const bool biased = ini.getBool("truth", "input_includes_bias", true) && model.dims().nb >= nu;
+    s.input = [amp, omega, nu, biased](double t, const Eigen::VectorXd& xb) {
+      Eigen::VectorXd u = Eigen::VectorXd::Zero(nu);
+      for (int i = 0; i + 1 < nu; i += 2) {
+        u[i] = amp * std::cos(omega * t);
+        u[i + 1] = amp * std::sin(omega * t);
+      }
+      if (biased) u += xb.head(nu);
+      return u;
+    };
+  }
   return s;
 }
 
-std::vector<std::string> scenarioNames() { return {"paper", "consistent"}; }
+std::vector<std::string> scenarioNames() { return {"paper", "consistent", "nav-paper-like", "nav-consistent"}; }
 
 IniDocument builtinScenario(const std::string& name, unsigned seed, int steps) {
   IniDocument ini;
   ini.set("scenario", "name", name);
   ini.set("scenario", "seed", std::to_string(seed));
   ini.set("scenario", "steps", std::to_string(steps));
+  if (name.rfind("nav-", 0) == 0) {
+    const models::Nav2D nav;
+    writeModel(nav, ini);
+    ini.set("scenario", "measure_every", "5");  // ranges at 2 Hz, accelerometer at 10 Hz
+    // Centripetal acceleration of a 50 m circle at 0.1 rad/s about (100, 100).
+    ini.set("truth", "input_amplitude", -0.5);
+    ini.set("truth", "input_omega", 0.1);
+    ini.set("ekf", "constant_process_noise", Eigen::MatrixXd(Eigen::RowVector3d::Zero()));
+    if (name == "nav-paper-like") {
+      ini.setComment("scenario",
+                     "Nav2D with priors several sigmas from the truth, as in the radar paper scenario:\n"
+                     "position 10 m (2 sd) and velocity 3 m/s (3 sd) off, accelerometer bias 2.5 sd,\n"
+                     "range bias 4 sd; no process noise in the truth.");
+      ini.set("prior", "state_mean", Eigen::MatrixXd(Eigen::RowVector4d(140, 110, 3, 2)));
+      ini.set("truth", "state0", Eigen::MatrixXd(Eigen::RowVector4d(150, 100, 0, 5)));
+      ini.set("truth", "constants", Eigen::MatrixXd(Eigen::RowVector3d(0.25, -0.15, 20)));
+      ini.set("truth", "process_noise", "false");
+    } else if (name == "nav-consistent") {
+      ini.setComment("scenario", "Nav2D with the truth drawn from the estimators' own prior and noise models.");
+      ini.set("truth", "process_noise", "true");
+    } else {
+      throw InvalidArgument("unknown scenario '" + name + "'");
+    }
+    ini.set("truth", "measurement_noise", "true");
+    return ini;
+  }
   const models::Radar2D radar;  // the paper's settings
   writeModel(radar, ini);
   if (name == "paper") {

@@ -43,6 +43,17 @@ void readDatasetData(const std::string& dir, const Model& model, Dataset& out) {
   for (const auto& row : m.rows)
     out.measurements.push_back(
         {row[0], Eigen::Map<const Eigen::VectorXd>(row.data() + 1, model.dims().ny)});
+  out.inputs.clear();
+  const fs::path ip = fs::path(dir) / "inputs.csv";
+  if (model.dims().nu > 0) {
+    if (!fs::exists(ip))
+      throw InputError(ip.string() + ": missing; model '" + model.name() + "' has inputs (" +
+                       std::to_string(model.dims().nu) + " columns after t)");
+    const CsvTable in = readCsv(ip.string());
+    checkTable(in, model.names().input);
+    for (const auto& row : in.rows)
+      out.inputs.push_back({row[0], Eigen::Map<const Eigen::VectorXd>(row.data() + 1, model.dims().nu)});
+  }
   out.truth.reset();
   const fs::path tp = fs::path(dir) / "truth.csv";
   if (fs::exists(tp)) {
@@ -81,6 +92,17 @@ void writeDataset(const std::string& dir, const Model& model, const SimulatedRun
     rows.push_back(std::move(r));
   }
   writeCsv((fs::path(dir) / "truth.csv").string(), th, rows);
+  if (!run.inputs.empty()) {
+    std::vector<std::string> ih{"t"};
+    for (const auto& n : model.names().input) ih.push_back(n);
+    rows.clear();
+    for (const auto& in : run.inputs) {
+      std::vector<double> r{in.t};
+      r.insert(r.end(), in.u.data(), in.u.data() + in.u.size());
+      rows.push_back(std::move(r));
+    }
+    writeCsv((fs::path(dir) / "inputs.csv").string(), ih, rows);
+  }
   scenario.save((fs::path(dir) / "scenario.ini").string());
 }
 

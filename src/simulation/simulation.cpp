@@ -34,7 +34,7 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
   run.times.push_back(0.0);
   for (int k = 1; k <= spec.steps; ++k) {
     const double t_prev = (k - 1) * T;
-    const Eigen::VectorXd u = spec.input ? spec.input(t_prev) : Eigen::VectorXd(Eigen::VectorXd::Zero(d.nu));
+    const Eigen::VectorXd u = spec.input ? spec.input(t_prev, run.constants) : Eigen::VectorXd(Eigen::VectorXd::Zero(d.nu));
     requireVector(u, d.nu, "simulate: input at t = " + std::to_string(t_prev));
     if (spec.input) run.inputs.push_back({t_prev, u});
     Eigen::VectorXd x = model.f(run.states.back(), run.constants, u, T);

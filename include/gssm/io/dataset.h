@@ -1,7 +1,8 @@
 #pragma once
 // Dataset folders: measurements.csv (t,<measurement names>, rows k = 1..N),
 // truth.csv (t,<state names>,<constant names>, rows k = 0..N, optional) and
-// scenario.ini (model, priors, truth settings, seed).
+// scenario.ini (model, priors, truth settings, seed), and inputs.csv
+// (t,<input names>) for models with inputs.
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@ struct Dataset {
   std::string dir;
   IniDocument scenario;
   std::vector<Measurement> measurements;
+  std::vector<Input> inputs;  ///< inputs.csv (t,<input names>), if the model has inputs
   std::optional<Truth> truth;
 };
 

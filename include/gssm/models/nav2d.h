@@ -19,7 +19,7 @@ class Nav2D final : public Model {
     double accel_noise = 0.05;  ///< white acceleration noise density (m/s²/√Hz): Q from a white-noise-acceleration model
     double range_sigma = 0.5;   ///< m
     std::vector<Eigen::Vector2d> beacons{{0, 0}, {200, 0}, {200, 200}, {0, 200}};
-    Eigen::Vector4d prior_state{50, 50, 5, 0};
+    Eigen::Vector4d prior_state{150, 100, 0, 5};  ///< on a 50 m circle about the beacons' centre
     Eigen::Vector4d prior_state_sd{5, 5, 1, 1};
     Eigen::Vector3d prior_constants{0, 0, 0};
     Eigen::Vector3d prior_constants_sd{0.1, 0.1, 5};
