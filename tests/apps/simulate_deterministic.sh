@@ -17,4 +17,13 @@ for s in consistent paper; do
   [ "$(wc -l < "$work/a-$s/measurements.csv")" -eq 51 ]
   [ "$(wc -l < "$work/a-$s/truth.csv")" -eq 52 ]
 done
+for s in nav-paper-like nav-consistent; do
+  "$bin/gssm-simulate" --scenario $s --seed 7 --steps 50 --out "$work/a-$s" > /dev/null
+  "$bin/gssm-simulate" --scenario $s --seed 7 --steps 50 --out "$work/b-$s" > /dev/null
+  for f in measurements.csv truth.csv inputs.csv scenario.ini; do
+    cmp "$work/a-$s/$f" "$work/b-$s/$f"
+  done
+  [ "$(wc -l < "$work/a-$s/measurements.csv")" -eq 11 ]  # ranges every 5th step
+  [ "$(wc -l < "$work/a-$s/inputs.csv")" -eq 51 ]
+done
 echo "simulate deterministic: ok"
