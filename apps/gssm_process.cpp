@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
     cli.option("window", "W", "states kept by fixed-lag and paper-window (overrides [fixed_lag] / [paper_window] window)");
     cli.option("config", "FILE", "INI file to use instead of DIR/scenario.ini");
     cli.option("out", "OUTDIR", "output folder");
+    cli.flag("skip-bad-rows", "skip malformed measurement rows (listed in metrics.json) instead of stopping at the first");
     cli.parse(argc, argv);
     const std::string data = cli.require("data"), out = cli.require("out");
     const std::string method = cli.get("method");
@@ -63,7 +64,13 @@ int main(int argc, char** argv) {
     const gssm::io::IniDocument config = gssm::io::readScenario(data, cli.get("config"));
     const auto model = gssm::io::makeModel(config);
     gssm::io::Dataset ds;
-    gssm::io::readDatasetData(data, *model, ds);
+    const bool skip = cli.given("skip-bad-rows");
+    gssm::io::readDatasetData(data, *model, ds, skip ? gssm::io::BadRows::Skip : gssm::io::BadRows::Stop);
+    gssm::DatasetStatus status;
+    if (skip) status.skipped = ds.row_errors;
+    else if (!ds.row_errors.empty()) status = {true, ds.row_errors.front(), {}};
+    for (const auto& e : status.skipped) std::cerr << "gssm-process: skipped " << e << "\n";
+    if (ds.measurements.empty()) throw std::runtime_error(status.partial ? status.stopped_at : "no measurements");
     fs::create_directories(out);
 
     // Progress on stderr, only when it is a terminal and the run is long.
@@ -101,11 +108,17 @@ int main(int argc, char** argv) {
       std::cout << "\n        " << run.summary << "\n";
       runs.push_back(std::move(run));
     }
-    std::ofstream((fs::path(out) / "metrics.json").string()) << gssm::metricsJson(metrics, data);
+    std::ofstream((fs::path(out) / "metrics.json").string()) << gssm::metricsJson(metrics, data, status);
     const std::string label = config.getString("scenario", "name", fs::path(data).filename().string());
     for (const auto& p : gssm::plot::writeRunFigures(*model, runs, ds.truth ? &*ds.truth : nullptr, out, label))
       std::cout << "figure: " << p << "\n";
     std::cout << "gssm-process: wrote " << out << "/metrics.json and estimates-*.csv\n";
+    if (status.partial) {
+      // Everything before the bad row was processed and written; say where it stopped.
+      std::cerr << "gssm-process: error: " << status.stopped_at << " (processed the " << ds.measurements.size()
+                << " rows before it; metrics.json is marked partial; --skip-bad-rows to go on)\n";
+      return 3;
+    }
     return 0;
   });
 }

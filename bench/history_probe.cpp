@@ -6,12 +6,22 @@
 #include "gssm/metrics.h"
 #include "gssm/models/radar2d.h"
 #include "gssm/simulation.h"
+#include "gssm/offline.h"
+#include "gssm/batch_solver.h"
 int main(int argc, char** argv) {
   const int steps = std::atoi(argv[1]); const std::string method = argv[2];
   gssm::models::Radar2D radar;
   gssm::SimulationSpec spec; spec.steps = steps; spec.x0 = Eigen::VectorXd::Constant(1,0.0); spec.xb = Eigen::Vector2d(100,1000); spec.process_noise=false;
   std::mt19937 rng(1); std::normal_distribution<double> n(0,1);
   auto run = gssm::simulate(radar, spec, [&]{return n(rng);});
+  if (method == "batch") {
+    auto t0 = std::chrono::steady_clock::now();
+    gssm::OfflineRun r = gssm::runBatch(radar, gssm::BatchSolverOptions{}, run.measurements);
+    struct rusage ru; getrusage(RUSAGE_SELF, &ru);
+    std::cout << "batch " << steps << " steps: " << r.summary << "\n  total incl. EKF initial guess and all marginals "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now()-t0).count() << " s, maxrss " << ru.ru_maxrss/1024 << " MB\n";
+    return 0;
+  }
   gssm::EstimatorOptions o; o.method = method; if (argc > 3) o.smoother.wildfire_threshold = std::atof(argv[3]);
   auto est = gssm::makeEstimator(radar, o);
   std::vector<double> t; int passes = 0;

@@ -29,7 +29,15 @@ RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const io::T
 /// Percentile (0..100) of a sample, by linear interpolation; 0 for empty.
 double percentile(std::vector<double> v, double p);
 
+/// How much of the dataset the runs cover.
+struct DatasetStatus {
+  bool partial = false;               ///< processing stopped at a bad row
+  std::string stopped_at;             ///< the error that stopped it
+  std::vector<std::string> skipped;   ///< rows skipped (--skip-bad-rows)
+};
+
 /// metrics.json for several runs of one dataset.
-std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& dataset);
+std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& dataset,
+                        const DatasetStatus& status = {});
 
 }  // namespace gssm

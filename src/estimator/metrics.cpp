@@ -66,9 +66,14 @@ std::string perState(const std::vector<std::string>& names, const Eigen::VectorX
 }
 }  // namespace
 
-std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& dataset) {
+std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& dataset,
+                        const DatasetStatus& status) {
   std::ostringstream os;
-  os << "{\n  \"dataset\": " << quoted(dataset) << ",\n  \"methods\": {";
+  os << "{\n  \"dataset\": " << quoted(dataset) << ",\n  \"partial\": " << (status.partial ? "true" : "false");
+  if (status.partial) os << ",\n  \"stopped_at\": " << quoted(status.stopped_at);
+  os << ",\n  \"skipped_rows\": " << status.skipped.size() << ",\n  \"skipped\": [";
+  for (std::size_t i = 0; i < status.skipped.size(); ++i) os << (i ? ", " : "") << quoted(status.skipped[i]);
+  os << "],\n  \"methods\": {";
   for (std::size_t r = 0; r < runs.size(); ++r) {
     const RunMetrics& m = runs[r];
     os << (r ? "," : "") << "\n    " << quoted(m.method) << ": {\n";

@@ -32,7 +32,7 @@ int CsvTable::column(const std::string& name) const {
   return -1;
 }
 
-CsvTable parseCsv(const std::string& text, const std::string& source) {
+CsvTable parseCsv(const std::string& text, const std::string& source, std::vector<CsvRowError>* row_errors) {
   CsvTable t;
   t.source = source;
   std::stringstream ss(text);
@@ -63,21 +63,30 @@ CsvTable parseCsv(const std::string& text, const std::string& source) {
       have_header = true;
       continue;
     }
-    if (cells.size() != t.header.size())
-      throw InputError(source + ":" + std::to_string(lineno) + ": " +
-                       std::to_string(cells.size()) + " fields, the header has " +
-                       std::to_string(t.header.size()));
+    auto bad = [&](const std::string& message) {
+      if (!row_errors) throw InputError(message);
+      row_errors->push_back({lineno, message});
+    };
+    if (cells.size() != t.header.size()) {
+      bad(source + ":" + std::to_string(lineno) + ": " + std::to_string(cells.size()) +
+          " fields, the header has " + std::to_string(t.header.size()));
+      continue;
+    }
     std::vector<double> row(cells.size());
-    for (std::size_t i = 0; i < cells.size(); ++i) {
+    bool ok = true;
+    for (std::size_t i = 0; i < cells.size() && ok; ++i) {
       errno = 0;
       char* end = nullptr;
       const double v = std::strtod(cells[i].c_str(), &end);
       if (cells[i].empty() || end != cells[i].c_str() + cells[i].size() || errno == ERANGE ||
-          !std::isfinite(v))
-        throw InputError(source + ":" + std::to_string(lineno) + ": column '" + t.header[i] +
-                         "': value '" + cells[i] + "' is not a finite number");
+          !std::isfinite(v)) {
+        bad(source + ":" + std::to_string(lineno) + ": column '" + t.header[i] + "': value '" + cells[i] +
+            "' is not a finite number");
+        ok = false;
+      }
       row[i] = v;
     }
+    if (!ok) continue;
     t.rows.push_back(std::move(row));
     t.line_of_row.push_back(lineno);
   }
@@ -85,12 +94,12 @@ CsvTable parseCsv(const std::string& text, const std::string& source) {
   return t;
 }
 
-CsvTable readCsv(const std::string& path) {
+CsvTable readCsv(const std::string& path, std::vector<CsvRowError>* row_errors) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parseCsv(ss.str(), path);
+  return parseCsv(ss.str(), path, row_errors);
 }
 
 std::string csvLine(const std::vector<double>& values) {

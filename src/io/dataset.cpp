@@ -1,5 +1,6 @@
 #include "gssm/io/dataset.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "gssm/error.h"
@@ -10,8 +11,8 @@ namespace gssm::io {
 namespace fs = std::filesystem;
 
 namespace {
-// Checks that the header is exactly t,<names> and times increase strictly.
-void checkTable(const CsvTable& t, const std::vector<std::string>& names) {
+// Checks that the header is exactly t,<names>.
+void checkHeader(const CsvTable& t, const std::vector<std::string>& names) {
   std::vector<std::string> expected{"t"};
   expected.insert(expected.end(), names.begin(), names.end());
   if (t.header != expected) {
@@ -20,6 +21,11 @@ void checkTable(const CsvTable& t, const std::vector<std::string>& names) {
     for (const auto& n : t.header) got += (got.empty() ? "" : ",") + n;
     throw InputError(t.source + ":1: header is '" + got + "', expected '" + want + "'");
   }
+}
+
+// ... and that times increase strictly.
+void checkTable(const CsvTable& t, const std::vector<std::string>& names) {
+  checkHeader(t, names);
   for (std::size_t r = 1; r < t.rows.size(); ++r)
     if (!(t.rows[r][0] > t.rows[r - 1][0]))
       throw InputError(t.source + ":" + std::to_string(t.line_of_row[r]) + ": column 't': time " +
@@ -35,14 +41,40 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
   return IniDocument::load(path);
 }
 
-void readDatasetData(const std::string& dir, const Model& model, Dataset& out) {
+void readDatasetData(const std::string& dir, const Model& model, Dataset& out, BadRows bad_rows) {
   out.dir = dir;
-  const CsvTable m = readCsv((fs::path(dir) / "measurements.csv").string());
-  checkTable(m, model.names().measurement);
+  out.row_errors.clear();
+  std::vector<CsvRowError> errors;
+  const CsvTable m = readCsv((fs::path(dir) / "measurements.csv").string(),
+                             bad_rows == BadRows::Throw ? nullptr : &errors);
+  checkHeader(m, model.names().measurement);
   out.measurements.clear();
-  for (const auto& row : m.rows)
-    out.measurements.push_back(
-        {row[0], Eigen::Map<const Eigen::VectorXd>(row.data() + 1, model.dims().ny)});
+  // Good rows in file order, with time-order errors found as we go.
+  std::size_t next_error = 0;
+  for (std::size_t r = 0; r < m.rows.size(); ++r) {
+    const int line = m.line_of_row[r];
+    if (bad_rows == BadRows::Stop && next_error < errors.size() && errors[next_error].line < line) break;
+    const double t = m.rows[r][0];
+    if (!out.measurements.empty() && !(t > out.measurements.back().t)) {
+      const double prev = out.measurements.back().t;
+      const std::string msg = m.source + ":" + std::to_string(line) + ": column 't': time " + formatDouble(t) +
+                              (t == prev ? " repeats the previous row's (duplicated timestamp; put several "
+                                           "channels in one row)"
+                                         : " is before the previous row's " + formatDouble(prev));
+      if (bad_rows == BadRows::Throw) throw InputError(msg);
+      errors.insert(errors.begin() + static_cast<long>(next_error), {line, msg});
+      if (bad_rows == BadRows::Stop) break;
+      ++next_error;
+      continue;
+    }
+    while (next_error < errors.size() && errors[next_error].line < line) ++next_error;
+    out.measurements.push_back({t, Eigen::Map<const Eigen::VectorXd>(m.rows[r].data() + 1, model.dims().ny)});
+  }
+  std::sort(errors.begin(), errors.end(), [](const CsvRowError& a, const CsvRowError& b) { return a.line < b.line; });
+  for (const auto& e : errors) {
+    out.row_errors.push_back(e.message);
+    if (bad_rows == BadRows::Stop) break;
+  }
   out.inputs.clear();
   const fs::path ip = fs::path(dir) / "inputs.csv";
   if (model.dims().nu > 0) {

@@ -91,3 +91,38 @@ assert len(rows) == 200
 b_est, b_sd = rows[-1][3], rows[-1][6]
 assert abs(b_est - 0.2) < 4 * b_sd, (b_est, b_sd)
 print("linear GSSM from an INI config: ok, bias", b_est, "+-", b_sd)
+
+# Bad input: a malformed row stops processing there; everything before it is
+# written, metrics.json is marked partial, exit code non-zero. With
+# --skip-bad-rows the row is reported and skipped.
+bad = os.path.join(work, "bad")
+shutil.copytree(data, bad)
+mpath = os.path.join(bad, "measurements.csv")
+lines = open(mpath).read().splitlines()
+lines[30] = lines[30].split(",")[0] + ",12x4"      # data row 30 (file line 31)
+open(mpath, "w").write("\n".join(lines) + "\n")
+bout = os.path.join(work, "bad-out")
+r = subprocess.run([f"{bin_dir}/gssm-process", "--data", bad, "--method", "fixed-lag", "--out", bout],
+                   capture_output=True, text=True)
+assert r.returncode == 3, (r.returncode, r.stderr)
+assert "measurements.csv:31" in r.stderr and "'range'" in r.stderr and "12x4" in r.stderr, r.stderr
+_, rows = read(os.path.join(bout, "estimates-fixed-lag.csv"))
+assert len(rows) == 29, len(rows)                 # the rows before the bad one
+mj = json.load(open(os.path.join(bout, "metrics.json")))
+assert mj["partial"] is True and "measurements.csv:31" in mj["stopped_at"], mj
+sout = os.path.join(work, "skip-out")
+r = subprocess.run([f"{bin_dir}/gssm-process", "--data", bad, "--method", "fixed-lag", "--skip-bad-rows",
+                    "--out", sout], capture_output=True, text=True)
+assert r.returncode == 0, r.stderr
+_, rows = read(os.path.join(sout, "estimates-fixed-lag.csv"))
+assert len(rows) == 59, len(rows)
+mj = json.load(open(os.path.join(sout, "metrics.json")))
+assert mj["partial"] is False and mj["skipped_rows"] == 1, mj
+# a duplicated timestamp is reported as such
+lines = open(os.path.join(data, "measurements.csv")).read().splitlines()
+lines[11] = lines[10]
+open(mpath, "w").write("\n".join(lines) + "\n")
+r = subprocess.run([f"{bin_dir}/gssm-process", "--data", bad, "--method", "ekf", "--out", bout],
+                   capture_output=True, text=True)
+assert r.returncode == 3 and "duplicated timestamp" in r.stderr and "measurements.csv:12" in r.stderr, r.stderr
+print("bad rows: stop with partial output / skip: ok")

@@ -14,9 +14,18 @@ struct CsvTable {
   int column(const std::string& name) const;
 };
 
+/// A data row that could not be used, with the full message.
+struct CsvRowError {
+  int line = 0;
+  std::string message;  ///< "source:line: column 'name': value 'v' is not a finite number"
+};
+
 /// Parses text; throws InputError "source:line: column 'name': value 'v' ...".
-CsvTable parseCsv(const std::string& text, const std::string& source);
-CsvTable readCsv(const std::string& path);
+/// With `row_errors`, bad data rows are recorded there and left out instead
+/// (a missing header or an empty file still throws).
+CsvTable parseCsv(const std::string& text, const std::string& source,
+                  std::vector<CsvRowError>* row_errors = nullptr);
+CsvTable readCsv(const std::string& path, std::vector<CsvRowError>* row_errors = nullptr);
 
 /// Writes header and rows with round-trip number formatting (deterministic).
 void writeCsv(const std::string& path, const std::vector<std::string>& header,

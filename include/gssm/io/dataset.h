@@ -25,13 +25,24 @@ struct Dataset {
   std::vector<Measurement> measurements;
   std::vector<Input> inputs;  ///< inputs.csv (t,<input names>), if the model has inputs
   std::optional<Truth> truth;
+  /// Bad rows of measurements.csv (malformed number, NaN, wrong field count,
+  /// time not increasing), in file order. With BadRows::Stop only the rows
+  /// before the first one are kept; with Skip every good row is kept.
+  std::vector<std::string> row_errors;
+};
+
+enum class BadRows {
+  Throw,  ///< throw InputError at the first bad row
+  Stop,   ///< keep the rows before the first bad row, record it
+  Skip,   ///< keep every good row, record each bad one
 };
 
 /// Reads scenario.ini (or `config_override` when non-empty).
 IniDocument readScenario(const std::string& dir, const std::string& config_override = "");
 /// Reads measurements.csv and truth.csv (if present) of a model's shape;
 /// checks column names and increasing timestamps, naming file and line.
-void readDatasetData(const std::string& dir, const Model& model, Dataset& out);
+void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
+                     BadRows bad_rows = BadRows::Throw);
 
 /// Writes measurements.csv, truth.csv and scenario.ini.
 void writeDataset(const std::string& dir, const Model& model, const SimulatedRun& run,
