@@ -30,7 +30,29 @@ for name, b in rows.items():
     print(f"| {label} | {us(b['median_s'])} | {us(b['p99_s'])} | {us(b['max_s'])} | "
           f"{b['median_s'] / ekf['median_s']:.1f}× | {b['p99_s'] / ekf['p99_s']:.1f}× |")
 for name, b in rows.items():
-    if name.startswith("BM_Batch"):
+    if name.startswith("BM_Batch") and False:
         t = b["real_time"] / 1e3 if b["time_unit"] == "ms" else b["real_time"]
         print(f"\nBatchSolver, whole 2000-step run once (EKF-initialized LM, incl. all marginals): "
               f"{t * 1e3:.1f} ms, {int(b['iterations'])} LM iterations.")
+
+if len(sys.argv) > 3:
+    size = json.load(open(sys.argv[3]))
+    by = {}
+    for b in size["benchmarks"]:
+        _, method, nc, nb = b["name"].split("/")[:4]
+        by[(method, int(nc), int(nb))] = b["median_s"]
+    print("\n## State size: synthetic linear GSSM, fixed-lag (w = 10) vs EKF\n")
+    print(f"Command: `{sys.argv[4]}`. Median per-update latency (µs), and the ratio fixed-lag / EKF.\n")
+    print("| n_c \\ n_b | " + " | ".join(str(nb) for nb in (1, 4, 16, 64)) + " |")
+    print("| --- | --- | --- | --- | --- |")
+    for nc in (1, 4, 16, 64):
+        cells = []
+        for nb in (1, 4, 16, 64):
+            e, f = by[("ekf", nc, nb)], by[("fixed_lag_w10", nc, nb)]
+            cells.append(f"{f*1e6:.0f} vs {e*1e6:.0f} ({f/e:.1f}×)")
+        print(f"| {nc} | " + " | ".join(cells) + " |")
+if len(sys.argv) > 5:
+    print("\n## History length and memory (`build/bench/gssm_history_probe STEPS METHOD`)\n")
+    print("```")
+    print(open(sys.argv[5]).read().rstrip())
+    print("```")
