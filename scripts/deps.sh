@@ -11,6 +11,7 @@ GSSM_PACKAGES=(
   libmrpt-img-dev libmrpt-opengl-dev
   libegl-mesa0 libgl1-mesa-dri
   python3
+  clang libclang-rt-14-dev
 )
 
 gssm_install_deps() {
