@@ -3,12 +3,22 @@
 // stacked state z = [x_c; x_b] (constants as zero-noise states). Tests
 // compare the GSSM solvers against it.
 #include <Eigen/Dense>
+#include <memory>
+#include <random>
 #include <vector>
 
 #include "gssm/data.h"
 #include "gssm/models/linear.h"
+#include "gssm/simulation.h"
 
 namespace gssm::testing {
+
+/// A seeded N(0, 1) source for simulations in tests.
+inline NormalSampler normalSampler(unsigned seed) {
+  auto rng = std::make_shared<std::mt19937>(seed);
+  auto dist = std::make_shared<std::normal_distribution<double>>(0.0, 1.0);
+  return [rng, dist] { return (*dist)(*rng); };
+}
 
 struct StackedLinear {
   Eigen::MatrixXd F, Qz, H, R;

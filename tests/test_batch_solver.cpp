@@ -17,11 +17,7 @@ using gssm::testing::relativeError;
 
 namespace {
 
-NormalSampler normalSampler(unsigned seed) {
-  auto rng = std::make_shared<std::mt19937>(seed);
-  auto dist = std::make_shared<std::normal_distribution<double>>(0.0, 1.0);
-  return [rng, dist] { return (*dist)(*rng); };
-}
+using gssm::testing::normalSampler;
 
 SimulatedRun radarPaperRun(const models::Radar2D& radar, int steps, unsigned seed) {
   SimulationSpec spec;

@@ -16,11 +16,7 @@ using namespace gssm;
 using gssm::testing::relativeError;
 
 namespace {
-NormalSampler normalSampler(unsigned seed) {
-  auto rng = std::make_shared<std::mt19937>(seed);
-  auto dist = std::make_shared<std::normal_distribution<double>>(0.0, 1.0);
-  return [rng, dist] { return (*dist)(*rng); };
-}
+using gssm::testing::normalSampler;
 
 // The radar written by a user as callables, with or without Jacobians.
 models::FunctionModel userRadar(bool analytic, bool wrong_jacobian = false) {

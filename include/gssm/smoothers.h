@@ -83,32 +83,39 @@ struct SmootherOptions {
 
 class SmootherCore;
 
-class IncrementalSmoother {
+/// What both smoothers share: the current estimates, covariances and report.
+class Smoother {
  public:
-  explicit IncrementalSmoother(SmootherOptions options = {});
-  ~IncrementalSmoother();
-  IncrementalSmoother(const IncrementalSmoother&) = delete;
-  IncrementalSmoother& operator=(const IncrementalSmoother&) = delete;
+  virtual ~Smoother();
+  Smoother(const Smoother&) = delete;
+  Smoother& operator=(const Smoother&) = delete;
 
   /// Adds factors and the initial values of the variables they introduce.
   /// Strong exception guarantee: on throw the smoother is unchanged.
-  UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values);
+  virtual UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values) = 0;
 
   bool contains(const Key& k) const;
   /// Current estimate of a variable (refreshes its root path first).
   Eigen::VectorXd estimate(const Key& k);
   /// Every variable, after a full back-substitution.
   Values calculateEstimate();
-  /// Joint marginal covariance of keys on one root path, e.g. {x_c(k), x_b}.
+  /// Joint marginal covariance of any variables held, blocks in the given order.
   Eigen::MatrixXd jointMarginalCovariance(const std::vector<Key>& keys) const;
   Eigen::MatrixXd marginalCovariance(const Key& k) const { return jointMarginalCovariance({k}); }
   const UpdateReport& lastReport() const;
   std::size_t numVariables() const;
   std::size_t numFactors() const;
-  const SmootherOptions& options() const;
 
- private:
+ protected:
+  explicit Smoother(std::unique_ptr<SmootherCore> core);
   std::unique_ptr<SmootherCore> core_;
+};
+
+class IncrementalSmoother final : public Smoother {
+ public:
+  explicit IncrementalSmoother(SmootherOptions options = {});
+  UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values) override;
+  const SmootherOptions& options() const;
 };
 
 struct FixedLagSmootherOptions {
@@ -117,32 +124,18 @@ struct FixedLagSmootherOptions {
   bool validate(std::string* why = nullptr) const;
 };
 
-class FixedLagSmoother {
+class FixedLagSmoother final : public Smoother {
  public:
   explicit FixedLagSmoother(FixedLagSmootherOptions options = {});
-  ~FixedLagSmoother();
-  FixedLagSmoother(const FixedLagSmoother&) = delete;
-  FixedLagSmoother& operator=(const FixedLagSmoother&) = delete;
-
   /// As IncrementalSmoother::update, then marginalizes states older than the
   /// window (those with step < newest step − window + 1).
-  UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values);
-
-  bool contains(const Key& k) const;
-  Eigen::VectorXd estimate(const Key& k);
-  Values calculateEstimate();
-  Eigen::MatrixXd jointMarginalCovariance(const std::vector<Key>& keys) const;
-  Eigen::MatrixXd marginalCovariance(const Key& k) const { return jointMarginalCovariance({k}); }
-  const UpdateReport& lastReport() const;
-  std::size_t numVariables() const;
-  std::size_t numFactors() const;
+  UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values) override;
   /// Oldest state still in the window (−1 before any state).
-  std::int64_t oldestStep() const;
+  std::int64_t oldestStep() const { return oldest_; }
   const FixedLagSmootherOptions& options() const { return options_; }
 
  private:
   FixedLagSmootherOptions options_;
-  std::unique_ptr<SmootherCore> core_;
   std::int64_t oldest_ = -1, newest_ = -1;
 };
 

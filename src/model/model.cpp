@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "gssm/error.h"
+#include "model/central_differences.h"
 
 namespace gssm {
 
@@ -78,19 +79,6 @@ void compare(const Eigen::MatrixXd& analytic, const Eigen::MatrixXd& numeric,
     }
 }
 
-// Central differences of g over the entries of x.
-template <class Fn>
-Eigen::MatrixXd numericJacobian(Fn g, const Eigen::VectorXd& x, Eigen::Index rows, double eps) {
-  Eigen::MatrixXd J(rows, x.size());
-  for (Eigen::Index j = 0; j < x.size(); ++j) {
-    const double step = eps * std::max(1.0, std::abs(x[j]));
-    Eigen::VectorXd xp = x, xm = x;
-    xp[j] += step;
-    xm[j] -= step;
-    J.col(j) = (g(xp) - g(xm)) / (2 * step);
-  }
-  return J;
-}
 }  // namespace
 
 JacobianCheck checkJacobians(const Model& model, const Eigen::VectorXd& xc,
@@ -101,10 +89,10 @@ JacobianCheck checkJacobians(const Model& model, const Eigen::VectorXd& xc,
   Eigen::MatrixXd J_f_xc, J_f_xb, J_h_xc, J_h_xb;
   model.f(xc, xb, u, dt, &J_f_xc, &J_f_xb);
   model.h(xc, xb, &J_h_xc, &J_h_xb);
-  compare(J_f_xc, numericJacobian([&](const Eigen::VectorXd& v) { return model.f(v, xb, u, dt); }, xc, d.nc, eps), "J_f_xc", out);
-  compare(J_f_xb, numericJacobian([&](const Eigen::VectorXd& v) { return model.f(xc, v, u, dt); }, xb, d.nc, eps), "J_f_xb", out);
-  compare(J_h_xc, numericJacobian([&](const Eigen::VectorXd& v) { return model.h(v, xb); }, xc, d.ny, eps), "J_h_xc", out);
-  compare(J_h_xb, numericJacobian([&](const Eigen::VectorXd& v) { return model.h(xc, v); }, xb, d.ny, eps), "J_h_xb", out);
+  compare(J_f_xc, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.f(v, xb, u, dt); }, xc, d.nc, eps), "J_f_xc", out);
+  compare(J_f_xb, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.f(xc, v, u, dt); }, xb, d.nc, eps), "J_f_xb", out);
+  compare(J_h_xc, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.h(v, xb); }, xc, d.ny, eps), "J_h_xc", out);
+  compare(J_h_xb, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.h(xc, v); }, xb, d.ny, eps), "J_h_xb", out);
   return out;
 }
 

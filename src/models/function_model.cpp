@@ -1,25 +1,11 @@
 #include "gssm/models/function_model.h"
 
 #include "gssm/error.h"
+#include "model/central_differences.h"
 
 namespace gssm::models {
 
-namespace {
-// Central differences of g over x, step scaled by max(1, |x_i|).
-template <class Fn>
-Eigen::MatrixXd centralDifferences(Fn g, const Eigen::VectorXd& x, Eigen::Index rows) {
-  constexpr double eps = 1e-6;
-  Eigen::MatrixXd J(rows, x.size());
-  for (Eigen::Index j = 0; j < x.size(); ++j) {
-    const double step = eps * std::max(1.0, std::abs(x[j]));
-    Eigen::VectorXd xp = x, xm = x;
-    xp[j] += step;
-    xm[j] -= step;
-    J.col(j) = (g(xp) - g(xm)) / (2 * step);
-  }
-  return J;
-}
-}  // namespace
+using internal::centralDifferences;
 
 FunctionModel::FunctionModel(ModelDims dims, ModelNames names, ModelNoise noise, ModelFunctions fns)
     : Model(dims, std::move(names), std::move(noise)), fns_(std::move(fns)) {

@@ -198,30 +198,32 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
   return rep;
 }
 
-// ---- IncrementalSmoother -------------------------------------------------------
-IncrementalSmoother::IncrementalSmoother(SmootherOptions options)
-    : core_(std::make_unique<SmootherCore>(options, toMode(options.ordering))) {}
-IncrementalSmoother::~IncrementalSmoother() = default;
-
-UpdateReport IncrementalSmoother::update(const std::vector<FactorPtr>& f, const Values& v) {
-  return core_->update(f, v);
-}
-bool IncrementalSmoother::contains(const Key& k) const { return core_->engine.hasVariable(k); }
-Eigen::VectorXd IncrementalSmoother::estimate(const Key& k) {
-  if (!contains(k)) throw InvalidArgument("IncrementalSmoother: no variable " + k.toString());
+// ---- Smoother (shared read API) -------------------------------------------------
+Smoother::Smoother(std::unique_ptr<SmootherCore> core) : core_(std::move(core)) {}
+Smoother::~Smoother() = default;
+bool Smoother::contains(const Key& k) const { return core_->engine.hasVariable(k); }
+Eigen::VectorXd Smoother::estimate(const Key& k) {
+  if (!contains(k)) throw InvalidArgument("smoother: no variable " + k.toString() + " (never added, or marginalized)");
   core_->engine.solvePath(k);
   return core_->engine.estimate(k);
 }
-Values IncrementalSmoother::calculateEstimate() {
+Values Smoother::calculateEstimate() {
   core_->engine.solveAll();
   return core_->engine.allEstimates();
 }
-Eigen::MatrixXd IncrementalSmoother::jointMarginalCovariance(const std::vector<Key>& keys) const {
+Eigen::MatrixXd Smoother::jointMarginalCovariance(const std::vector<Key>& keys) const {
   return core_->engine.pathMarginalCovariance(keys);
 }
-const UpdateReport& IncrementalSmoother::lastReport() const { return core_->last; }
-std::size_t IncrementalSmoother::numVariables() const { return core_->engine.numVariables(); }
-std::size_t IncrementalSmoother::numFactors() const { return core_->engine.numFactors(); }
+const UpdateReport& Smoother::lastReport() const { return core_->last; }
+std::size_t Smoother::numVariables() const { return core_->engine.numVariables(); }
+std::size_t Smoother::numFactors() const { return core_->engine.numFactors(); }
+
+// ---- IncrementalSmoother -------------------------------------------------------
+IncrementalSmoother::IncrementalSmoother(SmootherOptions options)
+    : Smoother(std::make_unique<SmootherCore>(options, toMode(options.ordering))) {}
+UpdateReport IncrementalSmoother::update(const std::vector<FactorPtr>& f, const Values& v) {
+  return core_->update(f, v);
+}
 const SmootherOptions& IncrementalSmoother::options() const { return core_->options; }
 
 // ---- FixedLagSmoother ----------------------------------------------------------
@@ -235,9 +237,9 @@ FixedLagSmootherOptions fixedLag(FixedLagSmootherOptions o) {
 }  // namespace
 
 FixedLagSmoother::FixedLagSmoother(FixedLagSmootherOptions options)
-    : options_(fixedLag(std::move(options))),
-      core_(std::make_unique<SmootherCore>(options_.smoother, internal::OrderingMode::TimeOrdered)) {}
-FixedLagSmoother::~FixedLagSmoother() = default;
+    : Smoother(nullptr), options_(fixedLag(std::move(options))) {
+  core_ = std::make_unique<SmootherCore>(options_.smoother, internal::OrderingMode::TimeOrdered);
+}
 
 UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Values& v) {
   std::int64_t newest = newest_, oldest = oldest_;
@@ -260,23 +262,5 @@ UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Val
   core_->last = rep;
   return rep;
 }
-
-bool FixedLagSmoother::contains(const Key& k) const { return core_->engine.hasVariable(k); }
-Eigen::VectorXd FixedLagSmoother::estimate(const Key& k) {
-  if (!contains(k)) throw InvalidArgument("FixedLagSmoother: no variable " + k.toString() + " (outside the window?)");
-  core_->engine.solvePath(k);
-  return core_->engine.estimate(k);
-}
-Values FixedLagSmoother::calculateEstimate() {
-  core_->engine.solveAll();
-  return core_->engine.allEstimates();
-}
-Eigen::MatrixXd FixedLagSmoother::jointMarginalCovariance(const std::vector<Key>& keys) const {
-  return core_->engine.pathMarginalCovariance(keys);
-}
-const UpdateReport& FixedLagSmoother::lastReport() const { return core_->last; }
-std::size_t FixedLagSmoother::numVariables() const { return core_->engine.numVariables(); }
-std::size_t FixedLagSmoother::numFactors() const { return core_->engine.numFactors(); }
-std::int64_t FixedLagSmoother::oldestStep() const { return oldest_; }
 
 }  // namespace gssm
