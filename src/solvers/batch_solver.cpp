@@ -110,14 +110,15 @@ struct BatchSolver::Impl {
         g.segment(offs[a], J[a].cols()) += J[a].transpose() * r;
         for (std::size_t b = 0; b < keys.size(); ++b) {
           if (offs[a] > offs[b]) continue;  // upper triangle only
-          const Eigen::MatrixXd blk = J[a].transpose() * J[b];
-          for (Eigen::Index j = 0; j < blk.cols(); ++j)
-            for (Eigen::Index i = 0; i < blk.rows(); ++i) {
+          // (JᵀJ)_ab entry by entry: no temporary on this hot path.
+          for (Eigen::Index j = 0; j < J[b].cols(); ++j)
+            for (Eigen::Index i = 0; i < J[a].cols(); ++i) {
               const Eigen::Index gi = offs[a] + i, gj = offs[b] + j;
               if (gi > gj) continue;  // diagonal block: keep its upper half
-              if (first) chol.add(gi, gj, blk(i, j));
-              else chol.value(e) = blk(i, j);
-              if (gi == gj) diag[gi] += blk(i, j);
+              const double v = J[a].col(i).dot(J[b].col(j));
+              if (first) chol.add(gi, gj, v);
+              else chol.value(e) = v;
+              if (gi == gj) diag[gi] += v;
               ++e;
             }
         }
@@ -179,10 +180,17 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   double lambda = lm ? options_.initial_lambda : 0.0;
   Eigen::VectorXd delta;
 
-  auto applyStep = [&](const Values& from, const Eigen::VectorXd& d) {
-    Values out = from;
-    for (auto& kv : out) kv.second += d.segment(s.offset.at(kv.first), kv.second.size());
-    return out;
+  // candidate = from + d, written in place (both hold the same keys in the
+  // same order): copying a million-node map per LM step cost 12% of a solve.
+  Values candidate = values;
+  auto applyStep = [&](const Values& from, const Eigen::VectorXd& d, Values& out) {
+    auto it = out.begin();
+    Eigen::Index off = 0;
+    for (const auto& kv : from) {
+      it->second = kv.second + d.segment(off, kv.second.size());
+      off += kv.second.size();
+      ++it;
+    }
   };
 
   // LM leaves a damping bias of order λ in its last steps, so whenever a
@@ -224,13 +232,14 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     for (const auto& kv : x) xflat.segment(s.offset.at(kv.first), kv.second.size()) = kv.second;
     if (delta.norm() <= options_.step_tolerance * (xflat.norm() + options_.step_tolerance)) {
       if (polishing) {  // a tiny undamped step is still the exact correction: take it
-        x = applyStep(x, delta);
+        applyStep(x, delta, candidate);
+        std::swap(x, candidate);
         cost = s.linearize(graph, x, g, diag, false);
       }
       if (converge(T::StepConverged)) break;
       continue;
     }
-    Values candidate = applyStep(x, delta);
+    applyStep(x, delta, candidate);
     const double new_cost = graph.cost(candidate);
     // Near the minimum the cost change (∝ ‖δ‖²) is below rounding, so an
     // undamped polish step is kept unless it makes the cost clearly worse.
@@ -249,7 +258,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       continue;
     }
     ++sum.iterations;
-    x = std::move(candidate);
+    std::swap(x, candidate);
     const double old_cost = cost;
     cost = s.linearize(graph, x, g, diag, false);
     if (!polishing) lambda = std::max(lambda / 10, 1e-12);
