@@ -69,6 +69,12 @@ class BatchSolver {
   /// is singular even with damping; `values` is then unchanged.
   BatchSolverSummary solve(const FactorGraph& graph, Values& values);
 
+  /// Linearizes and factors the information matrix at `values` without
+  /// moving them (e.g. at the true states, for a Cramér–Rao bound); the
+  /// marginal covariances then refer to that point. Throws NumericalError
+  /// naming the variable if the information matrix is singular there.
+  void evaluateAt(const FactorGraph& graph, const Values& values);
+
   /// Marginal covariance of one variable at the last solution.
   Eigen::MatrixXd marginalCovariance(const Key& key) const;
   /// Joint marginal covariance of several variables (blocks in the given order).

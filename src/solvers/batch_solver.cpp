@@ -286,6 +286,19 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   return sum;
 }
 
+void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
+  Impl& s = *impl_;
+  s.has_solution = false;
+  s.selected.reset();
+  s.setup(graph, values);
+  Eigen::VectorXd g, diag;
+  s.linearize(graph, values, g, diag, true);
+  s.setDamping(diag, 0.0);
+  const Eigen::Index bad = s.chol.factorize();
+  if (bad >= 0) s.throwSingular(bad);
+  s.has_solution = true;
+}
+
 Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& keys) const {
   Impl& s = *impl_;
   if (!s.has_solution)
