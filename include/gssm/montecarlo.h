@@ -3,6 +3,7 @@
 // (the paper's claim, tested honestly).
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,9 @@ struct MonteCarloOptions {
   int threads = 2;
   int window = 10;
   std::vector<std::string> methods{"ekf", "fixed-lag", "incremental", "paper-window", "batch"};
+  /// The estimators' own model and priors ([model], [prior], [ekf]) when they
+  /// differ from the truth's, e.g. a deliberately mis-tuned R; empty: same.
+  std::optional<io::IniDocument> estimator_config;
   /// Called from worker threads after each seed (done, total); may be empty.
   std::function<void(int, int)> progress;
   bool validate(std::string* why = nullptr) const;
@@ -31,6 +35,9 @@ struct MethodSummary {
   Eigen::VectorXd beats_ekf;        ///< per stacked state: fraction of seeds with RMSE below the EKF's
   std::vector<double> times;        ///< measurement times
   std::vector<Eigen::VectorXd> rmse_over_time;  ///< per step: sqrt(mean over seeds of e²)
+  /// "consistent", "over-confident" (mean NEES above the 95% interval: the
+  /// covariance is too small) or "under-confident" (below it).
+  std::string consistency;
   int failures = 0;                 ///< seeds where the estimator threw (excluded)
   std::string first_failure;
 };

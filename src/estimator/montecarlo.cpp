@@ -75,8 +75,14 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
   std::string why;
   if (!options.validate(&why)) throw InvalidArgument(why);
   const auto start = std::chrono::steady_clock::now();
-  const auto model = io::makeModel(scenario);
+  const auto model = io::makeModel(scenario);  // the truth's
   const SimulationSpec spec = io::simulationSpec(scenario, *model);
+  const io::IniDocument& est_config = options.estimator_config ? *options.estimator_config : scenario;
+  const auto est_model = options.estimator_config ? io::makeModel(est_config) : nullptr;
+  const Model& estimator_model = est_model ? *est_model : *model;
+  if (estimator_model.dims().nc != model->dims().nc || estimator_model.dims().nb != model->dims().nb ||
+      estimator_model.dims().ny != model->dims().ny || estimator_model.dims().nu != model->dims().nu)
+    throw InvalidArgument("MonteCarlo: the estimators' model must have the truth model's dimensions");
   const std::size_t M = options.methods.size(), S = static_cast<std::size_t>(options.seeds);
   const int n = model->dims().nc + model->dims().nb;
   std::vector<std::vector<SeedResult>> results(M, std::vector<SeedResult>(S));
@@ -98,13 +104,13 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
         try {
           OfflineRun out;
           if (options.methods[mi] == "batch") {
-            out = runBatch(*model, BatchSolverOptions{}, run.measurements, run.inputs);
+            out = runBatch(estimator_model, BatchSolverOptions{}, run.measurements, run.inputs);
           } else {
             EstimatorOptions eo;
             eo.method = options.methods[mi];
             eo.window = options.window;
-            eo.ekf = io::ekfOptions(scenario, *model);
-            out = runStreaming(*model, eo, run.measurements, run.inputs);
+            eo.ekf = io::ekfOptions(est_config, estimator_model);
+            out = runStreaming(estimator_model, eo, run.measurements, run.inputs);
           }
           Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
           std::size_t j = 0;  // truth row at the estimate's time (multi-rate: not every step)
@@ -178,6 +184,8 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
         inside += (avg >= res.nees_lo && avg <= res.nees_hi) ? 1 : 0;
       }
       m.nees_step_in_interval = static_cast<double>(inside) / static_cast<double>(sq_t.size());
+      m.consistency = m.mean_nees > res.nees_hi ? "over-confident"
+                      : m.mean_nees < res.nees_lo ? "under-confident" : "consistent";
     }
     res.methods.push_back(std::move(m));
   }
@@ -201,13 +209,13 @@ std::string MonteCarloResult::markdown() const {
   os << "Scenario `" << scenario << "`, " << seeds << " seeds × " << steps << " steps; NEES has " << dof
      << " dof, 95% interval of a " << seeds << "-seed average at one step: [" << nees_lo << ", " << nees_hi
      << "].\n\n";
-  os << "| method | mean RMSE (" << names << ") | RMS final error (" << names << ") | mean NEES | steps with NEES in 95% interval | seeds beating the EKF (" << names << ") | failures |\n";
-  os << "| --- | --- | --- | --- | --- | --- | --- |\n";
+  os << "| method | mean RMSE (" << names << ") | RMS final error (" << names << ") | mean NEES | verdict | steps with NEES in 95% interval | seeds beating the EKF (" << names << ") | failures |\n";
+  os << "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const auto& m : methods) {
     os << "| " << m.method << (m.method == "batch" ? " (smoother, uses future data)" : "") << " | "
        << perState(m.mean_rmse, 3) << " | " << perState(m.rms_final_error, 3) << " | ";
     os.precision(2);
-    os << m.mean_nees << " | " << std::lround(100 * m.nees_step_in_interval) << "% | ";
+    os << m.mean_nees << " | " << m.consistency << " | " << std::lround(100 * m.nees_step_in_interval) << "% | ";
     if (m.method == "ekf") os << "— | ";
     else {
       Eigen::VectorXd pct = 100 * m.beats_ekf;
