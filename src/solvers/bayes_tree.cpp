@@ -335,14 +335,8 @@ void BayesTreeEngine::update(const Values& new_variables, const std::vector<Fact
     vars_[kv.first] = std::move(v);
   }
   auto registerSlot = [&](int s) {
-    const Slot& slot = slots_[static_cast<std::size_t>(s)];
-    bool only_constants = true;
-    for (const auto& k : slot.linear.keys)
-      if (!k.isConstants()) {
-        slots_by_key_[k].push_back(s);
-        only_constants = false;
-      }
-    if (only_constants) constant_only_slots_.push_back(s);
+    for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys)
+      if (!k.isConstants()) slots_by_key_[k].push_back(s);
   };
   std::vector<int> new_slot_of(lin_new.size()), new_lin_slot_of(new_linear.size());
   for (std::size_t i = 0; i < lin_new.size(); ++i) {
@@ -596,8 +590,6 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
       auto& v = it->second;
       v.erase(std::remove(v.begin(), v.end(), s), v.end());
     }
-    constant_only_slots_.erase(std::remove(constant_only_slots_.begin(), constant_only_slots_.end(), s),
-                               constant_only_slots_.end());
     slot = Slot{};
     free_slots_.push_back(s);
     --slots_alive_;
@@ -608,13 +600,8 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   if (parent >= 0 && cl.marginal.b.size() > 0) {
     const int s = allocSlot();
     slots_[static_cast<std::size_t>(s)] = Slot{nullptr, std::move(cl.marginal), parent, true};
-    bool only_constants = true;
     for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys)
-      if (!k.isConstants()) {
-        slots_by_key_[k].push_back(s);
-        only_constants = false;
-      }
-    if (only_constants) constant_only_slots_.push_back(s);
+      if (!k.isConstants()) slots_by_key_[k].push_back(s);
     cliques_[static_cast<std::size_t>(parent)].owned.push_back(s);
   }
   if (parent >= 0) {

@@ -133,7 +133,6 @@ class BayesTreeEngine {
   std::vector<Slot> slots_;
   std::vector<int> free_slots_;
   std::unordered_map<Key, std::vector<int>, KeyHash> slots_by_key_;  // non-constant keys only
-  std::vector<int> constant_only_slots_;
   std::size_t slots_alive_ = 0, cliques_alive_ = 0;
   std::int64_t next_rank_ = 0;
   int root_ = -1;
