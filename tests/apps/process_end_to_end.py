@@ -126,3 +126,15 @@ r = subprocess.run([f"{bin_dir}/gssm-process", "--data", bad, "--method", "ekf",
                    capture_output=True, text=True)
 assert r.returncode == 3 and "duplicated timestamp" in r.stderr and "measurements.csv:12" in r.stderr, r.stderr
 print("bad rows: stop with partial output / skip: ok")
+
+# gssm-analyze: report sections and figures on a small dataset.
+aout = os.path.join(work, "analyze-out")
+r = subprocess.run([f"{bin_dir}/gssm-analyze", "--data", data, "--runs", "4", "--out", aout],
+                   capture_output=True, text=True)
+assert r.returncode == 0, r.stderr
+report = open(os.path.join(aout, "analysis.md")).read()
+for section in ["## 1. How close", "## 2. Consistency", "## 3. Identifiability", "## 4. Does the GSSM improve"]:
+    assert section in report, section
+for n in names:
+    assert os.path.getsize(os.path.join(aout, f"fig-bound-{n}.png")) > 10000, n
+print("gssm-analyze: ok")
