@@ -74,11 +74,44 @@ TEST(Consistency, KalmanFilterIsConsistentAndAnOverConfidentOneIsFlagged) {
   EXPECT_GT(good.methods[0].mean_nees, good.nees_lo);
   EXPECT_LT(good.methods[0].mean_nees, good.nees_hi);
   EXPECT_EQ(good.methods[0].consistency, "consistent");
+  EXPECT_GT(good.methods[0].mean_nis, good.nis_lo);
+  EXPECT_LT(good.methods[0].mean_nis, good.nis_hi);
+  EXPECT_EQ(good.methods[0].nis_consistency, "consistent");
   sys.noise.R /= 4.0;  // the estimator believes the sensor is twice as precise
   io::IniDocument overconfident;
   io::writeModel(models::LinearModel(sys), overconfident);
   o.estimator_config = overconfident;
   const MonteCarloResult bad = runMonteCarlo(scenario, o, sampler);
   EXPECT_EQ(bad.methods[0].consistency, "over-confident") << "mean NEES " << bad.methods[0].mean_nees;
+  EXPECT_EQ(bad.methods[0].nis_consistency, "over-confident") << "mean NIS " << bad.methods[0].mean_nis;
   EXPECT_NE(bad.markdown().find("over-confident"), std::string::npos);
+}
+
+#include "gssm/ekf.h"
+#include "gssm/estimator.h"
+
+// The generic NIS (from the estimate before each update) is the EKF's own
+// innovation statistic, and the same for the exact GSSM filters on a linear model.
+TEST(Consistency, GenericNisEqualsTheKalmanFiltersInnovationStatistic) {
+  std::mt19937 rng(62);
+  const models::LinearModel model(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1));
+  SimulationSpec spec;
+  spec.steps = 30;
+  const SimulatedRun run = simulate(model, spec, gssm::testing::normalSampler(63));
+  ExtendedKalmanFilter kf(model);
+  std::vector<std::unique_ptr<Estimator>> ests;
+  for (const std::string m : {"ekf", "fixed-lag", "incremental"}) {
+    EstimatorOptions o;
+    o.method = m;
+    o.compute_nis = true;
+    ests.push_back(makeEstimator(model, o));
+  }
+  for (const auto& m : run.measurements) {
+    kf.predict(m.t, Eigen::VectorXd(0));
+    kf.update(m.y);
+    for (auto& e : ests) {
+      e->addMeasurement(m.t, m.y);
+      EXPECT_NEAR(e->report().nis, kf.lastNis(), 1e-8 * (1 + kf.lastNis())) << e->method() << " t " << m.t;
+    }
+  }
 }

@@ -13,6 +13,7 @@
 // dimension, NaN, time not increasing, a singular system) leaves the
 // estimator exactly as it was, and the message names the input at fault.
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,6 +40,11 @@ struct EstimatorReport {
   int iterations = 0;         ///< solver iterations of the last update (1 for the EKF)
   UpdateReport smoother;      ///< the smoother's report (incremental, fixed-lag; zeros otherwise)
   std::string detail;         ///< one line from the underlying estimator
+  /// Normalized innovation squared of the last measurement, eᵀS⁻¹e with the
+  /// innovation e = y − h(prediction) and S = H P_pred Hᵀ + R from the
+  /// estimate before it (same definition for every method); NaN unless
+  /// EstimatorOptions::compute_nis.
+  double nis = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct EstimatorOptions {
@@ -48,6 +54,8 @@ struct EstimatorOptions {
   ExtendedKalmanFilterOptions ekf;
   SmootherOptions smoother;
   double t0 = 0.0;            ///< time of x_c(0)
+  /// Compute the NIS of every measurement (costs one covariance query per update).
+  bool compute_nis = false;
   bool validate(const Model& model, std::string* why = nullptr) const;
 };
 
@@ -99,6 +107,10 @@ class Estimator {
 
  private:
   void advance(double t);  // process-only step to t
+  /// NIS of y at a step dt after the current estimate (dt = 0: at it).
+  double innovationNis(double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y);
+  bool compute_nis_ = false;
+  friend std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOptions& options);
   Eigen::VectorXd inputInForce() const;
   double t_;            // time of the newest state
   std::int64_t k_ = 0;  // its step

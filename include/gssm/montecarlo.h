@@ -38,6 +38,9 @@ struct MethodSummary {
   /// "consistent", "over-confident" (mean NEES above the 95% interval: the
   /// covariance is too small) or "under-confident" (below it).
   std::string consistency;
+  double mean_nis = 0;              ///< average over seeds and steps (NaN for batch: no innovations)
+  std::string nis_consistency;      ///< verdict of the NIS against its interval ("" for batch)
+  double nis_step_in_interval = 0;  ///< fraction of steps whose seed-average NIS is inside its interval
   int failures = 0;                 ///< seeds where the estimator threw (excluded)
   std::string first_failure;
 };
@@ -46,6 +49,8 @@ struct MonteCarloResult {
   std::string scenario;
   int seeds = 0, steps = 0, dof = 0;
   double nees_lo = 0, nees_hi = 0;  ///< 95% interval of a seed-average NEES at one step
+  int nis_dof = 0;                  ///< measurement dimension
+  double nis_lo = 0, nis_hi = 0;    ///< 95% interval of a seed-average NIS at one step
   std::vector<std::string> state_names;
   std::vector<MethodSummary> methods;
   double seconds = 0;

@@ -26,6 +26,7 @@ struct OfflineRun {
   std::string method;
   std::vector<EstimateRow> rows;       ///< one per measurement (plus none for t0)
   std::vector<double> update_seconds;  ///< wall time of each update
+  std::vector<double> nis;             ///< NIS of each measurement (streaming runs with compute_nis)
   double total_seconds = 0;
   int iterations = 0;                  ///< solver iterations (batch), 0 for filters
   std::string summary;                 ///< the solver's own report line

@@ -94,10 +94,17 @@ std::string ScenarioAnalysis::markdown() const {
 
   os << "\n## 2. Consistency (NEES, " << mc.dof << " dof; 95% interval of a " << mc.seeds
      << "-run average: [" << mc.nees_lo << ", " << mc.nees_hi << "])\n\n";
-  os << "| method | mean NEES | steps inside the interval | verdict |\n| --- | --- | --- | --- |\n";
-  for (const auto& m : mc.methods)
+  os << "| method | mean NEES | steps inside the interval | verdict | mean NIS (" << mc.nis_dof
+     << " dof, interval [" << mc.nis_lo << ", " << mc.nis_hi << "]) | steps inside | verdict |\n"
+     << "| --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& m : mc.methods) {
     os << "| " << m.method << " | " << m.mean_nees << " | " << std::lround(100 * m.nees_step_in_interval)
-       << "% | " << m.consistency << " |\n";
+       << "% | " << m.consistency << " | ";
+    if (std::isfinite(m.mean_nis))
+      os << m.mean_nis << " | " << std::lround(100 * m.nis_step_in_interval) << "% | " << m.nis_consistency << " |\n";
+    else
+      os << "— (no innovations: uses all data) | — | — |\n";
+  }
 
   os << "\n## 3. Identifiability of the constants (filtering bound, data information only)\n\n";
   if (identifiability.empty()) {

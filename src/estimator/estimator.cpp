@@ -1,5 +1,6 @@
 #include "gssm/estimator.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
 #include <deque>
@@ -61,6 +62,29 @@ void Estimator::advance(double t) {
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+double Estimator::innovationNis(double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
+  const ModelDims& d = model_.dims();
+  const StateEstimate e = current();
+  const Eigen::VectorXd xc = e.mean.head(d.nc), xb = e.mean.tail(d.nb);
+  Eigen::VectorXd x = xc;
+  Eigen::MatrixXd P = e.covariance;
+  if (dt > 0) {  // predict [x_c; x_b] through the model, as an EKF would
+    Eigen::MatrixXd J_f_xc, J_f_xb;
+    x = model_.f(xc, xb, u, dt, &J_f_xc, &J_f_xb);
+    Eigen::MatrixXd F = Eigen::MatrixXd::Identity(d.nc + d.nb, d.nc + d.nb);
+    F.topLeftCorner(d.nc, d.nc) = J_f_xc;
+    F.topRightCorner(d.nc, d.nb) = J_f_xb;
+    P = F * P * F.transpose();
+    P.topLeftCorner(d.nc, d.nc) += model_.processNoise(dt);
+  }
+  Eigen::MatrixXd J_h_xc, J_h_xb;
+  const Eigen::VectorXd innovation = y - model_.h(x, xb, &J_h_xc, &J_h_xb);
+  Eigen::MatrixXd H(d.ny, d.nc + d.nb);
+  H << J_h_xc, J_h_xb;
+  const Eigen::MatrixXd S = H * P * H.transpose() + model_.measurementNoise();
+  return innovation.dot(S.ldlt().solve(innovation));
+}
+
 void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
   const auto start = std::chrono::steady_clock::now();
   if (!std::isfinite(t) || t < t_ || (t == t_ && k_ == 0)) {
@@ -70,6 +94,7 @@ void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
     throw InvalidArgument(os.str());
   }
   requireVector(y, model_.dims().ny, method() + ": measurement y at t = " + std::to_string(t));
+  const double nis = compute_nis_ ? innovationNis(t - t_, inputInForce(), y) : report_.nis;
   if (t == t_) {
     doMeasurement(k_, y);  // at the newest state
   } else {
@@ -77,6 +102,7 @@ void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
     t_ = t;
     ++k_;
   }
+  report_.nis = nis;
   report_.steps = k_;
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -365,18 +391,23 @@ class PaperWindowEstimator final : public Estimator {
 std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOptions& options) {
   std::string why;
   if (!options.validate(model, &why)) throw InvalidArgument(why);
-  if (options.method == "ekf") return std::make_unique<EkfEstimator>(model, options);
-  if (options.method == "incremental")
-    return std::make_unique<SmootherEstimator<IncrementalSmoother>>(model, "incremental",
-                                                                     options.smoother, options.t0, 0);
-  if (options.method == "fixed-lag") {
+  std::unique_ptr<Estimator> e;
+  if (options.method == "ekf") {
+    e = std::make_unique<EkfEstimator>(model, options);
+  } else if (options.method == "incremental") {
+    e = std::make_unique<SmootherEstimator<IncrementalSmoother>>(model, "incremental", options.smoother,
+                                                                 options.t0, 0);
+  } else if (options.method == "fixed-lag") {
     FixedLagSmootherOptions o;
     o.window = options.window;
     o.smoother = options.smoother;
-    return std::make_unique<SmootherEstimator<FixedLagSmoother>>(
-        model, "fixed-lag", o, options.t0, static_cast<std::size_t>(options.window));
+    e = std::make_unique<SmootherEstimator<FixedLagSmoother>>(model, "fixed-lag", o, options.t0,
+                                                              static_cast<std::size_t>(options.window));
+  } else {
+    e = std::make_unique<PaperWindowEstimator>(model, options);
   }
-  return std::make_unique<PaperWindowEstimator>(model, options);
+  e->compute_nis_ = options.compute_nis;
+  return e;
 }
 
 }  // namespace gssm

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -65,7 +66,7 @@ struct SeedResult {
   bool ok = false;
   std::string error;
   std::vector<Eigen::VectorXd> sq;  // per step
-  std::vector<double> nees;
+  std::vector<double> nees, nis;
   Eigen::VectorXd rmse, final_error;
 };
 }  // namespace
@@ -110,7 +111,9 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
             eo.method = options.methods[mi];
             eo.window = options.window;
             eo.ekf = io::ekfOptions(est_config, estimator_model);
+            eo.compute_nis = true;
             out = runStreaming(estimator_model, eo, run.measurements, run.inputs);
+            r.nis = out.nis;
           }
           Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
           std::size_t j = 0;  // truth row at the estimate's time (multi-rate: not every step)
@@ -145,6 +148,9 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
   res.state_names = model->stackedStateNames();
   res.nees_lo = chiSquareQuantile(0.025, n * options.seeds) / options.seeds;
   res.nees_hi = chiSquareQuantile(0.975, n * options.seeds) / options.seeds;
+  res.nis_dof = model->dims().ny;
+  res.nis_lo = chiSquareQuantile(0.025, res.nis_dof * options.seeds) / options.seeds;
+  res.nis_hi = chiSquareQuantile(0.975, res.nis_dof * options.seeds) / options.seeds;
   const std::size_t ekf = static_cast<std::size_t>(
       std::find(options.methods.begin(), options.methods.end(), "ekf") - options.methods.begin());
   for (std::size_t mi = 0; mi < M; ++mi) {
@@ -154,7 +160,7 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
     m.mean_rmse = m.rms_final_error = m.beats_ekf = Eigen::VectorXd::Zero(n);
     const std::size_t rows = static_cast<std::size_t>(spec.steps / spec.measure_every);
     std::vector<Eigen::VectorXd> sq_t(rows, Eigen::VectorXd::Zero(n));
-    std::vector<double> nees_t(rows, 0.0);
+    std::vector<double> nees_t(rows, 0.0), nis_t(rows, 0.0);
     int ok = 0;
     for (std::size_t s = 0; s < S; ++s) {
       const SeedResult& r = results[mi][s];
@@ -170,6 +176,7 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
       for (std::size_t k = 0; k < r.sq.size() && k < sq_t.size(); ++k) {
         sq_t[k] += r.sq[k];
         nees_t[k] += r.nees[k];
+        nis_t[k] += k < r.nis.size() ? r.nis[k] : std::numeric_limits<double>::quiet_NaN();
       }
     }
     if (ok > 0) {
@@ -186,6 +193,16 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
       m.nees_step_in_interval = static_cast<double>(inside) / static_cast<double>(sq_t.size());
       m.consistency = m.mean_nees > res.nees_hi ? "over-confident"
                       : m.mean_nees < res.nees_lo ? "under-confident" : "consistent";
+      m.mean_nis = 0;
+      int nis_inside = 0;
+      for (double v : nis_t) {
+        m.mean_nis += v / ok / static_cast<double>(nis_t.size());
+        nis_inside += (v / ok >= res.nis_lo && v / ok <= res.nis_hi) ? 1 : 0;
+      }
+      m.nis_step_in_interval = static_cast<double>(nis_inside) / static_cast<double>(nis_t.size());
+      if (std::isfinite(m.mean_nis))
+        m.nis_consistency = m.mean_nis > res.nis_hi ? "over-confident"
+                            : m.mean_nis < res.nis_lo ? "under-confident" : "consistent";
     }
     res.methods.push_back(std::move(m));
   }
@@ -209,13 +226,17 @@ std::string MonteCarloResult::markdown() const {
   os << "Scenario `" << scenario << "`, " << seeds << " seeds × " << steps << " steps; NEES has " << dof
      << " dof, 95% interval of a " << seeds << "-seed average at one step: [" << nees_lo << ", " << nees_hi
      << "].\n\n";
-  os << "| method | mean RMSE (" << names << ") | RMS final error (" << names << ") | mean NEES | verdict | steps with NEES in 95% interval | seeds beating the EKF (" << names << ") | failures |\n";
-  os << "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  os << "| method | mean RMSE (" << names << ") | RMS final error (" << names << ") | mean NEES | verdict | steps with NEES in 95% interval | mean NIS (" << nis_dof << " dof) | seeds beating the EKF (" << names << ") | failures |\n";
+  os << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const auto& m : methods) {
     os << "| " << m.method << (m.method == "batch" ? " (smoother, uses future data)" : "") << " | "
        << perState(m.mean_rmse, 3) << " | " << perState(m.rms_final_error, 3) << " | ";
     os.precision(2);
     os << m.mean_nees << " | " << m.consistency << " | " << std::lround(100 * m.nees_step_in_interval) << "% | ";
+    if (std::isfinite(m.mean_nis))
+      os << m.mean_nis << " (" << m.nis_consistency << ", " << std::lround(100 * m.nis_step_in_interval)
+         << "% of steps inside) | ";
+    else os << "— | ";
     if (m.method == "ekf") os << "— | ";
     else {
       Eigen::VectorXd pct = 100 * m.beats_ekf;

@@ -32,6 +32,7 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
     const auto t0 = Clock::now();
     est->addMeasurement(m.t, m.y);
     out.update_seconds.push_back(since(t0));
+    if (options.compute_nis) out.nis.push_back(est->report().nis);
     const StateEstimate e = est->current();
     out.rows.push_back({e.t, e.mean, e.covariance});
     out.iterations = std::max(out.iterations, est->report().iterations);
