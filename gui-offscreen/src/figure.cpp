@@ -163,7 +163,7 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
   int label_w = 0;
   for (double v : yt.values) label_w = std::max(label_w, static_cast<int>(formatTick(v, yt.step).size()));
   ax.left = 24 + (label_w + 1) * kCharW;
-  ax.top = 48;
+  ax.top = 56;
   ax.right = width - 24;
   ax.bottom = height - 56;
 
@@ -198,7 +198,7 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
 
   // ---- text -----------------------------------------------------------------
   img.selectTextFont("10x20");
-  centeredText(img, (ax.left + ax.right) / 2, 14, fig.title, text, 10);
+  centeredText(img, (ax.left + ax.right) / 2, 8, fig.title, text, 10);
   img.selectTextFont("6x13");
   centeredText(img, (ax.left + ax.right) / 2, height - 26, fig.xlabel, text);
   img.textOut(ax.left, ax.top - 20, fig.ylabel, text);
