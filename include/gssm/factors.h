@@ -125,6 +125,13 @@ class FactorGraph {
   std::vector<FactorPtr> factors_;
 };
 
+/// The variables of the stacked state [x_c(k); x_b] of `model` (x_b only if
+/// the model has constants), e.g. for its joint marginal covariance.
+inline std::vector<Key> stackedKeys(const Model& model, std::int64_t k) {
+  if (model.dims().nb > 0) return {Key::state(k), Key::constants()};
+  return {Key::state(k)};
+}
+
 /// Dimension of a variable of `model`.
 inline int variableDim(const Model& model, const Key& k) {
   return k.isConstants() ? model.dims().nb : model.dims().nc;

@@ -23,6 +23,18 @@ struct Problem {
 Problem buildProblem(const Model& model, const std::vector<Measurement>& measurements,
                      const std::vector<Input>& inputs = {}, double t0 = 0.0);
 
+/// One state of a run after x_c(0): its time and the measurements taken at it.
+struct ScheduledStep {
+  double t = 0;
+  std::vector<std::size_t> measurements;  ///< indices into the measurement list
+};
+
+/// The states a run creates, as the streaming estimators make them: one per
+/// input time after t0 and per measurement time (merged, in time order);
+/// measurements attach at their time. Entry i is x_c(i + 1).
+std::vector<ScheduledStep> stepSchedule(const std::vector<Measurement>& measurements,
+                                        const std::vector<Input>& inputs, double t0);
+
 /// The input in force at time t (zero-order hold); zeros before the first.
 Eigen::VectorXd inputAt(const Model& model, const std::vector<Input>& inputs, double t);
 

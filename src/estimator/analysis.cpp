@@ -36,8 +36,7 @@ std::int64_t stepAt(const Problem& p, double t) {
 }
 
 Eigen::MatrixXd boundAt(BatchSolver& solver, const Model& model, std::int64_t k) {
-  return model.dims().nb ? solver.jointMarginalCovariance({Key::state(k), Key::constants()})
-                         : solver.marginalCovariance(Key::state(k));
+  return solver.jointMarginalCovariance(stackedKeys(model, k));
 }
 }  // namespace
 

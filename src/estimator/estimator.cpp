@@ -222,8 +222,7 @@ class SmootherEstimator final : public Estimator {
     e.t = times_[times_.size() - 1 - static_cast<std::size_t>(step() - k)];
     const Eigen::VectorXd xb = nb ? smoother_.estimate(Key::constants()) : Eigen::VectorXd();
     e.mean = stack(smoother_.estimate(Key::state(k)), xb);
-    e.covariance = nb ? smoother_.jointMarginalCovariance({Key::state(k), Key::constants()})
-                      : smoother_.marginalCovariance(Key::state(k));
+    e.covariance = smoother_.jointMarginalCovariance(stackedKeys(model_, k));
     return e;
   }
 
@@ -288,8 +287,7 @@ class PaperWindowEstimator final : public Estimator {
     e.step = k;
     e.t = times_[static_cast<std::size_t>(k - oldest_)];
     e.mean = stack(values_.at(Key::state(k)), nb ? values_.at(Key::constants()) : Eigen::VectorXd());
-    e.covariance = nb ? solver_.jointMarginalCovariance({Key::state(k), Key::constants()})
-                      : solver_.marginalCovariance(Key::state(k));
+    e.covariance = solver_.jointMarginalCovariance(stackedKeys(model_, k));
     return e;
   }
   std::optional<Eigen::MatrixXd> marginalCovariance(const std::vector<Key>& keys) override {

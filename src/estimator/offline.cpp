@@ -70,8 +70,7 @@ OfflineRun runBatch(const Model& model, const BatchSolverOptions& options,
     row.mean.resize(nc + nb);
     row.mean.head(nc) = x.at(key);
     if (nb) row.mean.tail(nb) = x.at(Key::constants());
-    row.covariance = nb ? solver.jointMarginalCovariance({key, Key::constants()})
-                        : solver.marginalCovariance(key);
+    row.covariance = solver.jointMarginalCovariance(stackedKeys(model, key.step));
     out.rows.push_back(std::move(row));
   }
   out.total_seconds = since(start);

@@ -15,6 +15,21 @@ Eigen::VectorXd inputAt(const Model& model, const std::vector<Input>& inputs, do
   return std::prev(it)->u;
 }
 
+std::vector<ScheduledStep> stepSchedule(const std::vector<Measurement>& measurements,
+                                        const std::vector<Input>& inputs, double t0) {
+  std::vector<ScheduledStep> steps;
+  std::size_t mi = 0, ii = 0;
+  while (ii < inputs.size() && inputs[ii].t <= t0) ++ii;
+  while (mi < measurements.size() || ii < inputs.size()) {
+    const double t = std::min(mi < measurements.size() ? measurements[mi].t : INFINITY,
+                              ii < inputs.size() ? inputs[ii].t : INFINITY);
+    if (steps.empty() || t > steps.back().t) steps.push_back({t, {}});
+    for (; mi < measurements.size() && measurements[mi].t == t; ++mi) steps.back().measurements.push_back(mi);
+    while (ii < inputs.size() && inputs[ii].t == t) ++ii;
+  }
+  return steps;
+}
+
 Problem buildProblem(const Model& model, const std::vector<Measurement>& measurements,
                      const std::vector<Input>& inputs, double t0) {
   for (std::size_t i = 0; i < inputs.size(); ++i) {
@@ -43,26 +58,15 @@ Problem buildProblem(const Model& model, const std::vector<Measurement>& measure
     p.initial.insert(Key::constants(), model.priorConstants().mean);
   }
   const Eigen::VectorXd xb0 = has_constants ? model.priorConstants().mean : Eigen::VectorXd();
-  // Steps at every input time after t0 and every measurement time (as the
-  // streaming estimators make them); measurements attach at their time.
-  std::size_t mi = 0, ii = 0;
-  while (ii < inputs.size() && inputs[ii].t <= t0) ++ii;
-  while (mi < measurements.size() || ii < inputs.size()) {
-    const double t = std::min(mi < measurements.size() ? measurements[mi].t : INFINITY,
-                              ii < inputs.size() ? inputs[ii].t : INFINITY);
+  for (const ScheduledStep& step : stepSchedule(measurements, inputs, t0)) {
     const double prev = p.times.back();
-    if (t > prev) {
-      const auto k = static_cast<std::int64_t>(p.times.size()) - 1;
-      const Eigen::VectorXd u = inputAt(model, inputs, prev);
-      p.graph.add(std::make_shared<ProcessFactor>(model, k, u, t - prev));
-      p.initial.insert(Key::state(k + 1), model.f(p.initial.at(Key::state(k)), xb0, u, t - prev));
-      p.times.push_back(t);
-    }
     const auto k = static_cast<std::int64_t>(p.times.size()) - 1;
-    for (; mi < measurements.size() && measurements[mi].t == t; ++mi)
-      p.graph.add(std::make_shared<MeasurementFactor>(model, k, measurements[mi].y));
-    for (; ii < inputs.size() && inputs[ii].t == t; ++ii) {
-    }
+    const Eigen::VectorXd u = inputAt(model, inputs, prev);
+    p.graph.add(std::make_shared<ProcessFactor>(model, k, u, step.t - prev));
+    p.initial.insert(Key::state(k + 1), model.f(p.initial.at(Key::state(k)), xb0, u, step.t - prev));
+    p.times.push_back(step.t);
+    for (std::size_t i : step.measurements)
+      p.graph.add(std::make_shared<MeasurementFactor>(model, k + 1, measurements[i].y));
   }
   return p;
 }

@@ -1,7 +1,6 @@
 #include "gssm/ekf.h"
 
 #include <Eigen/Cholesky>
-#include <cmath>
 #include <sstream>
 
 #include "gssm/error.h"
@@ -102,26 +101,16 @@ void ExtendedKalmanFilter::update(const Eigen::VectorXd& y) {
 Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
                        const std::vector<Measurement>& measurements,
                        const std::vector<Input>& inputs, double t0) {
-  // The same steps as buildProblem: every input time after t0 and every
-  // measurement time; x_c(k) from the filtered estimate at each step.
+  // The same steps as buildProblem; x_c(k) from the filtered estimate.
   const ModelDims& d = model.dims();
   ExtendedKalmanFilter ekf(model, options, t0);
   Values x;
   x.insert(Key::state(0), model.priorState().mean);
   std::int64_t k = 0;
-  std::size_t mi = 0, ii = 0;
-  while (ii < inputs.size() && inputs[ii].t <= t0) ++ii;
-  while (mi < measurements.size() || ii < inputs.size()) {
-    const double t = std::min(mi < measurements.size() ? measurements[mi].t : INFINITY,
-                              ii < inputs.size() ? inputs[ii].t : INFINITY);
-    if (t > ekf.time()) {
-      ekf.predict(t, inputAt(model, inputs, ekf.time()));
-      ++k;
-    }
-    for (; mi < measurements.size() && measurements[mi].t == t; ++mi) ekf.update(measurements[mi].y);
-    for (; ii < inputs.size() && inputs[ii].t == t; ++ii) {
-    }
-    x.insertOrAssign(Key::state(k), ekf.mean().head(d.nc));
+  for (const ScheduledStep& step : stepSchedule(measurements, inputs, t0)) {
+    ekf.predict(step.t, inputAt(model, inputs, ekf.time()));
+    for (std::size_t i : step.measurements) ekf.update(measurements[i].y);
+    x.insert(Key::state(++k), ekf.mean().head(d.nc));
   }
   if (d.nb > 0) x.insert(Key::constants(), ekf.mean().tail(d.nb));
   return x;
