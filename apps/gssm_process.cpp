@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "gssm/checkpoint.h"
 #include "gssm/io/config.h"
 #include "gssm/io/csv.h"
 #include "gssm/io/dataset.h"
@@ -49,12 +50,19 @@ int main(int argc, char** argv) {
     cli.option("window", "W", "states kept by fixed-lag and paper-window (overrides [fixed_lag] / [paper_window] window)");
     cli.option("config", "FILE", "INI file to use instead of DIR/scenario.ini");
     cli.option("out", "OUTDIR", "output folder");
+    cli.option("checkpoint-every", "N",
+               "streaming methods: write OUTDIR/checkpoint-<method>.ckpt every N measurements");
+    cli.option("resume", "FILE",
+               "continue the streaming run that wrote checkpoint FILE (its method, unless --method says "
+               "the same); the output equals an uninterrupted run's");
     cli.flag("skip-bad-rows", "skip malformed measurement rows (listed in metrics.json) instead of stopping at the first");
     cli.parse(argc, argv);
     const std::string data = cli.require("data"), out = cli.require("out");
-    const std::string method = cli.get("method");
+    std::string method = cli.get("method");
+    const std::string resume = cli.given("resume") ? cli.get("resume") : "";
+    if (!resume.empty() && !cli.given("method")) method = "";  // taken from the checkpoint below
     std::vector<std::string> methods{"ekf", "batch", "incremental", "fixed-lag", "paper-window"};
-    if (method != "all") {
+    if (method != "all" && !method.empty()) {
       if (std::find(methods.begin(), methods.end(), method) == methods.end())
         throw std::invalid_argument("option --method = '" + method +
                                     "': expected ekf, batch, incremental, fixed-lag, paper-window or all");
@@ -63,6 +71,16 @@ int main(int argc, char** argv) {
 
     const gssm::io::IniDocument config = gssm::io::readScenario(data, cli.get("config"));
     const auto model = gssm::io::makeModel(config);
+    if (!resume.empty()) {
+      gssm::CheckpointInfo info;
+      gssm::restoreCheckpoint(*model, resume, &info);  // throws a clear error if unusable
+      if (method.empty()) methods = {info.method};
+      if (methods.size() != 1 || methods[0] == "batch")
+        throw std::invalid_argument("option --resume: resumes one streaming method; the checkpoint's is '" +
+                                    info.method + "'");
+    }
+    const std::size_t checkpoint_every =
+        cli.given("checkpoint-every") ? static_cast<std::size_t>(cli.getInt("checkpoint-every", 1, 1000000000)) : 0;
     gssm::io::Dataset ds;
     const bool skip = cli.given("skip-bad-rows");
     gssm::io::readDatasetData(data, *model, ds, skip ? gssm::io::BadRows::Skip : gssm::io::BadRows::Stop);
@@ -94,7 +112,9 @@ int main(int argc, char** argv) {
       eo.smoother = gssm::io::smootherOptions(config);
       gssm::OfflineRun run = m == "batch"
           ? gssm::runBatch(*model, gssm::BatchSolverOptions{}, ds.measurements, ds.inputs)
-          : gssm::runStreaming(*model, eo, ds.measurements, ds.inputs, progress(m));
+          : gssm::runStreaming(*model, eo, ds.measurements, ds.inputs, progress(m),
+                               {checkpoint_every ? (fs::path(out) / ("checkpoint-" + m + ".ckpt")).string() : "",
+                                checkpoint_every, resume});
       writeEstimates((fs::path(out) / ("estimates-" + m + ".csv")).string(), *model, run);
       metrics.push_back(gssm::computeMetrics(*model, run, ds.truth ? &*ds.truth : nullptr));
       const auto& last = run.rows.back();

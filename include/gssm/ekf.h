@@ -12,6 +12,12 @@
 #include "gssm/model.h"
 #include "gssm/values.h"
 
+namespace gssm::internal {
+struct CheckpointAccess;
+class ByteWriter;
+class ByteReader;
+}  // namespace gssm::internal
+
 namespace gssm {
 
 struct ExtendedKalmanFilterOptions {
@@ -46,6 +52,7 @@ class ExtendedKalmanFilter {
   const Model& model() const { return *model_; }
 
  private:
+  friend struct internal::CheckpointAccess;
   const Model* model_;
   ExtendedKalmanFilterOptions options_;
   double t_;

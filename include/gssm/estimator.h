@@ -92,6 +92,8 @@ class Estimator {
   double time() const { return t_; }
   std::int64_t step() const { return k_; }
   const Model& model() const { return model_; }
+  /// The options it was made with (by makeEstimator).
+  const EstimatorOptions& options() const { return options_; }
 
  protected:
   Estimator(const Model& model, const std::string& method, double t0);
@@ -106,6 +108,11 @@ class Estimator {
   EstimatorReport report_;
 
  private:
+  friend struct internal::CheckpointAccess;
+  /// The method's own state, for checkpoints (checkpoint.h). Defaults throw
+  /// CheckpointError: an estimator that does not implement them cannot be saved.
+  virtual void saveState(internal::ByteWriter& out) const;
+  virtual void loadState(internal::ByteReader& in);
   void advance(double t);  // process-only step to t
   /// NIS of y at a step dt after the current estimate (dt = 0: at it).
   double innovationNis(double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y);
@@ -115,6 +122,7 @@ class Estimator {
   double t_;            // time of the newest state
   std::int64_t k_ = 0;  // its step
   Eigen::VectorXd input_;  // in force from the newest state on (empty: zeros)
+  EstimatorOptions options_;
 };
 
 /// Builds the estimator named by options.method; the model must outlive it.

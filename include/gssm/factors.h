@@ -83,6 +83,7 @@ class MeasurementFactor final : public Factor {
                  std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   const Eigen::VectorXd& measurement() const { return y_; }
+  const GaussianNoise& noise() const { return noise_; }
 
  private:
   const Model* model_;

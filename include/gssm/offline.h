@@ -32,14 +32,28 @@ struct OfflineRun {
   std::string summary;                 ///< the solver's own report line
 };
 
+/// Checkpoints of a streaming run (checkpoint.h): each holds the estimator
+/// and the run so far (rows, latencies, NIS), so a resumed run ends with the
+/// same rows, bit for bit, as an uninterrupted one. A checkpoint stores every
+/// row so far, (1 + n + n²)·8 bytes each for a stacked state of size n.
+struct StreamingCheckpoints {
+  std::string path;         ///< file written every `every` measurements ("" = none)
+  std::size_t every = 0;
+  std::string resume_from;  ///< checkpoint to continue from ("" = start at the beginning)
+};
+
 /// Streams the measurements (and inputs, in time order) through a streaming
 /// estimator made by makeEstimator(model, options); rows hold current()
 /// after each measurement.
 /// `progress(done, total)`, if set, is called every 1% of the measurements.
+/// With `checkpoints.resume_from`, the estimator and the rows so far come
+/// from that checkpoint, which must have been written by a run of the same
+/// method on the same measurements (CheckpointError otherwise).
 OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::vector<Measurement>& measurements,
                         const std::vector<Input>& inputs = {},
-                        const std::function<void(std::size_t, std::size_t)>& progress = {});
+                        const std::function<void(std::size_t, std::size_t)>& progress = {},
+                        const StreamingCheckpoints& checkpoints = {});
 
 /// The batch MAP of the whole run; rows hold the smoothed estimate at each
 /// measurement time with its marginal covariance.

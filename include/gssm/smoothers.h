@@ -18,6 +18,12 @@
 
 #include "gssm/factors.h"
 
+namespace gssm::internal {
+struct CheckpointAccess;
+class ByteWriter;
+class ByteReader;
+}  // namespace gssm::internal
+
 namespace gssm {
 
 /// Every field is filled by every update.
@@ -107,6 +113,7 @@ class Smoother {
   std::size_t numFactors() const;
 
  protected:
+  friend struct internal::CheckpointAccess;
   explicit Smoother(std::unique_ptr<SmootherCore> core);
   std::unique_ptr<SmootherCore> core_;
 };
@@ -135,6 +142,7 @@ class FixedLagSmoother final : public Smoother {
   const FixedLagSmootherOptions& options() const { return options_; }
 
  private:
+  friend struct internal::CheckpointAccess;
   FixedLagSmootherOptions options_;
   std::int64_t oldest_ = -1, newest_ = -1;
 };

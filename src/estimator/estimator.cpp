@@ -6,7 +6,10 @@
 #include <deque>
 #include <sstream>
 
+#include "checkpoint/access.h"
+#include "checkpoint/factor_io.h"
 #include "gssm/batch_solver.h"
+#include "gssm/checkpoint.h"
 #include "gssm/error.h"
 #include "gssm/problem.h"
 
@@ -33,6 +36,13 @@ bool EstimatorOptions::validate(const Model& model, std::string* why) const {
 Estimator::Estimator(const Model& model, const std::string& method, double t0)
     : model_(model), t_(t0) {
   report_.method = method;
+}
+
+void Estimator::saveState(internal::ByteWriter&) const {
+  throw CheckpointError(method() + ": this estimator does not support checkpoints");
+}
+void Estimator::loadState(internal::ByteReader&) {
+  throw CheckpointError(method() + ": this estimator does not support checkpoints");
 }
 
 void Estimator::addInput(double t, const Eigen::VectorXd& u) {
@@ -109,6 +119,10 @@ void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
 
 namespace {
 
+// State times are accumulated step by step (t_k + dt), so the newest may
+// differ from the estimator's time by rounding.
+bool sameTime(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); }
+
 Eigen::VectorXd stack(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) {
   Eigen::VectorXd z(xc.size() + xb.size());
   z << xc, xb;
@@ -162,6 +176,8 @@ class EkfEstimator final : public Estimator {
   }
 
  private:
+  void saveState(internal::ByteWriter& out) const override { internal::CheckpointAccess::saveEkf(ekf_, out); }
+  void loadState(internal::ByteReader& in) override { internal::CheckpointAccess::loadEkf(ekf_, in); }
   ExtendedKalmanFilter ekf_;
 };
 
@@ -215,7 +231,9 @@ class SmootherEstimator final : public Estimator {
   StateEstimate current() override { return *smoothed(step()); }
 
   std::optional<StateEstimate> smoothed(std::int64_t k) override {
-    if (k < 0 || k > step() || !smoother_.contains(Key::state(k))) return std::nullopt;
+    if (k < 0 || k > step() || step() - k >= static_cast<std::int64_t>(times_.size()) ||
+        !smoother_.contains(Key::state(k)))
+      return std::nullopt;
     const bool nb = model_.dims().nb > 0;
     StateEstimate e;
     e.step = k;
@@ -252,6 +270,27 @@ class SmootherEstimator final : public Estimator {
   }
 
  private:
+  void saveState(internal::ByteWriter& out) const override {
+    internal::CheckpointAccess::saveSmoother(smoother_, out);
+    out.u64(times_.size());
+    for (double t : times_) out.f64(t);
+  }
+  void loadState(internal::ByteReader& in) override {
+    internal::CheckpointAccess::loadSmoother(smoother_, in, model_);
+    std::deque<double> times(in.count("state times", sizeof(double)));
+    for (double& t : times) t = in.f64("state time");
+    const auto held = static_cast<std::size_t>(step()) + 1;
+    const std::size_t expect = keep_times_ ? std::min(held, keep_times_) : held;
+    const bool nb = model_.dims().nb > 0;
+    if (times.size() != expect || !sameTime(times.back(), time()) ||
+        smoother_.numVariables() != times.size() + (nb ? 1 : 0) ||
+        !smoother_.contains(Key::state(step())) ||
+        !smoother_.contains(Key::state(step() - static_cast<std::int64_t>(times.size()) + 1)) ||
+        (nb && !smoother_.contains(Key::constants())))
+      in.fail("the smoother's variables do not match step " + std::to_string(step()) + " and " +
+              std::to_string(times.size()) + " state times");
+    times_ = std::move(times);
+  }
   Smoother smoother_;
   std::size_t keep_times_;   // 0: keep all
   std::deque<double> times_; // times of the states still held
@@ -375,6 +414,59 @@ class PaperWindowEstimator final : public Estimator {
     return solver.solve(g, values);
   }
 
+  void saveState(internal::ByteWriter& out) const override {
+    out.u64(steps_.size());
+    for (const auto& s : steps_) {
+      out.u64(s.size());
+      for (const auto& f : s) internal::writeFactor(out, *f);
+    }
+    out.u64(times_.size());
+    for (double t : times_) out.f64(t);
+    out.values(values_);
+    out.gaussian(prior_state_);
+    out.gaussian(prior_constants_);
+    out.i64(oldest_);
+  }
+  void loadState(internal::ByteReader& in) override {
+    std::deque<std::vector<FactorPtr>> steps(in.count("window steps", 8));
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+      steps[i].resize(in.count("factors of window step", 1));
+      for (auto& f : steps[i]) f = internal::readFactor(in, model_, "window factor");
+    }
+    std::deque<double> times(in.count("state times", sizeof(double)));
+    for (double& t : times) t = in.f64("state time");
+    Values values = in.values("window values");
+    Gaussian ps = in.gaussian("prior on the oldest state"), pb = in.gaussian("prior on the constants");
+    const std::int64_t oldest = in.i64("oldest step");
+    const bool nb = model_.dims().nb > 0;
+    const std::int64_t held = step() - oldest + 1;
+    bool ok = oldest >= 0 && held >= 1 && held <= window_ && static_cast<std::int64_t>(times.size()) == held &&
+              static_cast<std::int64_t>(steps.size()) == held - 1 && sameTime(times.back(), time()) &&
+              values.size() == static_cast<std::size_t>(held) + (nb ? 1 : 0) &&
+              ps.mean.size() == model_.dims().nc && pb.mean.size() == model_.dims().nb;
+    for (std::int64_t k = oldest; ok && k <= step(); ++k)
+      ok = values.contains(Key::state(k)) && values.at(Key::state(k)).size() == model_.dims().nc;
+    if (ok && nb) ok = values.contains(Key::constants()) && values.at(Key::constants()).size() == model_.dims().nb;
+    if (!ok) in.fail("the paper window's states, times and priors do not match step " + std::to_string(step()));
+    // The covariances come from a factorization at the window's values; the
+    // uninterrupted run factored the same matrix at the same point.
+    steps_ = std::move(steps);
+    times_ = std::move(times);
+    values_ = std::move(values);
+    prior_state_ = std::move(ps);
+    prior_constants_ = std::move(pb);
+    oldest_ = oldest;
+    solver_.evaluateAt(graph(), values_);
+  }
+  FactorGraph graph() const {
+    FactorGraph g;
+    g.add(std::make_shared<PriorFactor>(Key::state(oldest_), prior_state_));
+    if (model_.dims().nb > 0) g.add(std::make_shared<PriorFactor>(Key::constants(), prior_constants_));
+    for (const auto& s : steps_)
+      for (const auto& f : s) g.add(f);
+    return g;
+  }
+
   int window_;
   std::deque<std::vector<FactorPtr>> steps_;  // factors of each step in the window
   std::deque<double> times_;
@@ -405,6 +497,7 @@ std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOpti
     e = std::make_unique<PaperWindowEstimator>(model, options);
   }
   e->compute_nis_ = options.compute_nis;
+  e->options_ = options;
   return e;
 }
 

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <chrono>
 
+#include "checkpoint/byte_stream.h"
+#include "gssm/checkpoint.h"
+#include "gssm/error.h"
 #include "gssm/problem.h"
 
 namespace gssm {
@@ -14,32 +17,128 @@ double since(Clock::time_point t0) {
 }
 }  // namespace
 
+namespace {
+// The run so far, stored as a checkpoint's user data.
+constexpr const char* kRunTag = "gssm offline run v1";
+
+// Fingerprint of the measurements a checkpoint has consumed (folded in one
+// at a time), so a run is not resumed on another dataset.
+std::uint64_t foldMeasurement(std::uint64_t h, const Measurement& m) {
+  h = internal::fnv1a64(reinterpret_cast<const char*>(&m.t), sizeof m.t, h);
+  return internal::fnv1a64(reinterpret_cast<const char*>(m.y.data()),
+                           static_cast<std::size_t>(m.y.size()) * sizeof(double), h);
+}
+
+std::string encodeRun(const OfflineRun& run, std::size_t next_measurement, std::size_t next_input,
+                      std::uint64_t data_fingerprint) {
+  internal::ByteWriter w;
+  w.str(kRunTag);
+  w.u64(data_fingerprint);
+  w.str(run.method);
+  w.u64(next_measurement);
+  w.u64(next_input);
+  w.i32(run.iterations);
+  w.f64(run.total_seconds);
+  w.u64(run.rows.size());
+  for (const auto& r : run.rows) {
+    w.f64(r.t);
+    w.vec(r.mean);
+    w.mat(r.covariance);
+  }
+  w.u64(run.update_seconds.size());
+  for (double s : run.update_seconds) w.f64(s);
+  w.u64(run.nis.size());
+  for (double v : run.nis) w.f64(v);
+  return w.bytes();
+}
+
+OfflineRun decodeRun(const std::string& bytes, const std::string& source, std::size_t& next_measurement,
+                     std::size_t& next_input, std::uint64_t& data_fingerprint) {
+  internal::ByteReader r(bytes, source + " (run progress)");
+  if (r.str("run tag") != kRunTag) r.fail("not the checkpoint of an offline run (gssm-process)");
+  data_fingerprint = r.u64("data fingerprint");
+  OfflineRun run;
+  run.method = r.str("method");
+  next_measurement = r.u64("measurements consumed");
+  next_input = r.u64("inputs consumed");
+  run.iterations = r.i32("iterations");
+  run.total_seconds = r.f64("seconds");
+  run.rows.resize(r.count("rows", 24));
+  for (auto& row : run.rows) {
+    row.t = r.f64("row time");
+    row.mean = r.vec("row mean");
+    row.covariance = r.mat("row covariance");
+  }
+  run.update_seconds.resize(r.count("latencies", 8));
+  for (double& s : run.update_seconds) s = r.f64("latency");
+  run.nis.resize(r.count("NIS values", 8));
+  for (double& v : run.nis) v = r.f64("NIS", true);
+  if (!r.atEnd()) r.fail("unexpected bytes after the run progress");
+  if (run.rows.size() != next_measurement || run.update_seconds.size() != next_measurement)
+    r.fail("row count does not match the measurements consumed");
+  return run;
+}
+}  // namespace
+
 OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::vector<Measurement>& measurements,
                         const std::vector<Input>& inputs,
-                        const std::function<void(std::size_t, std::size_t)>& progress) {
+                        const std::function<void(std::size_t, std::size_t)>& progress,
+                        const StreamingCheckpoints& checkpoints) {
+  if (!checkpoints.path.empty() && checkpoints.every == 0)
+    throw InvalidArgument("runStreaming: a checkpoint path needs checkpoints.every >= 1");
   OfflineRun out;
   out.method = options.method;
   const std::size_t every = std::max<std::size_t>(1, measurements.size() / 100);
   const auto start = Clock::now();
-  auto est = makeEstimator(model, options);
-  std::size_t next_input = 0;
+  std::unique_ptr<Estimator> est;
+  std::size_t first = 0, next_input = 0;
+  std::uint64_t data_hash = internal::kFnv1a64Basis;
+  double seconds_before = 0;
+  if (!checkpoints.resume_from.empty()) {
+    CheckpointInfo info;
+    est = restoreCheckpoint(model, checkpoints.resume_from, &info);
+    std::uint64_t fingerprint = 0;
+    out = decodeRun(info.user_data, checkpoints.resume_from, first, next_input, fingerprint);
+    const auto fail = [&](const std::string& why) {
+      throw CheckpointError(checkpoints.resume_from + ": cannot resume this run: " + why);
+    };
+    if (info.method != options.method || out.method != options.method)
+      fail("it was written by method '" + info.method + "', this run is '" + options.method + "'");
+    if (est->options().window != options.window && options.method != "ekf" && options.method != "incremental")
+      fail("it was written with window " + std::to_string(est->options().window) + ", this run asks for " +
+           std::to_string(options.window));
+    if (first <= measurements.size())
+      for (std::size_t i = 0; i < first; ++i) data_hash = foldMeasurement(data_hash, measurements[i]);
+    if (first > measurements.size() || next_input > inputs.size() || data_hash != fingerprint)
+      fail("its first " + std::to_string(first) + " measurements differ from this dataset's (another dataset?)");
+    seconds_before = out.total_seconds;
+  } else {
+    est = makeEstimator(model, options);
+  }
   out.rows.reserve(measurements.size());
   out.update_seconds.reserve(measurements.size());
-  for (const auto& m : measurements) {
+  for (std::size_t i = first; i < measurements.size(); ++i) {
+    const Measurement& m = measurements[i];
     for (; next_input < inputs.size() && inputs[next_input].t < m.t; ++next_input)
       est->addInput(std::max(inputs[next_input].t, est->time()), inputs[next_input].u);
     const auto t0 = Clock::now();
     est->addMeasurement(m.t, m.y);
     out.update_seconds.push_back(since(t0));
+    data_hash = foldMeasurement(data_hash, m);
     if (options.compute_nis) out.nis.push_back(est->report().nis);
     const StateEstimate e = est->current();
     out.rows.push_back({e.t, e.mean, e.covariance});
     out.iterations = std::max(out.iterations, est->report().iterations);
     if (progress && (out.rows.size() % every == 0 || out.rows.size() == measurements.size()))
       progress(out.rows.size(), measurements.size());
+    if (!checkpoints.path.empty() && (i + 1) % checkpoints.every == 0) {
+      out.total_seconds = seconds_before + since(start);
+      saveCheckpoint(*est, checkpoints.path,
+                     encodeRun(out, i + 1, next_input, data_hash));
+    }
   }
-  out.total_seconds = since(start);
+  out.total_seconds = seconds_before + since(start);
   out.summary = est->report().detail;
   return out;
 }

@@ -49,7 +49,8 @@ std::string BatchSolverSummary::toString() const {
 // The linearized system of one graph: variable offsets, per-factor block
 // offsets into the triplet list, and the factorization.
 struct BatchSolver::Impl {
-  std::map<Key, Eigen::Index> offset;    // column of each variable
+  Values layout;                         // the variables (keys; values unused) in column order
+  std::vector<Eigen::Index> offset;      // first column of each, by Values position; then n
   std::vector<Key> keys_by_column;       // for error messages
   std::vector<Eigen::Index> dims_by_column;
   Eigen::Index n = 0;
@@ -61,17 +62,21 @@ struct BatchSolver::Impl {
 
   void setup(const FactorGraph& graph, const Values& values) {
     offset.clear();
+    layout = Values();
+    layout.reserve(values.size());
     keys_by_column.clear();
     dims_by_column.clear();
     n = 0;
     for (const auto& kv : values) {  // std::map order: states by step, constants last
-      offset[kv.first] = n;
+      offset.push_back(n);
+      layout.insert(kv.first, Eigen::VectorXd());
       for (Eigen::Index i = 0; i < kv.second.size(); ++i) {
         keys_by_column.push_back(kv.first);
         dims_by_column.push_back(i);
       }
       n += kv.second.size();
     }
+    offset.push_back(n);
     std::size_t nnz = 0;
     for (const auto& f : graph) {
       Eigen::Index d = 0;
@@ -105,7 +110,7 @@ struct BatchSolver::Impl {
       cost += 0.5 * r.squaredNorm();
       const auto& keys = f->keys();
       offs.resize(keys.size());
-      for (std::size_t a = 0; a < keys.size(); ++a) offs[a] = offset.at(keys[a]);
+      for (std::size_t a = 0; a < keys.size(); ++a) offs[a] = offset[x.indexOf(keys[a])];
       for (std::size_t a = 0; a < keys.size(); ++a) {
         g.segment(offs[a], J[a].cols()) += J[a].transpose() * r;
         for (std::size_t b = 0; b < keys.size(); ++b) {
@@ -229,7 +234,10 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     }
     delta = -s.chol.solve(g);
     Eigen::VectorXd xflat(s.n);
-    for (const auto& kv : x) xflat.segment(s.offset.at(kv.first), kv.second.size()) = kv.second;
+    {
+      std::size_t i = 0;
+      for (const auto& kv : x) xflat.segment(s.offset[i++], kv.second.size()) = kv.second;
+    }
     if (delta.norm() <= options_.step_tolerance * (xflat.norm() + options_.step_tolerance)) {
       if (polishing) {  // a tiny undamped step is still the exact correction: take it
         applyStep(x, delta, candidate);
@@ -306,12 +314,11 @@ Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& key
   std::vector<Eigen::Index> offs, dims;
   Eigen::Index m = 0;
   for (const auto& k : keys) {
-    auto it = s.offset.find(k);
-    if (it == s.offset.end())
+    if (!s.layout.contains(k))
       throw InvalidArgument("BatchSolver: " + k.toString() + " is not a variable of the last solve");
-    offs.push_back(it->second);
-    const auto next = std::next(it);
-    dims.push_back((next == s.offset.end() ? s.n : next->second) - it->second);
+    const std::size_t i = s.layout.indexOf(k);
+    offs.push_back(s.offset[i]);
+    dims.push_back(s.offset[i + 1] - s.offset[i]);
     m += dims.back();
   }
   Eigen::MatrixXd out(m, m);

@@ -12,12 +12,20 @@
 // relinearizing one factor changes only that factor's rows.
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "gssm/factors.h"
 
+namespace gssm {
+class Model;
+}
+
 namespace gssm::internal {
+
+class ByteWriter;
+class ByteReader;
 
 /// Whitened linear factor in δ coordinates: r(δ) = Σ_i A_i δ_{keys[i]} − b.
 struct LinearFactor {
@@ -103,6 +111,16 @@ class BayesTreeEngine {
   /// ½‖r‖² of every alive factor at the current estimate (nonlinear factors
   /// exactly, linear ones by their linear model).
   double cost() const;
+
+  /// Checkpoint: the whole engine (variables, factor slots with their
+  /// linearizations, cliques, free lists, counters), so a restored engine
+  /// continues with the same bits. load() validates every index and
+  /// dimension (throws CheckpointError) and replaces *this only on success.
+  void save(ByteWriter& out) const;
+  void load(ByteReader& in, const Model& model);
+  /// Empty when the tree is consistent (indices in range, dimensions agree,
+  /// parent/child links and ownership match, no cycles); else the first problem.
+  std::string invariantViolation() const;
 
  private:
   struct Var {

@@ -15,6 +15,9 @@ class SmootherCore {
   /// the add; a failed relinearization is skipped and noted in the report.
   UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values);
   void fillSizes(UpdateReport& r) const;
+  /// Checkpoint: the engine, the last report and the relinearization state.
+  void save(internal::ByteWriter& out) const;
+  void load(internal::ByteReader& in, const Model& model);
 
   internal::BayesTreeEngine engine;
   SmootherOptions options;

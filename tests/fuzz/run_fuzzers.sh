@@ -1,21 +1,19 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets with clang (+ASan/UBSan) from the io sources
-# only, and runs each for SECONDS (default 30) on a copy of the seed corpus.
-# Longer by hand: tests/fuzz/run_fuzzers.sh 600
+# Runs the libFuzzer targets built by a -DGSSM_FUZZ=ON build (clang,
+# ASan + UBSan) for SECONDS each on a copy of the seed corpus; fails on the
+# first crash, leak or sanitizer report, showing the log's tail.
+#   tests/fuzz/run_fuzzers.sh SECONDS BUILD_DIR      (longer by hand: 600)
 set -euo pipefail
 secs="${1:-30}"
 src="$(cd "$(dirname "$0")/../.." && pwd)"
-out="${2:-$src/build-fuzz}"
-mkdir -p "$out"
-flags=(-std=c++17 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
-       -I"$src/include" -isystem /usr/include/eigen3)
-for t in csv ini; do
-  clang++ "${flags[@]}" "$src/tests/fuzz/fuzz_$t.cpp" "$src/src/io/csv.cpp" "$src/src/io/ini.cpp" \
-    -o "$out/fuzz_$t"
-  rm -rf "$out/corpus-$t"; cp -r "$src/tests/fuzz/corpus/$t" "$out/corpus-$t"
+bin="${2:?build directory of a -DGSSM_FUZZ=ON build}/tests"
+for t in csv ini checkpoint; do
+  work="$bin/fuzz-$t"
+  rm -rf "$work"; mkdir -p "$work"; cp -r "$src/tests/fuzz/corpus/$t" "$work/corpus"
   echo "fuzz_$t: ${secs}s"
-  "$out/fuzz_$t" -max_total_time="$secs" -max_len=4096 -timeout=5 "$out/corpus-$t" 2> "$out/fuzz_$t.log" \
-    || { tail -40 "$out/fuzz_$t.log"; exit 1; }
-  grep -E "^#[0-9]+.*DONE|Done [0-9]+ runs" "$out/fuzz_$t.log" | tail -1
+  "$bin/fuzz_$t" -max_total_time="$secs" -max_len=16384 -timeout=10 -rss_limit_mb=4096 \
+      -artifact_prefix="$work/" "$work/corpus" 2> "$work/log" \
+    || { tail -60 "$work/log"; echo "fuzz_$t FAILED: crash input in $work/"; exit 1; }
+  grep -E "Done [0-9]+ runs" "$work/log" | tail -1
 done
 echo "fuzzers: ok"
