@@ -37,7 +37,8 @@ struct Key {
 
 struct KeyHash {
   std::size_t operator()(const Key& k) const noexcept {
-    return std::hash<std::int64_t>()(k.step * 2 + static_cast<int>(k.kind));
+    return std::hash<std::uint64_t>()(static_cast<std::uint64_t>(k.step) * 2u +
+                                      static_cast<std::uint64_t>(k.kind));
   }
 };
 

@@ -90,7 +90,7 @@ void CheckpointAccess::saveEstimator(const Estimator& e, ByteWriter& out) {
 void CheckpointAccess::loadEstimator(Estimator& e, ByteReader& in) {
   const double t = in.f64("estimator time");
   const std::int64_t k = in.i64("estimator step");
-  if (k < 0) in.fail("negative step counter " + std::to_string(k));
+  if (k < 0 || k > (std::int64_t(1) << 53)) in.fail("step counter " + std::to_string(k) + " out of range");
   Eigen::VectorXd input = in.vec("input in force");
   if (input.size() != 0 && input.size() != e.model_.dims().nu)
     in.fail("input in force has size " + std::to_string(input.size()) + ", the model's inputs " +
@@ -123,7 +123,7 @@ void CheckpointAccess::loadSmoother(Smoother& s, ByteReader& in, const Model& mo
   s.core_->load(in, model);
   if (auto* f = dynamic_cast<FixedLagSmoother*>(&s)) {
     const std::int64_t oldest = in.i64("fixed-lag oldest step"), newest = in.i64("fixed-lag newest step");
-    if (oldest < -1 || newest < oldest || newest - oldest >= f->options_.window ||
+    if (oldest < -1 || newest < oldest || newest > (std::int64_t(1) << 53) || newest - oldest >= f->options_.window ||
         (oldest >= 0 && (!s.contains(Key::state(oldest)) || !s.contains(Key::state(newest)))))
       in.fail("fixed-lag window [" + std::to_string(oldest) + ", " + std::to_string(newest) +
               "] does not match its variables or window " + std::to_string(f->options_.window));

@@ -10,6 +10,8 @@ namespace {
 // Largest dimension of one stored matrix side: far above any GSSM block,
 // small enough that rows × cols × 8 cannot overflow.
 constexpr std::int64_t kMaxDim = 1 << 20;
+// Steps beyond this are corruption (and k + 1 must not overflow).
+constexpr std::int64_t kMaxStep = std::int64_t(1) << 53;
 }  // namespace
 
 std::uint64_t fnv1a64(const char* data, std::size_t n, std::uint64_t h) {
@@ -133,7 +135,7 @@ Key ByteReader::key(const std::string& what) {
   const std::int64_t step = i64(what.c_str());
   if (kind > 1) fail(what + ": unknown variable kind " + std::to_string(kind));
   if (kind == 1 && step != 0) fail(what + ": the constants carry step 0, found " + std::to_string(step));
-  if (kind == 0 && step < 0) fail(what + ": negative step " + std::to_string(step));
+  if (kind == 0 && (step < 0 || step > kMaxStep)) fail(what + ": step " + std::to_string(step) + " out of range");
   return kind == 1 ? Key::constants() : Key::state(step);
 }
 std::vector<Key> ByteReader::keys(const std::string& what) {

@@ -52,14 +52,14 @@ FactorPtr readFactor(ByteReader& in, const Model& model, const std::string& what
     }
     case FactorTag::Process: {
       const std::int64_t k = in.i64((what + " step").c_str());
-      if (k < 0) in.fail(what + ": negative step " + std::to_string(k));
+      if (k < 0 || k >= (std::int64_t(1) << 53)) in.fail(what + ": step " + std::to_string(k) + " out of range");
       const Eigen::VectorXd u = in.vec(what + " input");
       const double dt = in.f64(what + " dt");
       return std::make_shared<ProcessFactor>(model, k, u, dt);
     }
     case FactorTag::Measurement: {
       const std::int64_t k = in.i64((what + " step").c_str());
-      if (k < 0) in.fail(what + ": negative step " + std::to_string(k));
+      if (k < 0 || k >= (std::int64_t(1) << 53)) in.fail(what + ": step " + std::to_string(k) + " out of range");
       const Eigen::VectorXd y = in.vec(what + " measurement");
       const Eigen::MatrixXd R = in.mat(what + " noise covariance");
       if (R.rows() != model.dims().ny || R.cols() != model.dims().ny)

@@ -439,6 +439,7 @@ class PaperWindowEstimator final : public Estimator {
     Gaussian ps = in.gaussian("prior on the oldest state"), pb = in.gaussian("prior on the constants");
     const std::int64_t oldest = in.i64("oldest step");
     const bool nb = model_.dims().nb > 0;
+    if (oldest < 0 || oldest > step()) in.fail("oldest window step " + std::to_string(oldest) + " out of range");
     const std::int64_t held = step() - oldest + 1;
     bool ok = oldest >= 0 && held >= 1 && held <= window_ && static_cast<std::int64_t>(times.size()) == held &&
               static_cast<std::int64_t>(steps.size()) == held - 1 && sameTime(times.back(), time()) &&
