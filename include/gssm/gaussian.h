@@ -33,6 +33,7 @@ class GaussianNoise {
  private:
   Eigen::MatrixXd covariance_;
   Eigen::MatrixXd L_;
+  bool diagonal_ = true;
 };
 
 /// A Gaussian density N(mean, covariance) on one variable.

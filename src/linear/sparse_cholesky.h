@@ -50,6 +50,10 @@ class SparseCholesky {
   cholmod_common common_;
   cholmod_triplet* triplet_ = nullptr;
   cholmod_factor* factor_ = nullptr;
+  // H in compressed columns, assembled from the triplets once per pattern;
+  // later factorizations refill its values through slot_ (entry → position).
+  cholmod_sparse* matrix_ = nullptr;
+  std::vector<int> slot_;
   Eigen::Index n_ = 0;
   std::size_t count_ = 0;
 };

@@ -1,6 +1,7 @@
 #include "gssm/batch_solver.h"
 
 #include <chrono>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -91,22 +92,30 @@ struct BatchSolver::Impl {
     chol.reset(n, nnz + static_cast<std::size_t>(n));
   }
 
+  // Jacobian buffers per factor shape (number of keys, residual size), so
+  // alternating process and measurement factors reuse their storage.
+  std::map<std::pair<std::size_t, int>, std::vector<Eigen::MatrixXd>> jacobians;
+
   // Linearizes every factor at x: fills the triplet values of H = JᵀJ (+ the
   // damping diagonal, zero here), the gradient g = Jᵀr and returns the cost.
+  // A non-finite residual throws, or with `trial` (an LM candidate) returns
+  // +∞, leaving the triplets to be refilled at the previous point.
   double linearize(const FactorGraph& graph, const Values& x, Eigen::VectorXd& g,
-                   Eigen::VectorXd& diag, bool first) {
+                   Eigen::VectorXd& diag, bool first, bool trial = false) {
     g.setZero(n);
     diag.setZero(n);
     double cost = 0;
     std::size_t e = 0;
     Eigen::VectorXd r;
-    std::vector<Eigen::MatrixXd> J;
     std::vector<Eigen::Index> offs;
     for (const auto& f : graph) {
+      std::vector<Eigen::MatrixXd>& J = jacobians[{f->keys().size(), f->dim()}];
       f->linearize(x, r, &J);
-      if (!r.allFinite())
+      if (!r.allFinite()) {
+        if (trial) return std::numeric_limits<double>::infinity();
         throw NumericalError("BatchSolver: factor '" + f->describe() +
                              "' has a non-finite residual at the current estimate");
+      }
       cost += 0.5 * r.squaredNorm();
       const auto& keys = f->keys();
       offs.resize(keys.size());
@@ -178,7 +187,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   sum.dimension = s.n;
 
   Values x = values;
-  Eigen::VectorXd g, diag;
+  Eigen::VectorXd g, diag, g_new, diag_new;
   double cost = s.linearize(graph, x, g, diag, true);
   sum.initial_cost = cost;
   const bool lm = options_.method == BatchSolverOptions::Method::LevenbergMarquardt;
@@ -248,12 +257,18 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       continue;
     }
     applyStep(x, delta, candidate);
-    const double new_cost = graph.cost(candidate);
+    // Linearize at the candidate right away (its cost comes with it): one
+    // pass over the factors per accepted step instead of two; a rejected
+    // step refills H at x.
+    const double new_cost = s.linearize(graph, candidate, g_new, diag_new, false, true);
+    if (!std::isfinite(new_cost) && !lm)  // Gauss–Newton cannot back off: say which factor
+      s.linearize(graph, candidate, g_new, diag_new, false);
     // Near the minimum the cost change (∝ ‖δ‖²) is below rounding, so an
     // undamped polish step is kept unless it makes the cost clearly worse.
     const bool accept = polishing ? (lm ? new_cost <= cost * (1 + 1e-10) : true) : new_cost < cost;
     if (!accept) {
       ++sum.rejected_steps;
+      cost = s.linearize(graph, x, g, diag, false);
       if (polishing) {  // the damped solution was already converged
         sum.termination = T::CostConverged;
         break;
@@ -267,8 +282,10 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     }
     ++sum.iterations;
     std::swap(x, candidate);
+    std::swap(g, g_new);
+    std::swap(diag, diag_new);
     const double old_cost = cost;
-    cost = s.linearize(graph, x, g, diag, false);
+    cost = new_cost;
     if (!polishing) lambda = std::max(lambda / 10, 1e-12);
     if (g.lpNorm<Eigen::Infinity>() <= options_.gradient_tolerance) {
       if (converge(T::GradientConverged)) break;
