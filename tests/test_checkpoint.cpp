@@ -117,6 +117,7 @@ TEST(Checkpoint, IteratedIncrementalAndNisContinueBitIdentically) {
   o.compute_nis = true;
   o.smoother.iterate_to_convergence = true;
   o.smoother.max_iterations = 200;
+  o.smoother.newton_polish_steps = 3;
   expectBitIdenticalContinuation(radar, o, events, {3, 12});
 }
 

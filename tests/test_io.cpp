@@ -110,10 +110,14 @@ TEST(Config, EstimatorSectionsAreReadAndChecked) {
   ini.set("smoother", "ordering", "time");
   ini.set("smoother", "relinearize_threshold", 0.5);
   ini.set("fixed_lag", "window", "25");
+  ini.set("smoother", "iterate_to_convergence", "true");
+  ini.set("smoother", "newton_polish_steps", "4");
   const auto parsed = IniDocument::parse(ini.toString(), "s.ini");
   const SmootherOptions o = smootherOptions(parsed);
   EXPECT_EQ(o.ordering, EliminationOrdering::TimeOrdered);
   EXPECT_EQ(o.relinearize_threshold, 0.5);
+  EXPECT_TRUE(o.iterate_to_convergence);
+  EXPECT_EQ(o.newton_polish_steps, 4);
   EXPECT_EQ(windowOption(parsed, "fixed_lag", 10), 25);
   EXPECT_EQ(windowOption(parsed, "paper_window", 10), 10);
   ini.set("smoother", "wildfire", "1");

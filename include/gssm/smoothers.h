@@ -84,6 +84,10 @@ struct SmootherOptions {
   /// (|Δx_i| ≤ tol·(1 + |x_i|)), between two iterations.
   double convergence_tolerance = 1e-11;
   int max_iterations = 5000;
+  /// With iterate_to_convergence: up to this many full Newton steps after
+  /// the iteration converged (see BatchSolverOptions::newton_polish_steps),
+  /// each followed by a re-elimination at the new point. 0 = off.
+  int newton_polish_steps = 0;
   bool validate(std::string* why = nullptr) const;
 };
 

@@ -19,6 +19,7 @@ void CheckpointAccess::writeOptions(ByteWriter& out, const EstimatorOptions& o) 
   out.boolean(s.iterate_to_convergence);
   out.f64(s.convergence_tolerance);
   out.i32(s.max_iterations);
+  out.i32(s.newton_polish_steps);
   out.f64(o.t0);
   out.boolean(o.compute_nis);
 }
@@ -41,6 +42,7 @@ EstimatorOptions CheckpointAccess::readOptions(ByteReader& in) {
   s.iterate_to_convergence = in.boolean("smoother iterate_to_convergence");
   s.convergence_tolerance = in.f64("smoother convergence_tolerance");
   s.max_iterations = in.i32("smoother max_iterations");
+  s.newton_polish_steps = in.i32("smoother newton_polish_steps");
   o.t0 = in.f64("t0");
   o.compute_nis = in.boolean("compute_nis");
   return o;

@@ -131,7 +131,9 @@ ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& mode
 
 SmootherOptions smootherOptions(const IniDocument& ini) {
   ini.requireOnlyKeys("smoother", {"relinearize", "relinearize_threshold", "constants_check_sigmas",
-                                   "max_local_iterations", "wildfire_threshold", "ordering"});
+                                   "max_local_iterations", "wildfire_threshold", "ordering",
+                                   "iterate_to_convergence", "convergence_tolerance", "max_iterations",
+                                   "newton_polish_steps"});
   SmootherOptions o;
   o.relinearize = ini.getBool("smoother", "relinearize", o.relinearize);
   o.relinearize_threshold = ini.getDouble("smoother", "relinearize_threshold", o.relinearize_threshold);
@@ -139,6 +141,10 @@ SmootherOptions smootherOptions(const IniDocument& ini) {
   o.max_local_iterations =
       static_cast<int>(ini.getInt("smoother", "max_local_iterations", o.max_local_iterations));
   o.wildfire_threshold = ini.getDouble("smoother", "wildfire_threshold", o.wildfire_threshold);
+  o.iterate_to_convergence = ini.getBool("smoother", "iterate_to_convergence", o.iterate_to_convergence);
+  o.convergence_tolerance = ini.getDouble("smoother", "convergence_tolerance", o.convergence_tolerance);
+  o.max_iterations = static_cast<int>(ini.getInt("smoother", "max_iterations", o.max_iterations));
+  o.newton_polish_steps = static_cast<int>(ini.getInt("smoother", "newton_polish_steps", o.newton_polish_steps));
   const std::string ordering = ini.getString("smoother", "ordering", "colamd");
   if (ordering != "colamd" && ordering != "time")
     throw InputError(ini.source() + ": [smoother] ordering = '" + ordering + "': expected colamd or time");

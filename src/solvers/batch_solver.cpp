@@ -8,6 +8,7 @@
 
 #include "gssm/error.h"
 #include "linear/sparse_cholesky.h"
+#include "solvers/newton.h"
 
 namespace gssm {
 
@@ -22,6 +23,7 @@ bool BatchSolverOptions::validate(std::string* why) const {
   if (!(gradient_tolerance >= 0)) return fail("gradient_tolerance must be >= 0");
   if (!(initial_lambda > 0)) return fail("initial_lambda must be > 0");
   if (!(max_lambda > initial_lambda)) return fail("max_lambda must exceed initial_lambda");
+  if (newton_polish_steps < 0) return fail("newton_polish_steps must be >= 0");
   return true;
 }
 
@@ -40,8 +42,8 @@ const char* toString(BatchSolverSummary::Termination t) {
 std::string BatchSolverSummary::toString() const {
   std::ostringstream os;
   os << "BatchSolver: " << gssm::toString(termination) << " after " << iterations
-     << " iterations (" << rejected_steps << " rejected, " << factorizations
-     << " factorizations), cost " << initial_cost << " -> " << final_cost
+     << " iterations (" << rejected_steps << " rejected, " << factorizations << " factorizations"
+     << (newton_steps ? ", " + std::to_string(newton_steps) + " Newton" : std::string()) << "), cost " << initial_cost << " -> " << final_cost
      << ", max|gradient| " << gradient_norm << ", " << num_variables << " variables / "
      << num_factors << " factors / dim " << dimension << ", " << seconds << " s";
   return os.str();
@@ -292,6 +294,32 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     } else if (old_cost - cost <= options_.relative_cost_tolerance * old_cost) {
       if (converge(T::CostConverged)) break;
     }
+  }
+  const bool converged = sum.termination == T::CostConverged || sum.termination == T::StepConverged ||
+                         sum.termination == T::GradientConverged;
+  if (converged && options_.newton_polish_steps > 0) {
+    for (int it = 0; it < options_.newton_polish_steps; ++it) {
+      internal::NewtonSystem sys(x);
+      Eigen::VectorXd r;
+      std::vector<Eigen::MatrixXd> J;
+      for (const auto& f : graph) {
+        f->linearize(x, r, &J);
+        const Eigen::MatrixXd C = internal::residualCurvature(*f, x, r);
+        sys.add(f->keys(), r, J, &C);
+      }
+      Eigen::VectorXd d;
+      if (!sys.solve(d)) break;  // not near a minimum: keep the LM answer
+      Values xn = internal::addStep(x, d);
+      const double c = graph.cost(xn);
+      if (!(c <= cost * (1 + 1e-10))) break;
+      x = std::move(xn);
+      cost = c;
+      ++sum.newton_steps;
+      double xnorm = 0;
+      for (const auto& kv : x) xnorm += kv.second.squaredNorm();
+      if (d.norm() <= options_.step_tolerance * (std::sqrt(xnorm) + options_.step_tolerance)) break;
+    }
+    if (sum.newton_steps > 0) cost = s.linearize(graph, x, g, diag, false);  // JᵀJ at the solution
   }
   // Factor the undamped information matrix at the solution: it gives the
   // marginal covariances and tells whether the solution is determined.

@@ -9,6 +9,7 @@
 #include <unordered_set>
 
 #include "gssm/error.h"
+#include "solvers/newton.h"
 
 namespace gssm::internal {
 
@@ -569,6 +570,23 @@ double BayesTreeEngine::cost() const {
     }
   }
   return c;
+}
+
+void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
+  Eigen::VectorXd r;
+  std::vector<Eigen::MatrixXd> J;
+  for (const auto& s : slots_) {
+    if (!s.alive) continue;
+    if (s.nonlinear) {
+      s.nonlinear->linearize(x, r, &J);
+      const Eigen::MatrixXd C = residualCurvature(*s.nonlinear, x, r);
+      sys.add(s.nonlinear->keys(), r, J, &C);
+    } else {  // r = Σ A δ − b in δ coordinates: J = A, no curvature
+      r = -s.linear.b;
+      for (std::size_t i = 0; i < s.linear.keys.size(); ++i) r += s.linear.A[i] * vars_.at(s.linear.keys[i]).delta;
+      sys.add(s.linear.keys, r, s.linear.A, nullptr);
+    }
+  }
 }
 
 void BayesTreeEngine::marginalizeLeaf(const Key& key) {

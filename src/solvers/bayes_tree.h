@@ -26,6 +26,7 @@ namespace gssm::internal {
 
 class ByteWriter;
 class ByteReader;
+class NewtonSystem;
 
 /// Whitened linear factor in δ coordinates: r(δ) = Σ_i A_i δ_{keys[i]} − b.
 struct LinearFactor {
@@ -111,6 +112,10 @@ class BayesTreeEngine {
   /// ½‖r‖² of every alive factor at the current estimate (nonlinear factors
   /// exactly, linear ones by their linear model).
   double cost() const;
+  /// Adds every alive factor to a full Newton system at the current
+  /// estimate `x` (= allEstimates()): nonlinear factors with their
+  /// second-order terms, linear ones as they are.
+  void addToNewton(NewtonSystem& sys, const Values& x) const;
 
   /// Checkpoint: the whole engine (variables, factor slots with their
   /// linearizations, cliques, free lists, counters), so a restored engine

@@ -4,6 +4,7 @@
 
 #include "gssm/error.h"
 #include "gssm/smoothers.h"
+#include "solvers/newton.h"
 #include "solvers/smoother_core.h"
 
 namespace gssm {
@@ -32,6 +33,7 @@ bool SmootherOptions::validate(std::string* why) const {
   if (!(wildfire_threshold >= 0)) return fail("wildfire_threshold must be >= 0");
   if (!(convergence_tolerance > 0)) return fail("convergence_tolerance must be > 0");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
+  if (newton_polish_steps < 0) return fail("newton_polish_steps must be >= 0");
   return true;
 }
 
@@ -138,6 +140,39 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
       if (polishing) break;
       polishing = true;
     }
+  }
+  // Newton polish: quadratic convergence where the iteration above crawls.
+  for (int it = 0; it < options.newton_polish_steps; ++it) {
+    const Values x = engine.allEstimates();
+    internal::NewtonSystem sys(x);
+    engine.addToNewton(sys, x);
+    Eigen::VectorXd d;
+    if (!sys.solve(d)) {
+      rep.note = "Newton polish skipped: the Hessian is not positive definite here";
+      break;
+    }
+    internal::BayesTreeEngine snapshot = engine;
+    internal::EngineCounts trial = counts;
+    try {
+      engine.setEstimates(internal::addStep(x, d));
+      engine.update(Values{}, {}, {}, engine.nonlinearSlots(), trial, 0.0);  // the tree at the new point
+    } catch (const NumericalError& e) {
+      engine = std::move(snapshot);
+      rep.note = std::string("Newton polish stopped: ") + e.what();
+      break;
+    }
+    trial.variables_backsubstituted += engine.solveAll();
+    const double cost = engine.cost();
+    if (!(cost <= previous_cost * (1 + 1e-10))) {
+      engine = std::move(snapshot);
+      break;
+    }
+    counts = trial;
+    ++rep.iterations;
+    Values now = engine.allEstimates();
+    const double change = relChange(now, x);
+    previous_cost = cost;
+    if (change <= options.convergence_tolerance) break;
   }
 }
 

@@ -1,0 +1,84 @@
+#include "solvers/newton.h"
+
+#include <cmath>
+
+namespace gssm::internal {
+
+Eigen::MatrixXd residualCurvature(const Factor& f, const Values& x, const Eigen::VectorXd& r) {
+  const auto& keys = f.keys();
+  std::vector<Eigen::Index> off(keys.size() + 1, 0);
+  for (std::size_t a = 0; a < keys.size(); ++a) off[a + 1] = off[a] + x.at(keys[a]).size();
+  const Eigen::Index n = off.back();
+  Eigen::MatrixXd C(n, n);
+  Values xp = x;  // only the factor's keys are read; a copy keeps x untouched
+  Eigen::VectorXd rp;
+  std::vector<Eigen::MatrixXd> Jp, Jm;
+  auto JTr = [&](const std::vector<Eigen::MatrixXd>& J) {
+    Eigen::VectorXd out(n);
+    for (std::size_t a = 0; a < keys.size(); ++a) out.segment(off[a], off[a + 1] - off[a]) = J[a].transpose() * r;
+    return out;
+  };
+  for (std::size_t a = 0; a < keys.size(); ++a) {
+    Eigen::VectorXd& v = xp.at(keys[a]);
+    for (Eigen::Index i = 0; i < v.size(); ++i) {
+      const double v0 = v[i];
+      const double h = 1e-5 * std::max(1.0, std::abs(v0));  // ~ε^(1/3): central-difference optimum
+      v[i] = v0 + h;
+      f.linearize(xp, rp, &Jp);
+      v[i] = v0 - h;
+      f.linearize(xp, rp, &Jm);
+      v[i] = v0;
+      C.col(off[a] + i) = (JTr(Jp) - JTr(Jm)) / (2 * h);
+    }
+  }
+  return 0.5 * (C + C.transpose());
+}
+
+NewtonSystem::NewtonSystem(const Values& layout) : layout_(layout) {
+  Eigen::Index n = 0;
+  for (const auto& kv : layout) {
+    offset_.push_back(n);
+    n += kv.second.size();
+  }
+  offset_.push_back(n);
+  g_ = Eigen::VectorXd::Zero(n);
+  chol_.reset(n, static_cast<std::size_t>(4 * n + 16));
+}
+
+void NewtonSystem::add(const std::vector<Key>& keys, const Eigen::VectorXd& r,
+                       const std::vector<Eigen::MatrixXd>& J, const Eigen::MatrixXd* curvature) {
+  std::vector<Eigen::Index> col(keys.size()), local(keys.size() + 1, 0);
+  for (std::size_t a = 0; a < keys.size(); ++a) {
+    col[a] = offset_[layout_.indexOf(keys[a])];
+    local[a + 1] = local[a] + J[a].cols();
+    g_.segment(col[a], J[a].cols()) += J[a].transpose() * r;
+  }
+  for (std::size_t a = 0; a < keys.size(); ++a)
+    for (std::size_t b = 0; b < keys.size(); ++b)
+      for (Eigen::Index i = 0; i < J[a].cols(); ++i)
+        for (Eigen::Index j = 0; j < J[b].cols(); ++j) {
+          const Eigen::Index gi = col[a] + i, gj = col[b] + j;
+          if (gi > gj) continue;  // upper triangle; duplicates are summed
+          double v = J[a].col(i).dot(J[b].col(j));
+          if (curvature) v += (*curvature)(local[a] + i, local[b] + j);
+          chol_.add(gi, gj, v);
+        }
+}
+
+bool NewtonSystem::solve(Eigen::VectorXd& delta) {
+  if (chol_.factorize() >= 0) return false;
+  delta = -chol_.solve(g_);
+  return delta.allFinite();
+}
+
+Values addStep(const Values& x, const Eigen::VectorXd& delta) {
+  Values out = x;
+  Eigen::Index off = 0;
+  for (auto& kv : out) {
+    kv.second += delta.segment(off, kv.second.size());
+    off += kv.second.size();
+  }
+  return out;
+}
+
+}  // namespace gssm::internal
