@@ -88,7 +88,9 @@ class Estimator {
   /// the method holds them all (EKF: the newest state and the constants).
   virtual std::optional<Eigen::MatrixXd> marginalCovariance(const std::vector<Key>& keys) = 0;
 
-  const EstimatorReport& report() const { return report_; }
+  /// The last call's report; its `detail` line is formatted here, on demand
+  /// (formatting it on every update cost 10% of a fixed-lag update).
+  const EstimatorReport& report() const;
   double time() const { return t_; }
   std::int64_t step() const { return k_; }
   const Model& model() const { return model_; }
@@ -103,9 +105,13 @@ class Estimator {
                       const Eigen::VectorXd& y) = 0;
   /// Adds a measurement at the newest state x_c(k), k ≥ 1; strongly safe.
   virtual void doMeasurement(std::int64_t k, const Eigen::VectorXd& y) = 0;
+  /// The one-line `detail` of the last update, called by report() only
+  /// after markDetail() (default: the smoother report's line).
+  virtual std::string formatDetail() const { return report_.smoother.toString(); }
+  void markDetail() { detail_stale_ = true; }
 
   const Model& model_;
-  EstimatorReport report_;
+  mutable EstimatorReport report_;
 
  private:
   friend struct internal::CheckpointAccess;
@@ -123,6 +129,7 @@ class Estimator {
   std::int64_t k_ = 0;  // its step
   Eigen::VectorXd input_;  // in force from the newest state on (empty: zeros)
   EstimatorOptions options_;
+  mutable bool detail_stale_ = false;
 };
 
 /// Builds the estimator named by options.method; the model must outlive it.

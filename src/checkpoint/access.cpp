@@ -79,7 +79,7 @@ void CheckpointAccess::saveEstimator(const Estimator& e, ByteWriter& out) {
   out.f64(e.t_);
   out.i64(e.k_);
   out.vec(e.input_);
-  const EstimatorReport& r = e.report_;
+  const EstimatorReport& r = e.report();  // formats a pending detail line
   out.i64(r.steps);
   out.f64(r.seconds);
   out.i32(r.iterations);

@@ -45,6 +45,14 @@ void Estimator::loadState(internal::ByteReader&) {
   throw CheckpointError(method() + ": this estimator does not support checkpoints");
 }
 
+const EstimatorReport& Estimator::report() const {
+  if (detail_stale_) {
+    report_.detail = formatDetail();
+    detail_stale_ = false;
+  }
+  return report_;
+}
+
 void Estimator::addInput(double t, const Eigen::VectorXd& u) {
   requireVector(u, model_.dims().nu, method() + ": input u at t = " + std::to_string(t));
   // A time stamp within rounding of the newest state's (k·T computed two
@@ -166,16 +174,22 @@ class EkfEstimator final : public Estimator {
     if (y.size()) next.update(y);
     ekf_ = std::move(next);
     report_.iterations = 1;
-    report_.detail = y.size() ? "EKF update, NIS " + std::to_string(ekf_.lastNis()) : "EKF prediction";
+    updated_ = y.size() > 0;
+    markDetail();
   }
   void doMeasurement(std::int64_t, const Eigen::VectorXd& y) override {
     ExtendedKalmanFilter next = ekf_;
     next.update(y);
     ekf_ = std::move(next);
-    report_.detail = "EKF update, NIS " + std::to_string(ekf_.lastNis());
+    updated_ = true;
+    markDetail();
   }
 
  private:
+  std::string formatDetail() const override {
+    return updated_ ? "EKF update, NIS " + std::to_string(ekf_.lastNis()) : "EKF prediction";
+  }
+  bool updated_ = false;  // the last step had a measurement
   void saveState(internal::ByteWriter& out) const override { internal::CheckpointAccess::saveEkf(ekf_, out); }
   void loadState(internal::ByteReader& in) override { internal::CheckpointAccess::loadEkf(ekf_, in); }
   ExtendedKalmanFilter ekf_;
@@ -259,14 +273,14 @@ class SmootherEstimator final : public Estimator {
     initial.insert(Key::state(k), predictState(model_, smoother_.estimate(Key::state(k - 1)), xb, u, dt, k));
     report_.smoother = smoother_.update(factors, initial);  // transactional
     report_.iterations = report_.smoother.iterations;
-    report_.detail = report_.smoother.toString();
+    markDetail();
     times_.push_back(times_.back() + dt);
     while (keep_times_ > 0 && times_.size() > keep_times_) times_.pop_front();
   }
   void doMeasurement(std::int64_t k, const Eigen::VectorXd& y) override {
     report_.smoother = smoother_.update({std::make_shared<MeasurementFactor>(model_, k, y)}, Values{});
     report_.iterations = report_.smoother.iterations;
-    report_.detail = report_.smoother.toString();
+    markDetail();
   }
 
  private:
@@ -370,7 +384,8 @@ class PaperWindowEstimator final : public Estimator {
     oldest_ = oldest;
     solver_ = std::move(solver);
     report_.iterations = sum.iterations;
-    report_.detail = sum.toString();
+    last_summary_ = sum;
+    markDetail();
   }
 
  private:
@@ -384,7 +399,8 @@ class PaperWindowEstimator final : public Estimator {
     values_ = std::move(values);
     solver_ = std::move(solver);
     report_.iterations = sum.iterations;
-    report_.detail = sum.toString();
+    last_summary_ = sum;
+    markDetail();
   }
   static BatchSolverOptions gaussNewton() {
     BatchSolverOptions o;
@@ -468,6 +484,8 @@ class PaperWindowEstimator final : public Estimator {
     return g;
   }
 
+  std::string formatDetail() const override { return last_summary_.toString(); }
+  BatchSolverSummary last_summary_;
   int window_;
   std::deque<std::vector<FactorPtr>> steps_;  // factors of each step in the window
   std::deque<double> times_;
