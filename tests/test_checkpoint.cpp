@@ -294,3 +294,21 @@ TEST(Checkpoint, CommittedVersionOneFilesStillRestore) {
     EXPECT_TRUE(est->current().mean.allFinite()) << method;
   }
 }
+
+TEST(Checkpoint, OptionsThatWouldStallAnUpdateAreRefused) {
+  // Found by the checkpoint fuzzer: a checkpoint (header repaired) whose
+  // options asked for 4194307 relinearization rounds per update restored
+  // fine and then ran for minutes. Options now have upper bounds.
+  const models::Radar2D radar;
+  std::ifstream f(std::string(GSSM_SOURCE_DIR) + "/tests/fuzz/corpus/checkpoint/regression-huge-local-iterations.ckpt",
+                  std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 28u);
+  const std::string msg = errorOf([&] { restoreCheckpointBytes(radar, withValidChecksum(bytes), "fuzz.ckpt"); });
+  EXPECT_NE(msg.find("max_local_iterations must be in [0, 100], got 4194307"), std::string::npos) << msg;
+  SmootherOptions o;
+  o.max_iterations = 100001;
+  std::string why;
+  EXPECT_FALSE(o.validate(&why));
+  EXPECT_NE(why.find("max_iterations"), std::string::npos) << why;
+}

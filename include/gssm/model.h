@@ -8,6 +8,7 @@
 //
 // The same model object drives the EKF, the batch solver and the smoothers.
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,14 @@ class Model {
   const ModelNoise& noise() const { return noise_; }
   double nominalStep() const { return noise_.T; }
   const Eigen::MatrixXd& measurementNoise() const { return noise_.R; }
+  /// R as a whitening noise model, factored once per model.
+  const GaussianNoise& measurementNoiseModel() const { return r_model_; }
+  /// Q(dt) as a noise model, factored once per distinct dt among the last
+  /// few asked for (time stamps k·T differenced give a handful of dt values
+  /// that differ in the last bits) and shared; processNoise must be a pure
+  /// function of dt. `what` names it in the error if Q(dt) is not positive
+  /// definite.
+  GaussianNoise processNoiseModel(double dt, const std::string& what) const;
   const Gaussian& priorState() const { return noise_.prior_state; }
   const Gaussian& priorConstants() const { return noise_.prior_constants; }
 
@@ -83,6 +92,9 @@ class Model {
   ModelDims dims_;
   ModelNames names_;
   ModelNoise noise_;
+  GaussianNoise r_model_;
+  struct NoiseCache;
+  std::shared_ptr<NoiseCache> q_cache_;  // shared by copies (same parameters); thread-safe
 };
 
 /// Result of comparing a model's analytic Jacobians with central differences.

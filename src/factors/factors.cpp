@@ -61,7 +61,7 @@ ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::Ve
       model_(&model),
       u_(u),
       dt_(dt),
-      noise_(model.processNoise(dt), "process noise of step " + std::to_string(k)) {
+      noise_(model.processNoiseModel(dt, "process noise of step " + std::to_string(k))) {
   if (!(dt > 0) || !std::isfinite(dt))
     throw InvalidArgument("process factor x_c(" + std::to_string(k) + ") -> x_c(" +
                           std::to_string(k + 1) + "): time step must be > 0, got " +
@@ -93,8 +93,7 @@ std::string ProcessFactor::describe() const {
 
 // ---- MeasurementFactor -------------------------------------------------------
 MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y)
-    : MeasurementFactor(model, k, y,
-                        GaussianNoise(model.measurementNoise(), "measurement noise R")) {}
+    : MeasurementFactor(model, k, y, model.measurementNoiseModel()) {}
 
 MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y,
                                      const GaussianNoise& noise)

@@ -1,5 +1,8 @@
 #include "gssm/model.h"
 
+#include <algorithm>
+#include <array>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -38,6 +41,8 @@ Model::Model(ModelDims dims, ModelNames names, ModelNoise noise)
                           std::to_string(noise_.T));
   requireCovariance(noise_.Q, dims_.nc, "model: process noise Q");
   requireCovariance(noise_.R, dims_.ny, "model: measurement noise R");
+  r_model_ = GaussianNoise(noise_.R, "model: measurement noise R");
+  q_cache_ = std::make_shared<NoiseCache>();
   requireVector(noise_.prior_state.mean, dims_.nc, "model: prior mean of x_c(0)");
   requireCovariance(noise_.prior_state.covariance, dims_.nc, "model: prior covariance of x_c(0)");
   requireVector(noise_.prior_constants.mean, dims_.nb, "model: prior mean of x_b");
@@ -47,6 +52,27 @@ Model::Model(ModelDims dims, ModelNames names, ModelNoise noise)
 }
 
 Eigen::MatrixXd Model::processNoise(double dt) const { return noise_.Q * (dt / noise_.T); }
+
+struct Model::NoiseCache {
+  std::mutex mutex;
+  std::array<std::pair<double, GaussianNoise>, 8> entries;
+  std::size_t used = 0, next = 0;
+};
+
+GaussianNoise Model::processNoiseModel(double dt, const std::string& what) const {
+  NoiseCache& c = *q_cache_;
+  {
+    std::lock_guard<std::mutex> lock(c.mutex);
+    for (std::size_t i = 0; i < c.used; ++i)
+      if (c.entries[i].first == dt) return c.entries[i].second;
+  }
+  GaussianNoise q(processNoise(dt), what);  // may throw: nothing cached
+  std::lock_guard<std::mutex> lock(c.mutex);
+  c.entries[c.next] = {dt, q};
+  c.next = (c.next + 1) % c.entries.size();
+  c.used = std::max(c.used, c.next == 0 ? c.entries.size() : c.next);
+  return q;
+}
 
 std::vector<std::string> Model::stackedStateNames() const {
   std::vector<std::string> out = names_.state;

@@ -29,11 +29,16 @@ bool SmootherOptions::validate(std::string* why) const {
   };
   if (!(relinearize_threshold > 0)) return fail("relinearize_threshold must be > 0");
   if (!(constants_check_sigmas > 0)) return fail("constants_check_sigmas must be > 0");
-  if (max_local_iterations < 0) return fail("max_local_iterations must be >= 0");
+  // Upper bounds: values beyond them only make an update run for minutes
+  // (a checkpoint fuzzer found max_local_iterations = 4194307).
+  if (max_local_iterations < 0 || max_local_iterations > 100)
+    return fail("max_local_iterations must be in [0, 100], got " + std::to_string(max_local_iterations));
   if (!(wildfire_threshold >= 0)) return fail("wildfire_threshold must be >= 0");
   if (!(convergence_tolerance > 0)) return fail("convergence_tolerance must be > 0");
-  if (max_iterations < 1) return fail("max_iterations must be >= 1");
-  if (newton_polish_steps < 0) return fail("newton_polish_steps must be >= 0");
+  if (max_iterations < 1 || max_iterations > 100000)
+    return fail("max_iterations must be in [1, 100000], got " + std::to_string(max_iterations));
+  if (newton_polish_steps < 0 || newton_polish_steps > 100)
+    return fail("newton_polish_steps must be in [0, 100], got " + std::to_string(newton_polish_steps));
   return true;
 }
 
