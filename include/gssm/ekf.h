@@ -8,15 +8,10 @@
 
 #include <vector>
 
+#include "gssm/checkpoint_fwd.h"
 #include "gssm/data.h"
 #include "gssm/model.h"
 #include "gssm/values.h"
-
-namespace gssm::internal {
-struct CheckpointAccess;
-class ByteWriter;
-class ByteReader;
-}  // namespace gssm::internal
 
 namespace gssm {
 

@@ -12,6 +12,8 @@
 // Every call has the strong exception guarantee: one that throws (wrong
 // dimension, NaN, time not increasing, a singular system) leaves the
 // estimator exactly as it was, and the message names the input at fault.
+// An estimator is not thread-safe: use each from one thread at a time (even
+// report() formats its detail line lazily).
 #include <Eigen/Core>
 #include <limits>
 #include <memory>

@@ -16,13 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "gssm/checkpoint_fwd.h"
 #include "gssm/factors.h"
-
-namespace gssm::internal {
-struct CheckpointAccess;
-class ByteWriter;
-class ByteReader;
-}  // namespace gssm::internal
 
 namespace gssm {
 
