@@ -4,75 +4,104 @@
 
 namespace gssm::internal {
 
+namespace {
+// One field list per record, visited by a writer or a reader, so the two
+// directions cannot drift apart.
+struct FieldWriter {
+  ByteWriter& out;
+  void operator()(const double& v, const char*, bool = false) { out.f64(v); }
+  void operator()(const int& v, const char*) { out.i32(v); }
+  void operator()(const bool& v, const char*) { out.boolean(v); }
+  void operator()(const std::size_t& v, const char*) { out.u64(v); }
+  void operator()(const std::string& v, const char*) { out.str(v); }
+  void operator()(const Eigen::VectorXd& v, const char*) { out.vec(v); }
+  template <class Enum>
+  void enumeration(const Enum& v, int, const char*) { out.u8(static_cast<std::uint8_t>(v)); }
+};
+
+struct FieldReader {
+  ByteReader& in;
+  void operator()(double& v, const char* what, bool allow_nonfinite = false) { v = in.f64(what, allow_nonfinite); }
+  void operator()(int& v, const char* what) { v = in.i32(what); }
+  void operator()(bool& v, const char* what) { v = in.boolean(what); }
+  void operator()(std::size_t& v, const char* what) { v = in.u64(what); }
+  void operator()(std::string& v, const char* what) { v = in.str(what); }
+  void operator()(Eigen::VectorXd& v, const char* what) { v = in.vec(what); }
+  template <class Enum>
+  void enumeration(Enum& v, int max, const char* what) {
+    const std::uint8_t raw = in.u8(what);
+    if (raw > max) in.fail(std::string(what) + ": unknown value " + std::to_string(raw));
+    v = static_cast<Enum>(raw);
+  }
+};
+
+// Options and reports are visited through non-const references; writing
+// goes through a copy.
+template <class Io>
+void fields(Io& io, EstimatorOptions& o) {
+  io(o.method, "estimator method");
+  io(o.window, "window");
+  io(o.ekf.constant_process_noise, "ekf constant_process_noise");
+  io(o.ekf.joseph_form, "ekf joseph_form");
+  SmootherOptions& s = o.smoother;
+  io.enumeration(s.ordering, 1, "smoother ordering");
+  io(s.relinearize, "smoother relinearize");
+  io(s.relinearize_threshold, "smoother relinearize_threshold");
+  io(s.constants_check_sigmas, "smoother constants_check_sigmas");
+  io(s.max_local_iterations, "smoother max_local_iterations");
+  io(s.wildfire_threshold, "smoother wildfire_threshold", true);  // ∞ = lazy
+  io(s.iterate_to_convergence, "smoother iterate_to_convergence");
+  io(s.convergence_tolerance, "smoother convergence_tolerance");
+  io(s.max_iterations, "smoother max_iterations");
+  io(s.newton_polish_steps, "smoother newton_polish_steps");
+  io(o.t0, "t0");
+  io(o.compute_nis, "compute_nis");
+}
+
+template <class Io>
+void fields(Io& io, UpdateReport& r) {
+  io(r.new_factors, "update report new_factors");
+  io(r.new_variables, "update report new_variables");
+  io(r.cliques_reeliminated, "update report cliques_reeliminated");
+  io(r.orphans, "update report orphans");
+  io(r.factors_checked, "update report factors_checked");
+  io(r.factors_relinearized, "update report factors_relinearized");
+  io(r.relinearization_pass, "update report relinearization_pass");
+  io(r.iterations, "update report iterations");
+  io(r.variables_backsubstituted, "update report variables_backsubstituted");
+  io(r.variables_marginalized, "update report variables_marginalized");
+  io(r.num_variables, "update report num_variables");
+  io(r.num_factors, "update report num_factors");
+  io(r.num_cliques, "update report num_cliques");
+  io(r.seconds, "update report seconds");
+  io(r.note, "update report note");
+}
+}  // namespace
+
 void CheckpointAccess::writeOptions(ByteWriter& out, const EstimatorOptions& o) {
-  out.str(o.method);
-  out.i32(o.window);
-  out.vec(o.ekf.constant_process_noise);
-  out.boolean(o.ekf.joseph_form);
-  const SmootherOptions& s = o.smoother;
-  out.u8(static_cast<std::uint8_t>(s.ordering));
-  out.boolean(s.relinearize);
-  out.f64(s.relinearize_threshold);
-  out.f64(s.constants_check_sigmas);
-  out.i32(s.max_local_iterations);
-  out.f64(s.wildfire_threshold);
-  out.boolean(s.iterate_to_convergence);
-  out.f64(s.convergence_tolerance);
-  out.i32(s.max_iterations);
-  out.i32(s.newton_polish_steps);
-  out.f64(o.t0);
-  out.boolean(o.compute_nis);
+  FieldWriter w{out};
+  EstimatorOptions copy = o;
+  fields(w, copy);
 }
 
 EstimatorOptions CheckpointAccess::readOptions(ByteReader& in) {
+  FieldReader r{in};
   EstimatorOptions o;
-  o.method = in.str("estimator method");
-  o.window = in.i32("window");
-  o.ekf.constant_process_noise = in.vec("ekf constant_process_noise");
-  o.ekf.joseph_form = in.boolean("ekf joseph_form");
-  SmootherOptions& s = o.smoother;
-  const std::uint8_t ordering = in.u8("smoother ordering");
-  if (ordering > 1) in.fail("unknown smoother ordering " + std::to_string(ordering));
-  s.ordering = static_cast<EliminationOrdering>(ordering);
-  s.relinearize = in.boolean("smoother relinearize");
-  s.relinearize_threshold = in.f64("smoother relinearize_threshold");
-  s.constants_check_sigmas = in.f64("smoother constants_check_sigmas");
-  s.max_local_iterations = in.i32("smoother max_local_iterations");
-  s.wildfire_threshold = in.f64("smoother wildfire_threshold", true);
-  s.iterate_to_convergence = in.boolean("smoother iterate_to_convergence");
-  s.convergence_tolerance = in.f64("smoother convergence_tolerance");
-  s.max_iterations = in.i32("smoother max_iterations");
-  s.newton_polish_steps = in.i32("smoother newton_polish_steps");
-  o.t0 = in.f64("t0");
-  o.compute_nis = in.boolean("compute_nis");
+  fields(r, o);
   return o;
 }
 
-void CheckpointAccess::writeUpdateReport(ByteWriter& out, const UpdateReport& r) {
-  for (int v : {r.new_factors, r.new_variables, r.cliques_reeliminated, r.orphans, r.factors_checked,
-                r.factors_relinearized, r.iterations, r.variables_backsubstituted, r.variables_marginalized})
-    out.i32(v);
-  out.boolean(r.relinearization_pass);
-  out.u64(r.num_variables);
-  out.u64(r.num_factors);
-  out.u64(r.num_cliques);
-  out.f64(r.seconds);
-  out.str(r.note);
+void CheckpointAccess::writeUpdateReport(ByteWriter& out, const UpdateReport& report) {
+  FieldWriter w{out};
+  UpdateReport copy = report;
+  fields(w, copy);
 }
 
 UpdateReport CheckpointAccess::readUpdateReport(ByteReader& in) {
-  UpdateReport r;
-  for (int* v : {&r.new_factors, &r.new_variables, &r.cliques_reeliminated, &r.orphans, &r.factors_checked,
-                 &r.factors_relinearized, &r.iterations, &r.variables_backsubstituted,
-                 &r.variables_marginalized})
-    *v = in.i32("update report count");
-  r.relinearization_pass = in.boolean("update report relinearization_pass");
-  r.num_variables = in.u64("update report num_variables");
-  r.num_factors = in.u64("update report num_factors");
-  r.num_cliques = in.u64("update report num_cliques");
-  r.seconds = in.f64("update report seconds");
-  r.note = in.str("update report note");
-  return r;
+  FieldReader r{in};
+  UpdateReport report;
+  fields(r, report);
+  return report;
 }
 
 void CheckpointAccess::saveEstimator(const Estimator& e, ByteWriter& out) {

@@ -60,6 +60,11 @@ void ByteWriter::gaussian(const Gaussian& g) {
   mat(g.covariance);
 }
 
+void ByteWriter::times(const std::deque<double>& t) {
+  u64(t.size());
+  for (double v : t) f64(v);
+}
+
 // ---- reader -----------------------------------------------------------------------
 void ByteReader::fail(const std::string& what) const {
   std::ostringstream os;
@@ -78,31 +83,6 @@ void ByteReader::raw(void* p, std::size_t n, const std::string& what) {
   pos_ += n;
 }
 
-std::uint8_t ByteReader::u8(const char* what) {
-  std::uint8_t v;
-  raw(&v, 1, what);
-  return v;
-}
-std::uint32_t ByteReader::u32(const char* what) {
-  std::uint32_t v;
-  raw(&v, sizeof v, what);
-  return v;
-}
-std::uint64_t ByteReader::u64(const char* what) {
-  std::uint64_t v;
-  raw(&v, sizeof v, what);
-  return v;
-}
-std::int32_t ByteReader::i32(const char* what) {
-  std::int32_t v;
-  raw(&v, sizeof v, what);
-  return v;
-}
-std::int64_t ByteReader::i64(const char* what) {
-  std::int64_t v;
-  raw(&v, sizeof v, what);
-  return v;
-}
 double ByteReader::f64(const std::string& what, bool allow_nonfinite) {
   double v;
   raw(&v, sizeof v, what);
@@ -185,6 +165,12 @@ Gaussian ByteReader::gaussian(const std::string& what) {
     fail(what + ": covariance is " + std::to_string(g.covariance.rows()) + " x " +
          std::to_string(g.covariance.cols()) + " for a mean of size " + std::to_string(g.mean.size()));
   return g;
+}
+
+std::deque<double> ByteReader::times(const std::string& what) {
+  std::deque<double> t(count(what + " (count)", sizeof(double)));
+  for (double& v : t) v = f64(what);
+  return t;
 }
 
 }  // namespace gssm::internal

@@ -8,6 +8,7 @@
 // a CheckpointError naming the byte offset and the field being read.
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,7 @@ class ByteWriter {
   void mat(const Eigen::MatrixXd& m);
   void values(const Values& v);
   void gaussian(const Gaussian& g);
+  void times(const std::deque<double>& t);
   const std::string& bytes() const { return buf_; }
 
  private:
@@ -48,11 +50,11 @@ class ByteReader {
   ByteReader(const std::string& bytes, std::string source, std::size_t base_offset = 0)
       : data_(bytes.data()), size_(bytes.size()), source_(std::move(source)), base_(base_offset) {}
 
-  std::uint8_t u8(const char* what);
-  std::uint32_t u32(const char* what);
-  std::uint64_t u64(const char* what);
-  std::int32_t i32(const char* what);
-  std::int64_t i64(const char* what);
+  std::uint8_t u8(const char* what) { return scalar<std::uint8_t>(what); }
+  std::uint32_t u32(const char* what) { return scalar<std::uint32_t>(what); }
+  std::uint64_t u64(const char* what) { return scalar<std::uint64_t>(what); }
+  std::int32_t i32(const char* what) { return scalar<std::int32_t>(what); }
+  std::int64_t i64(const char* what) { return scalar<std::int64_t>(what); }
   /// Finite unless `allow_nonfinite` (e.g. a NaN NIS before any measurement).
   double f64(const std::string& what, bool allow_nonfinite = false);
   bool boolean(const char* what);
@@ -66,6 +68,8 @@ class ByteReader {
   Eigen::MatrixXd mat(const std::string& what);
   Values values(const std::string& what);
   Gaussian gaussian(const std::string& what);
+  /// Finite time stamps (a count, then each).
+  std::deque<double> times(const std::string& what);
 
   bool atEnd() const { return pos_ == size_; }
   std::size_t offset() const { return base_ + pos_; }
@@ -74,6 +78,12 @@ class ByteReader {
 
  private:
   void raw(void* p, std::size_t n, const std::string& what);
+  template <class T>
+  T scalar(const char* what) {
+    T v;
+    raw(&v, sizeof v, what);
+    return v;
+  }
   const char* data_;
   std::size_t size_, pos_ = 0;
   std::string source_;

@@ -286,13 +286,11 @@ class SmootherEstimator final : public Estimator {
  private:
   void saveState(internal::ByteWriter& out) const override {
     internal::CheckpointAccess::saveSmoother(smoother_, out);
-    out.u64(times_.size());
-    for (double t : times_) out.f64(t);
+    out.times(times_);
   }
   void loadState(internal::ByteReader& in) override {
     internal::CheckpointAccess::loadSmoother(smoother_, in, model_);
-    std::deque<double> times(in.count("state times", sizeof(double)));
-    for (double& t : times) t = in.f64("state time");
+    std::deque<double> times = in.times("state times");
     const auto held = static_cast<std::size_t>(step()) + 1;
     const std::size_t expect = keep_times_ ? std::min(held, keep_times_) : held;
     const bool nb = model_.dims().nb > 0;
@@ -436,8 +434,7 @@ class PaperWindowEstimator final : public Estimator {
       out.u64(s.size());
       for (const auto& f : s) internal::writeFactor(out, *f);
     }
-    out.u64(times_.size());
-    for (double t : times_) out.f64(t);
+    out.times(times_);
     out.values(values_);
     out.gaussian(prior_state_);
     out.gaussian(prior_constants_);
@@ -449,8 +446,7 @@ class PaperWindowEstimator final : public Estimator {
       steps[i].resize(in.count("factors of window step", 1));
       for (auto& f : steps[i]) f = internal::readFactor(in, model_, "window factor");
     }
-    std::deque<double> times(in.count("state times", sizeof(double)));
-    for (double& t : times) t = in.f64("state time");
+    std::deque<double> times = in.times("state times");
     Values values = in.values("window values");
     Gaussian ps = in.gaussian("prior on the oldest state"), pb = in.gaussian("prior on the constants");
     const std::int64_t oldest = in.i64("oldest step");
