@@ -124,7 +124,6 @@ class Estimator {
   void advance(double t);  // process-only step to t
   /// NIS of y at a step dt after the current estimate (dt = 0: at it).
   double innovationNis(double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y);
-  bool compute_nis_ = false;
   friend std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOptions& options);
   Eigen::VectorXd inputInForce() const;
   double t_;            // time of the newest state

@@ -13,6 +13,7 @@ struct FieldWriter {
   void operator()(const int& v, const char*) { out.i32(v); }
   void operator()(const bool& v, const char*) { out.boolean(v); }
   void operator()(const std::size_t& v, const char*) { out.u64(v); }
+  void operator()(const std::int64_t& v, const char*) { out.i64(v); }
   void operator()(const std::string& v, const char*) { out.str(v); }
   void operator()(const Eigen::VectorXd& v, const char*) { out.vec(v); }
   template <class Enum>
@@ -25,6 +26,7 @@ struct FieldReader {
   void operator()(int& v, const char* what) { v = in.i32(what); }
   void operator()(bool& v, const char* what) { v = in.boolean(what); }
   void operator()(std::size_t& v, const char* what) { v = in.u64(what); }
+  void operator()(std::int64_t& v, const char* what) { v = in.i64(what); }
   void operator()(std::string& v, const char* what) { v = in.str(what); }
   void operator()(Eigen::VectorXd& v, const char* what) { v = in.vec(what); }
   template <class Enum>
@@ -76,6 +78,16 @@ void fields(Io& io, UpdateReport& r) {
   io(r.seconds, "update report seconds");
   io(r.note, "update report note");
 }
+
+template <class Io>
+void fields(Io& io, EstimatorReport& r) {  // all but the method, which the options carry
+  io(r.steps, "report steps");
+  io(r.seconds, "report seconds");
+  io(r.iterations, "report iterations");
+  fields(io, r.smoother);
+  io(r.detail, "report detail");
+  io(r.nis, "report nis", true);  // NaN without compute_nis
+}
 }  // namespace
 
 void CheckpointAccess::writeOptions(ByteWriter& out, const EstimatorOptions& o) {
@@ -108,13 +120,9 @@ void CheckpointAccess::saveEstimator(const Estimator& e, ByteWriter& out) {
   out.f64(e.t_);
   out.i64(e.k_);
   out.vec(e.input_);
-  const EstimatorReport& r = e.report();  // formats a pending detail line
-  out.i64(r.steps);
-  out.f64(r.seconds);
-  out.i32(r.iterations);
-  writeUpdateReport(out, r.smoother);
-  out.str(r.detail);
-  out.f64(r.nis);
+  EstimatorReport r = e.report();  // formats a pending detail line
+  FieldWriter w{out};
+  fields(w, r);
   e.saveState(out);
 }
 
@@ -128,12 +136,8 @@ void CheckpointAccess::loadEstimator(Estimator& e, ByteReader& in) {
             std::to_string(e.model_.dims().nu));
   EstimatorReport r;
   r.method = e.report_.method;
-  r.steps = in.i64("report steps");
-  r.seconds = in.f64("report seconds");
-  r.iterations = in.i32("report iterations");
-  r.smoother = readUpdateReport(in);
-  r.detail = in.str("report detail");
-  r.nis = in.f64("report nis", true);
+  FieldReader reader{in};
+  fields(reader, r);
   // The base state first: the method's loadState checks itself against it.
   e.t_ = t;
   e.k_ = k;

@@ -2,7 +2,6 @@
 // cliques as empty placeholders (their indices stay free), so allocation
 // after a restore picks the same indices as the uninterrupted run.
 #include <algorithm>
-#include <sstream>
 #include <unordered_set>
 
 #include "checkpoint/byte_stream.h"
@@ -152,7 +151,6 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
 }
 
 std::string BayesTreeEngine::invariantViolation() const {
-  std::ostringstream os;
   const auto nc = static_cast<int>(cliques_.size()), ns = static_cast<int>(slots_.size());
   auto aliveClique = [&](int c) { return c >= 0 && c < nc && clique_alive_[static_cast<std::size_t>(c)]; };
   auto aliveSlot = [&](int s) { return s >= 0 && s < ns && slots_[static_cast<std::size_t>(s)].alive; };
@@ -248,7 +246,6 @@ std::string BayesTreeEngine::invariantViolation() const {
   if (alive_cliques != vars_.size()) return "cliques and variables differ in number";
   if (root_ != -1 && (!aliveClique(root_) || cliques_[static_cast<std::size_t>(root_)].parent != -1))
     return "the root is not a live parentless clique";
-  (void)os;
   return "";
 }
 

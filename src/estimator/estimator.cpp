@@ -112,7 +112,7 @@ void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
     throw InvalidArgument(os.str());
   }
   requireVector(y, model_.dims().ny, method() + ": measurement y at t = " + std::to_string(t));
-  const double nis = compute_nis_ ? innovationNis(t - t_, inputInForce(), y) : report_.nis;
+  const double nis = options_.compute_nis ? innovationNis(t - t_, inputInForce(), y) : report_.nis;
   if (t == t_) {
     doMeasurement(k_, y);  // at the newest state
   } else {
@@ -511,7 +511,6 @@ std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOpti
   } else {
     e = std::make_unique<PaperWindowEstimator>(model, options);
   }
-  e->compute_nis_ = options.compute_nis;
   e->options_ = options;
   return e;
 }

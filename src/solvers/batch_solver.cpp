@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "gssm/error.h"
+#include "linear/normal_equations.h"
 #include "linear/sparse_cholesky.h"
 #include "solvers/newton.h"
 
@@ -122,23 +123,13 @@ struct BatchSolver::Impl {
       const auto& keys = f->keys();
       offs.resize(keys.size());
       for (std::size_t a = 0; a < keys.size(); ++a) offs[a] = offset[x.indexOf(keys[a])];
-      for (std::size_t a = 0; a < keys.size(); ++a) {
-        g.segment(offs[a], J[a].cols()) += J[a].transpose() * r;
-        for (std::size_t b = 0; b < keys.size(); ++b) {
-          if (offs[a] > offs[b]) continue;  // upper triangle only
-          // (JᵀJ)_ab entry by entry: no temporary on this hot path.
-          for (Eigen::Index j = 0; j < J[b].cols(); ++j)
-            for (Eigen::Index i = 0; i < J[a].cols(); ++i) {
-              const Eigen::Index gi = offs[a] + i, gj = offs[b] + j;
-              if (gi > gj) continue;  // diagonal block: keep its upper half
-              const double v = J[a].col(i).dot(J[b].col(j));
-              if (first) chol.add(gi, gj, v);
-              else chol.value(e) = v;
-              if (gi == gj) diag[gi] += v;
-              ++e;
-            }
-        }
-      }
+      for (std::size_t a = 0; a < keys.size(); ++a) g.segment(offs[a], J[a].cols()) += J[a].transpose() * r;
+      internal::forEachUpperJtJ(offs, J, [&](Eigen::Index gi, Eigen::Index gj, double v, auto...) {
+        if (first) chol.add(gi, gj, v);
+        else chol.value(e) = v;
+        if (gi == gj) diag[gi] += v;
+        ++e;
+      });
     }
     if (first) {
       damping_begin = chol.entries();

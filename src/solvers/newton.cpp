@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "linear/normal_equations.h"
+
 namespace gssm::internal {
 
 Eigen::MatrixXd residualCurvature(const Factor& f, const Values& x, const Eigen::VectorXd& r) {
@@ -10,7 +12,8 @@ Eigen::MatrixXd residualCurvature(const Factor& f, const Values& x, const Eigen:
   for (std::size_t a = 0; a < keys.size(); ++a) off[a + 1] = off[a] + x.at(keys[a]).size();
   const Eigen::Index n = off.back();
   Eigen::MatrixXd C(n, n);
-  Values xp = x;  // only the factor's keys are read; a copy keeps x untouched
+  Values xp;  // the factor's keys only: x may hold a whole run
+  for (const auto& k : keys) xp.insert(k, x.at(k));
   Eigen::VectorXd rp;
   std::vector<Eigen::MatrixXd> Jp, Jm;
   auto JTr = [&](const std::vector<Eigen::MatrixXd>& J) {
@@ -53,16 +56,11 @@ void NewtonSystem::add(const std::vector<Key>& keys, const Eigen::VectorXd& r,
     local[a + 1] = local[a] + J[a].cols();
     g_.segment(col[a], J[a].cols()) += J[a].transpose() * r;
   }
-  for (std::size_t a = 0; a < keys.size(); ++a)
-    for (std::size_t b = 0; b < keys.size(); ++b)
-      for (Eigen::Index i = 0; i < J[a].cols(); ++i)
-        for (Eigen::Index j = 0; j < J[b].cols(); ++j) {
-          const Eigen::Index gi = col[a] + i, gj = col[b] + j;
-          if (gi > gj) continue;  // upper triangle; duplicates are summed
-          double v = J[a].col(i).dot(J[b].col(j));
-          if (curvature) v += (*curvature)(local[a] + i, local[b] + j);
-          chol_.add(gi, gj, v);
-        }
+  forEachUpperJtJ(col, J, [&](Eigen::Index gi, Eigen::Index gj, double v, std::size_t a, Eigen::Index i,
+                              std::size_t b, Eigen::Index j) {
+    if (curvature) v += (*curvature)(local[a] + i, local[b] + j);
+    chol_.add(gi, gj, v);  // duplicates are summed
+  });
 }
 
 bool NewtonSystem::solve(Eigen::VectorXd& delta) {
