@@ -12,6 +12,7 @@
 #include "cli.h"
 #include "gssm/analysis_report.h"
 #include "gssm/io/config.h"
+#include "gssm/io/dataset.h"
 #include "gssm/plot/figure.h"
 
 namespace fs = std::filesystem;
@@ -30,15 +31,18 @@ int main(int argc, char** argv) {
     cli.parse(argc, argv);
     const std::string data = cli.require("data"), out = cli.require("out");
     const gssm::io::IniDocument scenario = gssm::io::readScenario(data);
-    const auto model = gssm::io::makeModel(scenario);
+    gssm::io::LoadedScenario loaded = gssm::io::loadScenario(scenario);
+    if (!scenario.has("scenario", "name")) loaded.scenario.name = data;
+    const int window = static_cast<int>(cli.getInt("window", 1, 100000));
+    loaded.scenario.options.fixed_lag.window = loaded.scenario.options.paper_window.window = window;
     gssm::io::Dataset ds;
-    gssm::io::readDatasetData(data, *model, ds);
+    gssm::io::readDatasetData(data, *loaded.truth, ds);
     gssm::MonteCarloOptions o;
     o.seeds = static_cast<int>(cli.getInt("runs", 2, 100000));
-    o.window = static_cast<int>(cli.getInt("window", 1, 100000));
     o.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     o.first_seed = 1000;  // independent of the dataset's own seed
-    const gssm::ScenarioAnalysis a = gssm::analyzeScenario(*model, ds, scenario, o, [](unsigned seed) {
+    const gssm::ScenarioAnalysis a = gssm::analyzeScenario(loaded.scenario, gssm::io::recordedRun(*loaded.truth, ds), o,
+                                                           [](unsigned seed) {
       auto rng = std::make_shared<mrpt::random::CRandomGenerator>(seed);
       return gssm::NormalSampler([rng] { return rng->drawGaussian1D_normalized(); });
     });
@@ -54,7 +58,7 @@ int main(int argc, char** argv) {
       f.ylabel = "RMSE / bound sd, " + a.state_names[i];
       for (std::size_t m = 0; m < a.montecarlo.methods.size(); ++m) {
         const auto& ms = a.montecarlo.methods[m];
-        gssm::plot::Series s{ms.method, ms.times, {}, gssm::plot::paletteColor(m), 2, false};
+        gssm::plot::Series s{gssm::methodName(ms.method), ms.times, {}, gssm::plot::paletteColor(m), 2, false};
         for (const auto& v : ms.rmse_over_time) s.y.push_back(v[ii]);
         f.series.push_back(std::move(s));
       }

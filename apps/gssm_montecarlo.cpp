@@ -33,10 +33,12 @@ int main(int argc, char** argv) {
     gssm::MonteCarloOptions o;
     o.seeds = static_cast<int>(cli.getInt("seeds", 1, 1000000));
     o.first_seed = static_cast<unsigned>(cli.getInt("first-seed", 0, 4000000000LL));
-    o.window = static_cast<int>(cli.getInt("window", 1, 100000));
+    const int window = static_cast<int>(cli.getInt("window", 1, 100000));
     o.threads = static_cast<int>(cli.getInt("threads", 1, 256));
     const int steps = static_cast<int>(cli.getInt("steps", 1, 10000000));
-    const auto scenario = gssm::io::builtinScenario(cli.get("scenario"), o.first_seed, steps);
+    gssm::io::LoadedScenario loaded =
+        gssm::io::loadScenario(gssm::io::builtinScenario(cli.get("scenario"), o.first_seed, steps));
+    loaded.scenario.options.fixed_lag.window = loaded.scenario.options.paper_window.window = window;
     const bool tty = isatty(STDERR_FILENO);
     std::mutex io;
     o.progress = [&](int done, int total) {
@@ -48,7 +50,7 @@ int main(int argc, char** argv) {
                   << (done == total ? "\n" : "") << std::flush;
       }
     };
-    const gssm::MonteCarloResult res = gssm::runMonteCarlo(scenario, o, [](unsigned seed) {
+    const gssm::MonteCarloResult res = gssm::runMonteCarlo(loaded.scenario, o, [](unsigned seed) {
       auto rng = std::make_shared<mrpt::random::CRandomGenerator>(seed);
       return gssm::NormalSampler([rng] { return rng->drawGaussian1D_normalized(); });
     });
@@ -56,7 +58,7 @@ int main(int argc, char** argv) {
     const std::string table = res.markdown();
     std::ofstream(fs::path(out) / "montecarlo.md")
         << "# Monte Carlo: " << res.scenario << "\n\nCommand: `gssm-montecarlo --scenario " << cli.get("scenario")
-        << " --seeds " << o.seeds << " --steps " << steps << " --window " << o.window << "`\n\n" << table;
+        << " --seeds " << o.seeds << " --steps " << steps << " --window " << window << "`\n\n" << table;
     std::cout << table << "\n(" << res.seconds << " s)\n";
     for (std::size_t i = 0; i < res.state_names.size(); ++i) {
       gssm::plot::Figure f;
@@ -65,7 +67,8 @@ int main(int argc, char** argv) {
       f.ylabel = "RMSE " + res.state_names[i];
       for (std::size_t m = 0; m < res.methods.size(); ++m) {
         const auto& ms = res.methods[m];
-        gssm::plot::Series s{ms.method, ms.times, {}, gssm::plot::paletteColor(m), 2, ms.method == "batch"};
+        gssm::plot::Series s{gssm::methodName(ms.method), ms.times, {}, gssm::plot::paletteColor(m), 2,
+                             !gssm::methodInfo(ms.method).streaming};
         for (const auto& v : ms.rmse_over_time) s.y.push_back(v[static_cast<Eigen::Index>(i)]);
         f.series.push_back(std::move(s));
       }

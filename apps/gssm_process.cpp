@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
                                 "scenario.ini, optional truth.csv) and writes "
                                 "estimates-<method>.csv and metrics.json to OUTDIR.");
     cli.option("data", "DIR", "dataset folder");
-    cli.option("method", "ekf|batch|incremental|fixed-lag|paper-window|all", "estimator to run", "all");
+    cli.option("method", gssm::methodNameList() + ", or all", "estimator to run", "all");
     cli.option("window", "W", "states kept by fixed-lag and paper-window (overrides [fixed_lag] / [paper_window] window)");
     cli.option("config", "FILE", "INI file to use instead of DIR/scenario.ini");
     cli.option("out", "OUTDIR", "output folder");
@@ -58,15 +58,12 @@ int main(int argc, char** argv) {
     cli.flag("skip-bad-rows", "skip malformed measurement rows (listed in metrics.json) instead of stopping at the first");
     cli.parse(argc, argv);
     const std::string data = cli.require("data"), out = cli.require("out");
-    std::string method = cli.get("method");
     const std::string resume = cli.given("resume") ? cli.get("resume") : "";
-    if (!resume.empty() && !cli.given("method")) method = "";  // taken from the checkpoint below
-    std::vector<std::string> methods{"ekf", "batch", "incremental", "fixed-lag", "paper-window"};
-    if (method != "all" && !method.empty()) {
-      if (std::find(methods.begin(), methods.end(), method) == methods.end())
-        throw std::invalid_argument("option --method = '" + method +
-                                    "': expected ekf, batch, incremental, fixed-lag, paper-window or all");
-      methods = {method};
+    std::vector<gssm::Method> methods;  // empty with --resume alone: the checkpoint's
+    if (cli.get("method") == "all" && (resume.empty() || cli.given("method"))) {
+      for (const auto& info : gssm::methods()) methods.push_back(info.method);
+    } else if (cli.given("method") || resume.empty()) {
+      methods = {gssm::io::parseMethod(cli.get("method"), "option --method")};
     }
 
     const gssm::io::IniDocument config = gssm::io::readScenario(data, cli.get("config"));
@@ -74,10 +71,10 @@ int main(int argc, char** argv) {
     if (!resume.empty()) {
       gssm::CheckpointInfo info;
       gssm::restoreCheckpoint(*model, resume, &info);  // throws a clear error if unusable
-      if (method.empty()) methods = {info.method};
-      if (methods.size() != 1 || methods[0] == "batch")
-        throw std::invalid_argument("option --resume: resumes one streaming method; the checkpoint's is '" +
-                                    info.method + "'");
+      if (methods.empty()) methods = {info.method};
+      if (methods.size() != 1 || !gssm::methodInfo(methods[0]).streaming)
+        throw std::invalid_argument(std::string("option --resume: resumes one streaming method; the checkpoint's is '") +
+                                    gssm::methodName(info.method) + "'");
     }
     const std::size_t checkpoint_every =
         cli.given("checkpoint-every") ? static_cast<std::size_t>(cli.getInt("checkpoint-every", 1, 1000000000)) : 0;
@@ -102,19 +99,20 @@ int main(int argc, char** argv) {
     };
     std::vector<gssm::RunMetrics> metrics;
     std::vector<gssm::OfflineRun> runs;
-    for (const auto& m : methods) {
-      gssm::EstimatorOptions eo;
-      eo.method = m;
-      const std::string section = m == "paper-window" ? "paper_window" : "fixed_lag";
-      eo.window = cli.given("window") ? static_cast<int>(cli.getInt("window", 1, 1000000))
-                                      : gssm::io::windowOption(config, section, 10);
-      eo.ekf = gssm::io::ekfOptions(config, *model);
-      eo.smoother = gssm::io::smootherOptions(config);
-      gssm::OfflineRun run = m == "batch"
-          ? gssm::runBatch(*model, gssm::BatchSolverOptions{}, ds.measurements, ds.inputs)
-          : gssm::runStreaming(*model, eo, ds.measurements, ds.inputs, progress(m),
-                               {checkpoint_every ? (fs::path(out) / ("checkpoint-" + m + ".ckpt")).string() : "",
-                                checkpoint_every, resume});
+    gssm::EstimatorOptions options = gssm::io::estimatorOptions(config, *model);
+    if (cli.given("window"))
+      options.fixed_lag.window = options.paper_window.window = static_cast<int>(cli.getInt("window", 1, 1000000));
+    for (const gssm::Method method : methods) {
+      options.method = method;
+      const std::string m = gssm::methodName(method);
+      const bool streaming = gssm::methodInfo(method).streaming;
+      gssm::StreamingCheckpoints checkpoints;
+      if (streaming) {
+        checkpoints = {checkpoint_every ? (fs::path(out) / ("checkpoint-" + m + ".ckpt")).string() : "",
+                       checkpoint_every, resume};
+      }
+      gssm::OfflineRun run =
+          gssm::runOffline(*model, options, ds.measurements, ds.inputs, progress(m), checkpoints);
       writeEstimates((fs::path(out) / ("estimates-" + m + ".csv")).string(), *model, run);
       metrics.push_back(gssm::computeMetrics(*model, run, ds.truth ? &*ds.truth : nullptr));
       const auto& last = run.rows.back();
@@ -130,7 +128,12 @@ int main(int argc, char** argv) {
     }
     std::ofstream((fs::path(out) / "metrics.json").string()) << gssm::metricsJson(metrics, data, status);
     const std::string label = config.getString("scenario", "name", fs::path(data).filename().string());
-    for (const auto& p : gssm::plot::writeRunFigures(*model, runs, ds.truth ? &*ds.truth : nullptr, out, label))
+    std::optional<gssm::plot::PlanView> plan;
+    const auto names = model->stackedStateNames();
+    const auto px = std::find(names.begin(), names.end(), "px"), py = std::find(names.begin(), names.end(), "py");
+    if (px != names.end() && py != names.end())
+      plan = gssm::plot::PlanView{px - names.begin(), py - names.begin(), gssm::io::landmarks(config), "beacons"};
+    for (const auto& p : gssm::plot::writeRunFigures(*model, runs, ds.truth ? &*ds.truth : nullptr, out, label, plan))
       std::cout << "figure: " << p << "\n";
     std::cout << "gssm-process: wrote " << out << "/metrics.json and estimates-*.csv\n";
     if (status.partial) {

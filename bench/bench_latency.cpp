@@ -32,14 +32,14 @@ const gssm::SimulatedRun& paperRun(int steps) {
   return cache[steps] = gssm::simulate(radar, spec, [&] { return n(rng); });
 }
 
-void streamEstimator(benchmark::State& state, const std::string& method, int window) {
+void streamEstimator(benchmark::State& state, gssm::Method method, int window) {
   const gssm::models::Radar2D radar;
   const int steps = static_cast<int>(state.range(0));
   const auto& run = paperRun(steps);
   gssm::EstimatorOptions o;
   o.method = method;
-  o.window = window;
-  if (method == "ekf") o.ekf.constant_process_noise = Eigen::Vector2d(0.005 * 0.005, 0);  // the paper's EKF
+  o.fixed_lag.window = o.paper_window.window = window;
+  if (method == gssm::Method::Ekf) o.ekf.constant_process_noise = Eigen::Vector2d(0.005 * 0.005, 0);  // the paper's EKF
   std::vector<double> times;
   times.reserve(static_cast<std::size_t>(steps) * 4);
   for (auto _ : state) {
@@ -62,7 +62,7 @@ void BM_Batch(benchmark::State& state) {
   const auto& run = paperRun(static_cast<int>(state.range(0)));
   int iterations = 0;
   for (auto _ : state) {
-    const gssm::OfflineRun r = gssm::runBatch(radar, gssm::BatchSolverOptions{}, run.measurements);
+    const gssm::OfflineRun r = gssm::runBatch(radar, gssm::EstimatorOptions(gssm::Method::Batch), run.measurements);
     iterations = r.iterations;
     benchmark::DoNotOptimize(r.rows.back().mean.data());
   }
@@ -71,14 +71,14 @@ void BM_Batch(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK_CAPTURE(streamEstimator, ekf, std::string("ekf"), 10)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w5, std::string("fixed-lag"), 5)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w10, std::string("fixed-lag"), 10)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w20, std::string("fixed-lag"), 20)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w50, std::string("fixed-lag"), 50)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w100, std::string("fixed-lag"), 100)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(streamEstimator, incremental, std::string("incremental"), 10)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(streamEstimator, paper_window_w10, std::string("paper-window"), 10)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(streamEstimator, paper_window_w100, std::string("paper-window"), 100)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, ekf, gssm::Method::Ekf, 10)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w5, gssm::Method::FixedLag, 5)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w10, gssm::Method::FixedLag, 10)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w20, gssm::Method::FixedLag, 20)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w50, gssm::Method::FixedLag, 50)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, fixed_lag_w100, gssm::Method::FixedLag, 100)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, incremental, gssm::Method::Incremental, 10)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, paper_window_w10, gssm::Method::PaperWindow, 10)->Arg(2000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(streamEstimator, paper_window_w100, gssm::Method::PaperWindow, 100)->Arg(2000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Batch)->Arg(2000)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -36,7 +36,7 @@ gssm::models::LinearModel syntheticModel(int nc, int nb) {
   return gssm::models::LinearModel(s);
 }
 
-void stateSize(benchmark::State& state, const std::string& method) {
+void stateSize(benchmark::State& state, gssm::Method method) {
   const int nc = static_cast<int>(state.range(0)), nb = static_cast<int>(state.range(1));
   const auto model = syntheticModel(nc, nb);
   std::mt19937 rng(3);
@@ -46,7 +46,7 @@ void stateSize(benchmark::State& state, const std::string& method) {
   const gssm::SimulatedRun run = gssm::simulate(model, spec, [&] { return g(rng); });
   gssm::EstimatorOptions o;
   o.method = method;
-  o.window = 10;
+  o.fixed_lag.window = o.paper_window.window = 10;
   o.smoother.relinearize = false;  // linear: nothing to relinearize
   std::vector<double> times;
   for (auto _ : state) {
@@ -68,6 +68,6 @@ void sizes(benchmark::internal::Benchmark* b) {
 
 }  // namespace
 
-BENCHMARK_CAPTURE(stateSize, ekf, std::string("ekf"))->Apply(sizes)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(stateSize, fixed_lag_w10, std::string("fixed-lag"))->Apply(sizes)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(stateSize, ekf, gssm::Method::Ekf)->Apply(sizes)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(stateSize, fixed_lag_w10, gssm::Method::FixedLag)->Apply(sizes)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

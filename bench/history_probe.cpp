@@ -43,14 +43,18 @@ int main(int argc, char** argv) {
     std::vector<gssm::Measurement> ms;
     for (long k = 1; k <= steps; ++k) ms.push_back(next(k));
     const auto t0 = std::chrono::steady_clock::now();
-    const gssm::OfflineRun r = gssm::runBatch(radar, gssm::BatchSolverOptions{}, ms);
+    const gssm::OfflineRun r = gssm::runBatch(radar, gssm::EstimatorOptions(gssm::Method::Batch), ms);
     std::cout << "batch, " << steps << " steps: " << r.summary << "\n  total with EKF initial guess and all "
               << "marginals: " << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
               << " s, peak RSS " << maxRssMb() << " MB\n";
     return 0;
   }
   gssm::EstimatorOptions o;
-  o.method = method;
+  if (!gssm::methodNamed(method)) {
+    std::cerr << "history_probe: unknown method '" << method << "' (" << gssm::methodNameList() << ")\n";
+    return 2;
+  }
+  o.method = *gssm::methodNamed(method);
   auto est = gssm::makeEstimator(radar, o);
   std::deque<double> window;
   for (long k = 1; k <= steps; ++k) {

@@ -16,11 +16,11 @@
 namespace {
 // Streams `steps` radar measurements; calls sample(k, median of the last 1000).
 template <class Fn>
-void stream(const std::string& method, int window, long steps, long every, Fn sample) {
+void stream(gssm::Method method, int window, long steps, long every, Fn sample) {
   const gssm::models::Radar2D radar;
   gssm::EstimatorOptions o;
   o.method = method;
-  o.window = window;
+  o.fixed_lag.window = o.paper_window.window = window;
   auto est = gssm::makeEstimator(radar, o);
   std::mt19937 rng(1);
   std::normal_distribution<double> n01(0, 1);
@@ -56,14 +56,14 @@ int main(int argc, char** argv) {
   gssm::plot::Series pw{"paper window (full re-solve)", {}, {}, gssm::plot::paletteColor(3), 2, false};
   gssm::plot::Series ekf{"EKF", {}, {}, gssm::plot::paletteColor(0), 2, true};
   double ekf_median = 0;
-  stream("ekf", 10, 3000, 3000, [&](long, double m) { ekf_median = m; });
+  stream(gssm::Method::Ekf, 10, 3000, 3000, [&](long, double m) { ekf_median = m; });
   for (int win : {1, 2, 5, 10, 20, 50, 100, 200}) {
-    stream("fixed-lag", win, 3000, 3000, [&](long, double m) {
+    stream(gssm::Method::FixedLag, win, 3000, 3000, [&](long, double m) {
       fl.x.push_back(win);
       fl.y.push_back(m * 1e6);
     });
     if (win <= 100)
-      stream("paper-window", win, 1000, 1000, [&](long, double m) {
+      stream(gssm::Method::PaperWindow, win, 1000, 1000, [&](long, double m) {
         pw.x.push_back(win);
         pw.y.push_back(m * 1e6);
       });
@@ -81,8 +81,8 @@ int main(int argc, char** argv) {
   h.ylabel = "median latency (us)";
   const long every = std::max(1000L, history / 50);
   std::size_t color = 0;
-  for (const std::string m : {"ekf", "fixed-lag", "incremental"}) {
-    gssm::plot::Series s{m, {}, {}, gssm::plot::paletteColor(color++), 2, false};
+  for (const gssm::Method m : {gssm::Method::Ekf, gssm::Method::FixedLag, gssm::Method::Incremental}) {
+    gssm::plot::Series s{gssm::methodName(m), {}, {}, gssm::plot::paletteColor(color++), 2, false};
     stream(m, 10, history, every, [&](long k, double med) {
       s.x.push_back(k / 1000.0);
       s.y.push_back(med * 1e6);

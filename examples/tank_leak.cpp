@@ -36,9 +36,9 @@ int main() {
   const double leak = 0.012, offset = 0.05;
   double level = 1.1;
   gssm::EstimatorOptions smoother, filter;
-  smoother.method = "fixed-lag";
-  smoother.window = 20;
-  filter.method = "ekf";
+  smoother.method = gssm::Method::FixedLag;
+  smoother.fixed_lag.window = 20;
+  filter.method = gssm::Method::Ekf;
   auto est = gssm::makeEstimator(tank, smoother);
   auto ekf = gssm::makeEstimator(tank, filter);
   for (int k = 1; k <= 2000; ++k) {

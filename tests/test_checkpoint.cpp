@@ -67,7 +67,7 @@ void expectBitIdenticalContinuation(const Model& model, const EstimatorOptions& 
     trace.push_back(observe(*full));
   }
   for (std::size_t cut : cuts) {
-    const std::string what = o.method + " restored after event " + std::to_string(cut);
+    const std::string what = std::string(methodName(o.method)) + " restored after event " + std::to_string(cut);
     auto first = makeEstimator(model, o);
     for (std::size_t i = 0; i < cut; ++i) {
       apply(*first, events[i]);
@@ -100,10 +100,10 @@ SimulatedRun radarRun(int steps, unsigned seed) {
 TEST(Checkpoint, EveryMethodContinuesBitIdenticallyOnTheRadar) {
   const models::Radar2D radar;
   const auto events = eventsOf(radarRun(60, 5));
-  for (const auto& method : estimatorMethods()) {
+  for (const auto& method : streamingMethods()) {
     EstimatorOptions o;
     o.method = method;
-    o.window = 10;
+    o.fixed_lag.window = o.paper_window.window = 10;
     // 0: fresh; 1 and 5: inside the nonlinear start-up; 30: window full.
     expectBitIdenticalContinuation(radar, o, events, {0, 1, 5, 30});
   }
@@ -113,7 +113,7 @@ TEST(Checkpoint, IteratedIncrementalAndNisContinueBitIdentically) {
   const models::Radar2D radar;
   const auto events = eventsOf(radarRun(20, 6));
   EstimatorOptions o;
-  o.method = "incremental";
+  o.method = Method::Incremental;
   o.compute_nis = true;
   o.smoother.iterate_to_convergence = true;
   o.smoother.max_iterations = 200;
@@ -132,10 +132,10 @@ TEST(Checkpoint, MultiRateWithInputsContinuesBitIdentically) {
     return u;
   };
   const auto events = eventsOf(simulate(nav, spec, gssm::testing::normalSampler(7)));
-  for (const std::string method : {"ekf", "incremental", "fixed-lag"}) {
+  for (const Method method : {Method::Ekf, Method::Incremental, Method::FixedLag}) {
     EstimatorOptions o;
     o.method = method;
-    o.window = 7;
+    o.fixed_lag.window = o.paper_window.window = 7;
     o.compute_nis = true;
     o.ekf.constant_process_noise = Eigen::VectorXd::Constant(3, 1e-8);
     ASSERT_EQ(events.size(), 80u);
@@ -149,21 +149,21 @@ TEST(Checkpoint, LinearModelWithoutConstantsContinuesBitIdentically) {
   SimulationSpec spec;
   spec.steps = 30;
   const auto events = eventsOf(simulate(model, spec, gssm::testing::normalSampler(4)));
-  for (const auto& method : estimatorMethods()) {
+  for (const auto& method : streamingMethods()) {
     EstimatorOptions o;
     o.method = method;
-    o.window = 4;
+    o.fixed_lag.window = o.paper_window.window = 4;
     expectBitIdenticalContinuation(model, o, events, {2, 17});
   }
 }
 
 namespace {
 // A fixed-lag checkpoint of a radar run (window full, marginal prior present).
-std::string radarCheckpoint(const std::string& method = "fixed-lag") {
+std::string radarCheckpoint(Method method = Method::FixedLag) {
   const models::Radar2D radar;
   EstimatorOptions o;
   o.method = method;
-  o.window = 5;
+  o.fixed_lag.window = o.paper_window.window = 5;
   auto est = makeEstimator(radar, o);
   for (const auto& m : radarRun(25, 9).measurements) est->addMeasurement(m.t, m.y);
   return checkpointBytes(*est, "progress");
@@ -219,7 +219,7 @@ TEST(Checkpoint, PayloadCorruptionBehindAValidChecksumIsCaughtOrHarmless) {
   // yields an estimator that can be read and stepped without crashing.
   const models::Radar2D radar;
   const auto more = radarRun(27, 9).measurements;
-  for (const std::string method : {"fixed-lag", "paper-window", "ekf"}) {
+  for (const Method method : {Method::FixedLag, Method::PaperWindow, Method::Ekf}) {
     const std::string bytes = radarCheckpoint(method);
     int rejected = 0, accepted = 0;
     for (std::size_t i = 28; i < bytes.size(); ++i) {
@@ -284,8 +284,8 @@ TEST(Checkpoint, CommittedVersionOneFilesStillRestore) {
   // The fuzzer's seeds are checkpoints written by this format version; if a
   // change breaks reading them, bump kCheckpointVersion and regenerate them.
   const models::Radar2D radar;
-  for (const auto& method : estimatorMethods()) {
-    const std::string path = std::string(GSSM_SOURCE_DIR) + "/tests/fuzz/corpus/checkpoint/radar-" + method + ".ckpt";
+  for (const auto& method : streamingMethods()) {
+    const std::string path = std::string(GSSM_SOURCE_DIR) + "/tests/fuzz/corpus/checkpoint/radar-" + methodName(method) + ".ckpt";
     CheckpointInfo info;
     auto est = restoreCheckpoint(radar, path, &info);
     EXPECT_EQ(info.method, method);

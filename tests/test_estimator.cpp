@@ -1,3 +1,4 @@
+#include <set>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -54,10 +55,10 @@ TEST(Estimator, EveryThrowingPathLeavesTheEstimatorUnchanged) {
   SimulationSpec spec;
   spec.steps = 20;
   const SimulatedRun run = simulate(radar, spec, normalSampler(2));
-  for (const auto& method : estimatorMethods()) {
+  for (const auto& method : streamingMethods()) {
     EstimatorOptions o;
     o.method = method;
-    o.window = 5;
+    o.fixed_lag.window = o.paper_window.window = 5;
     auto est = makeEstimator(radar, o);
     for (int k = 0; k < 12; ++k) est->addMeasurement(run.measurements[k].t, run.measurements[k].y);
     const Snapshot before(*est);
@@ -68,7 +69,7 @@ TEST(Estimator, EveryThrowingPathLeavesTheEstimatorUnchanged) {
     expectThrowsNaming([&] { est->addMeasurement(NAN, run.measurements[12].y); }, "measurement time");
     expectThrowsNaming([&] { est->addInput(t, Eigen::VectorXd::Constant(1, 1.0)); }, "input u");
     expectThrowsNaming([&] { est->addInput(0.0, Eigen::VectorXd(0)); }, "newest state");
-    before.expectSame(*est, method);
+    before.expectSame(*est, methodName(method));
     // and it carries on normally afterwards
     est->addMeasurement(t, run.measurements[12].y);
     EXPECT_EQ(est->step(), 13) << method;
@@ -112,10 +113,10 @@ class FailsOnLongSteps final : public Model {
 
 TEST(Estimator, NumericalFailureInsideAnUpdateLeavesTheEstimatorUnchanged) {
   const FailsOnLongSteps model;
-  for (const auto& method : estimatorMethods()) {
+  for (const auto& method : streamingMethods()) {
     EstimatorOptions o;
     o.method = method;
-    o.window = 3;
+    o.fixed_lag.window = o.paper_window.window = 3;
     auto est = makeEstimator(model, o);
     for (int k = 1; k <= 6; ++k) est->addMeasurement(0.1 * k, Eigen::VectorXd::Constant(1, 0.5));
     const Snapshot before(*est);
@@ -125,7 +126,7 @@ TEST(Estimator, NumericalFailureInsideAnUpdateLeavesTheEstimatorUnchanged) {
     } catch (const NumericalError& e) {
       EXPECT_FALSE(std::string(e.what()).empty());
     }
-    before.expectSame(*est, method + " after a failed update");
+    before.expectSame(*est, std::string(methodName(method)) + " after a failed update");
     est->addMeasurement(0.8, Eigen::VectorXd::Constant(1, 0.5));  // and it goes on
     EXPECT_EQ(est->step(), 7) << method;
   }
@@ -138,10 +139,10 @@ TEST(Estimator, FixedLagNewestStateEqualsKalmanFilterThroughTheStreamingApi) {
   spec.steps = 25;
   const SimulatedRun run = simulate(model, spec, normalSampler(8));
   const auto ref = gssm::testing::kalmanAndRts(gssm::testing::stack(model, 0.1), run.measurements);
-  for (const std::string method : {"ekf", "fixed-lag", "incremental"}) {
+  for (const Method method : {Method::Ekf, Method::FixedLag, Method::Incremental}) {
     EstimatorOptions o;
     o.method = method;
-    o.window = 4;
+    o.fixed_lag.window = o.paper_window.window = 4;
     auto est = makeEstimator(model, o);
     for (int k = 1; k <= spec.steps; ++k) {
       est->addMeasurement(run.measurements[k - 1].t, run.measurements[k - 1].y);
@@ -151,7 +152,7 @@ TEST(Estimator, FixedLagNewestStateEqualsKalmanFilterThroughTheStreamingApi) {
       EXPECT_LT(relativeError(e.covariance, ref.Pf[k]), 1e-8) << method << " step " << k;
       EXPECT_EQ(e.step, k);
     }
-    if (method == "incremental") {
+    if (method == Method::Incremental) {
       const auto s = est->smoothed(3);
       ASSERT_TRUE(s.has_value());
       EXPECT_LT(relativeError(s->mean, ref.zs[3]), 1e-8);
@@ -165,11 +166,11 @@ TEST(Estimator, FixedLagNewestStateEqualsKalmanFilterThroughTheStreamingApi) {
       ASSERT_TRUE(cov.has_value());
       EXPECT_LT(relativeError(*cov, batch.jointMarginalCovariance(pair)), 1e-8);
     }
-    if (method == "ekf") {
+    if (method == Method::Ekf) {
       EXPECT_FALSE(est->marginalCovariance({Key::state(3)}).has_value());
       EXPECT_LT(relativeError(*est->marginalCovariance({Key::constants()}), ref.Pf.back().bottomRightCorner(2, 2)), 1e-8);
     }
-    if (method == "fixed-lag") {
+    if (method == Method::FixedLag) {
       EXPECT_FALSE(est->smoothed(3).has_value());  // left the window
     }
   }
@@ -178,11 +179,45 @@ TEST(Estimator, FixedLagNewestStateEqualsKalmanFilterThroughTheStreamingApi) {
 TEST(Estimator, OptionsValidateNamesTheField) {
   const models::Radar2D radar;
   EstimatorOptions o;
-  o.method = "kalman";
-  expectThrowsNaming([&] { makeEstimator(radar, o); }, "unknown method 'kalman'");
-  o.method = "fixed-lag";
-  o.window = 0;
-  expectThrowsNaming([&] { makeEstimator(radar, o); }, "window");
+  o.method = Method::Batch;  // in the method table, but not streaming
+  expectThrowsNaming([&] { makeEstimator(radar, o); }, "'batch' needs the whole run");
+  o.method = Method::FixedLag;
+  o.fixed_lag.window = 0;
+  expectThrowsNaming([&] { makeEstimator(radar, o); }, "fixed_lag.window must be >= 1");
+  o.method = Method::PaperWindow;  // reads only its own window
+  EXPECT_NO_THROW(makeEstimator(radar, o));
+  o.paper_window.window = 0;
+  expectThrowsNaming([&] { makeEstimator(radar, o); }, "paper_window.window must be >= 1");
+}
+
+TEST(Method, OneTableNamesEveryMethodOnce) {
+  std::set<std::string> names;
+  for (const auto& info : methods()) {
+    EXPECT_TRUE(names.insert(info.name).second) << info.name;
+    EXPECT_EQ(methodNamed(info.name), info.method);
+    EXPECT_EQ(&methodInfo(info.method), &info);
+    EXPECT_EQ(info.streaming, info.method != Method::Batch);
+  }
+  EXPECT_EQ(names.size(), 5u);
+  EXPECT_FALSE(methodNamed("kalman").has_value());
+  EXPECT_EQ(streamingMethods().size(), 4u);
+}
+
+TEST(Estimator, ReportSaysWhatWasUsed) {
+  const models::Radar2D radar;
+  EstimatorOptions o(Method::FixedLag);
+  o.fixed_lag.window = 7;
+  o.incremental.ordering = EliminationOrdering::ConstrainedColamd;  // not read by the fixed lag
+  auto fl = makeEstimator(radar, o);
+  EXPECT_EQ(fl->report().method, Method::FixedLag);
+  EXPECT_EQ(fl->report().window, 7);
+  EXPECT_EQ(fl->report().ordering, EliminationOrdering::TimeOrdered);
+  o.method = Method::Incremental;
+  auto inc = makeEstimator(radar, o);
+  EXPECT_EQ(inc->report().window, 0);
+  EXPECT_EQ(inc->report().ordering, EliminationOrdering::ConstrainedColamd);
+  o.method = Method::Ekf;
+  EXPECT_FALSE(makeEstimator(radar, o)->report().ordering.has_value());
 }
 
 TEST(PaperWindow, IsOverConfidentComparedWithTheExactFixedLagSmoother) {
@@ -193,8 +228,8 @@ TEST(PaperWindow, IsOverConfidentComparedWithTheExactFixedLagSmoother) {
   spec.steps = 200;
   const SimulatedRun run = simulate(radar, spec, normalSampler(9));
   EstimatorOptions pw, fl;
-  pw.method = "paper-window";
-  fl.method = "fixed-lag";
+  pw.method = Method::PaperWindow;
+  fl.method = Method::FixedLag;
   auto a = makeEstimator(radar, pw), b = makeEstimator(radar, fl);
   for (const auto& m : run.measurements) {
     a->addMeasurement(m.t, m.y);

@@ -73,7 +73,7 @@ TEST(Config, BuiltinScenarioBuildsThePaperModel) {
   EXPECT_EQ(spec.steps, 50);
   EXPECT_FALSE(spec.process_noise);
   EXPECT_EQ((*spec.xb)[1], 1000);
-  EXPECT_EQ(ekfOptions(ini, *model).constant_process_noise[0], 0.005 * 0.005);
+  EXPECT_EQ(estimatorOptions(ini, *model).ekf.constant_process_noise[0], 0.005 * 0.005);
   EXPECT_THROW(builtinScenario("nope", 1, 1), InvalidArgument);
 }
 
@@ -112,19 +112,38 @@ TEST(Config, EstimatorSectionsAreReadAndChecked) {
   ini.set("fixed_lag", "window", "25");
   ini.set("smoother", "iterate_to_convergence", "true");
   ini.set("smoother", "newton_polish_steps", "4");
+  ini.set("batch", "algorithm", "gauss-newton");
+  ini.set("batch", "newton_polish_steps", "2");
   const auto parsed = IniDocument::parse(ini.toString(), "s.ini");
-  const SmootherOptions o = smootherOptions(parsed);
-  EXPECT_EQ(o.ordering, EliminationOrdering::TimeOrdered);
+  const auto model = makeModel(parsed);
+  const EstimatorOptions eo = estimatorOptions(parsed, *model);
+  const SmootherOptions& o = eo.smoother;
+  EXPECT_EQ(eo.incremental.ordering, EliminationOrdering::TimeOrdered);
   EXPECT_EQ(o.relinearize_threshold, 0.5);
   EXPECT_TRUE(o.iterate_to_convergence);
   EXPECT_EQ(o.newton_polish_steps, 4);
-  EXPECT_EQ(windowOption(parsed, "fixed_lag", 10), 25);
-  EXPECT_EQ(windowOption(parsed, "paper_window", 10), 10);
+  EXPECT_EQ(eo.fixed_lag.window, 25);
+  EXPECT_EQ(eo.paper_window.window, 10);
+  EXPECT_EQ(eo.batch.method, BatchSolverOptions::Method::GaussNewton);
+  EXPECT_EQ(eo.batch.newton_polish_steps, 2);
+  EXPECT_EQ(estimatorOptions(parsed, *model, Method::PaperWindow).window(), 10);
+  EXPECT_EQ(estimatorOptions(parsed, *model, Method::FixedLag).window(), 25);
   ini.set("smoother", "wildfire", "1");
-  expectInputError([&] { smootherOptions(IniDocument::parse(ini.toString(), "s.ini")); },
+  expectInputError([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
                    {"s.ini", "unknown key 'wildfire'", "[smoother]"});
   ini = builtinScenario("paper", 1, 10);
   ini.set("fixed_lag", "window", "0");
-  expectInputError([&] { windowOption(IniDocument::parse(ini.toString(), "s.ini"), "fixed_lag", 10); },
-                   {"s.ini", "window"});
+  expectInputError([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
+                   {"s.ini", "[fixed_lag]", "window"});
+  ini = builtinScenario("paper", 1, 10);
+  ini.set("batch", "algorithm", "newton");
+  expectInputError([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
+                   {"s.ini", "[batch] algorithm", "'newton'"});
+}
+
+TEST(Config, MethodNamesAreParsedAtTheEdge) {
+  EXPECT_EQ(parseMethod("fixed-lag", "option --method"), Method::FixedLag);
+  EXPECT_EQ(parseMethod("batch", "option --method"), Method::Batch);
+  expectInputError([] { parseMethod("kalman", "option --method"); },
+                   {"option --method", "'kalman'", "ekf, batch, incremental, fixed-lag, paper-window"});
 }

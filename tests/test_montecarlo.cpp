@@ -18,11 +18,12 @@ TEST(ChiSquare, QuantilesMatchTables) {
 }
 
 TEST(MonteCarlo, SmallRunIsConsistentWithItsOwnDefinitions) {
-  const auto scenario = io::builtinScenario("consistent", 1, 60);
+  io::LoadedScenario loaded = io::loadScenario(io::builtinScenario("consistent", 1, 60));
+  loaded.scenario.options.fixed_lag.window = loaded.scenario.options.paper_window.window = 5;
+  const MonteCarloScenario& scenario = loaded.scenario;
   MonteCarloOptions o;
   o.seeds = 6;
   o.threads = 2;
-  o.window = 5;
   auto sampler = [](unsigned seed) {
     auto rng = std::make_shared<std::mt19937>(seed);
     auto d = std::make_shared<std::normal_distribution<double>>(0.0, 1.0);
@@ -45,11 +46,25 @@ TEST(MonteCarlo, SmallRunIsConsistentWithItsOwnDefinitions) {
       EXPECT_LE(ma.beats_ekf[i], 1.0);
     }
   }
-  EXPECT_EQ(a.methods[0].method, "ekf");
+  EXPECT_EQ(a.methods[0].method, Method::Ekf);
   EXPECT_NE(a.markdown().find("| fixed-lag |"), std::string::npos);
   MonteCarloOptions bad;
-  bad.methods = {"fixed-lag"};
+  bad.methods = {Method::FixedLag};
   EXPECT_THROW(runMonteCarlo(scenario, bad, sampler), InvalidArgument);
+}
+
+// The Monte Carlo reads every estimator section of its scenario, as
+// gssm-process does (it once ignored [smoother] and [fixed_lag]).
+TEST(MonteCarlo, ScenarioCarriesEveryEstimatorSection) {
+  io::IniDocument ini = io::builtinScenario("paper", 1, 20);
+  ini.set("fixed_lag", "window", "3");
+  ini.set("smoother", "relinearize_threshold", "0.25");
+  const io::LoadedScenario loaded = io::loadScenario(io::IniDocument::parse(ini.toString(), "s.ini"));
+  EXPECT_EQ(loaded.scenario.options.fixed_lag.window, 3);
+  EXPECT_EQ(loaded.scenario.options.smoother.relinearize_threshold, 0.25);
+  EXPECT_EQ(loaded.scenario.options.ekf.constant_process_noise[0], 0.005 * 0.005);
+  EXPECT_EQ(loaded.scenario.truth, loaded.truth.get());
+  EXPECT_EQ(loaded.scenario.estimator, nullptr);
 }
 
 #include "gssm/models/linear.h"
@@ -68,9 +83,9 @@ TEST(Consistency, KalmanFilterIsConsistentAndAnOverConfidentOneIsFlagged) {
   scenario.set("scenario", "steps", "60");
   MonteCarloOptions o;
   o.seeds = 200;
-  o.methods = {"ekf"};
+  o.methods = {Method::Ekf};
   const auto sampler = [](unsigned seed) { return gssm::testing::normalSampler(seed); };
-  const MonteCarloResult good = runMonteCarlo(scenario, o, sampler);
+  const MonteCarloResult good = runMonteCarlo(io::loadScenario(scenario).scenario, o, sampler);
   EXPECT_GT(good.methods[0].mean_nees, good.nees_lo);
   EXPECT_LT(good.methods[0].mean_nees, good.nees_hi);
   EXPECT_EQ(good.methods[0].consistency, "consistent");
@@ -80,8 +95,9 @@ TEST(Consistency, KalmanFilterIsConsistentAndAnOverConfidentOneIsFlagged) {
   sys.noise.R /= 4.0;  // the estimator believes the sensor is twice as precise
   io::IniDocument overconfident;
   io::writeModel(models::LinearModel(sys), overconfident);
-  o.estimator_config = overconfident;
-  const MonteCarloResult bad = runMonteCarlo(scenario, o, sampler);
+  const io::LoadedScenario mistuned = io::loadScenario(scenario, &overconfident);
+  ASSERT_NE(mistuned.scenario.estimator, nullptr);
+  const MonteCarloResult bad = runMonteCarlo(mistuned.scenario, o, sampler);
   EXPECT_EQ(bad.methods[0].consistency, "over-confident") << "mean NEES " << bad.methods[0].mean_nees;
   EXPECT_EQ(bad.methods[0].nis_consistency, "over-confident") << "mean NIS " << bad.methods[0].mean_nis;
   EXPECT_NE(bad.markdown().find("over-confident"), std::string::npos);
@@ -100,7 +116,7 @@ TEST(Consistency, GenericNisEqualsTheKalmanFiltersInnovationStatistic) {
   const SimulatedRun run = simulate(model, spec, gssm::testing::normalSampler(63));
   ExtendedKalmanFilter kf(model);
   std::vector<std::unique_ptr<Estimator>> ests;
-  for (const std::string m : {"ekf", "fixed-lag", "incremental"}) {
+  for (const Method m : {Method::Ekf, Method::FixedLag, Method::Incremental}) {
     EstimatorOptions o;
     o.method = m;
     o.compute_nis = true;

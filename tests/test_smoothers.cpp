@@ -41,9 +41,7 @@ TEST(IncrementalSmoother, LinearModelEqualsBatchAfterEveryStep) {
     SimulationSpec spec;
     spec.steps = 40;
     const SimulatedRun run = simulate(model, spec, normalSampler(6));
-    SmootherOptions o;
-    o.ordering = ordering;
-    IncrementalSmoother smoother(o);
+    IncrementalSmoother smoother(SmootherOptions{}, ordering);
     auto [f0, v0] = gssm::testing::initialStep(model);
     smoother.update(f0, v0);
     for (int k = 1; k <= spec.steps; ++k) {
@@ -227,10 +225,10 @@ TEST(MultiRate, RangesEveryFifthStepBatchEqualsIncrementalAfterEveryUpdate) {
     inputs.push_back({run.times[k], Eigen::VectorXd::Constant(1, std::cos(0.3 * k))});
     if ((k + 1) % 5 == 0) ms.push_back(run.measurements[static_cast<std::size_t>(k)]);
   }
-  for (const std::string method : {"incremental", "fixed-lag", "ekf", "paper-window"}) {
+  for (const Method method : {Method::Incremental, Method::FixedLag, Method::Ekf, Method::PaperWindow}) {
     EstimatorOptions o;
     o.method = method;
-    o.window = 30;  // longer than the run: fixed-lag then equals incremental
+    o.fixed_lag.window = o.paper_window.window = 30;  // longer than the run: fixed-lag then equals incremental
     auto est = makeEstimator(model, o);
     std::size_t next_m = 0;
     for (int k = 0; k < spec.steps; ++k) {
@@ -238,7 +236,7 @@ TEST(MultiRate, RangesEveryFifthStepBatchEqualsIncrementalAfterEveryUpdate) {
       if (next_m < ms.size() && std::abs(ms[next_m].t - run.times[k + 1]) < 1e-12) {
         est->addMeasurement(ms[next_m].t, ms[next_m].y);
         ++next_m;
-        if (method == "paper-window") continue;  // runs, but is not exact
+        if (method == Method::PaperWindow) continue;  // runs, but is not exact
         const std::vector<Measurement> upto(ms.begin(), ms.begin() + static_cast<long>(next_m));
         const std::vector<Input> in_upto(inputs.begin(), inputs.begin() + k + 1);
         Problem p = buildProblem(model, upto, in_upto);
@@ -292,10 +290,10 @@ TEST(Nav2D, BatchEqualsIncrementalAfterEveryUpdateAndFixedLagEqualsIncremental) 
   for (int every : {1, 5}) {
     const SimulatedRun run = navRun(nav, 150, every, 21);
     EstimatorOptions inc_o, fl_o;
-    inc_o.method = "incremental";
+    inc_o.method = Method::Incremental;
     inc_o.smoother.iterate_to_convergence = true;
-    fl_o.method = "fixed-lag";
-    fl_o.window = 1000;  // longer than the run
+    fl_o.method = Method::FixedLag;
+    fl_o.fixed_lag.window = fl_o.paper_window.window = 1000;  // longer than the run
     fl_o.smoother.iterate_to_convergence = true;
     auto inc = makeEstimator(nav, inc_o), fl = makeEstimator(nav, fl_o);
     Values warm;

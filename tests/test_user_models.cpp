@@ -54,7 +54,7 @@ TEST(FunctionModel, NumericJacobianPathGivesTheSameEstimatesAsTheAnalyticPath) {
   SimulationSpec spec;
   spec.steps = 300;
   const SimulatedRun run = simulate(analytic, spec, normalSampler(5));
-  for (const auto& method : estimatorMethods()) {
+  for (const auto& method : streamingMethods()) {
     EstimatorOptions o;
     o.method = method;
     auto a = makeEstimator(analytic, o), n = makeEstimator(numeric, o);
@@ -99,7 +99,7 @@ TEST(LinearModel, ReadFromIniGivesTheSameEstimatesAsBuiltInCpp) {
   SimulationSpec spec;
   spec.steps = 50;
   const SimulatedRun run = simulate(cpp, spec, normalSampler(4));
-  for (const std::string method : {"ekf", "fixed-lag", "incremental"}) {
+  for (const Method method : {Method::Ekf, Method::FixedLag, Method::Incremental}) {
     EstimatorOptions o;
     o.method = method;
     auto a = makeEstimator(cpp, o), b = makeEstimator(*from_ini, o);
@@ -131,7 +131,7 @@ TEST(FunctionModel, NumericJacobiansOnNav2DGiveTheSameEstimates) {
   spec.measure_every = 2;
   spec.input = [](double t, const Eigen::VectorXd&) { return Eigen::VectorXd(Eigen::Vector2d(0.3 * std::cos(t), 0.2)); };
   const SimulatedRun run = simulate(nav, spec, normalSampler(17));
-  for (const auto& method : estimatorMethods()) {
+  for (const auto& method : streamingMethods()) {
     EstimatorOptions o;
     o.method = method;
     auto a = makeEstimator(nav, o), n = makeEstimator(numeric, o);

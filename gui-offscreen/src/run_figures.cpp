@@ -4,25 +4,17 @@
 #include <cmath>
 #include <filesystem>
 
-#include "gssm/models/nav2d.h"
 #include "gssm/plot/figure.h"
 
 namespace gssm::plot {
 
 namespace {
-std::string display(const std::string& method) {
-  if (method == "batch") return "batch MAP (smoother)";
-  if (method == "incremental") return "GSSM incremental";
-  if (method == "fixed-lag") return "GSSM fixed-lag";
-  if (method == "paper-window") return "paper window";
-  if (method == "ekf") return "EKF";
-  return method;
-}
+std::string display(Method method) { return methodInfo(method).label; }
 }  // namespace
 
 std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
-                                         const io::Truth* truth, const std::string& dir,
-                                         const std::string& scenario_label) {
+                                         const Truth* truth, const std::string& dir,
+                                         const std::string& scenario_label, const std::optional<PlanView>& plan) {
   namespace fs = std::filesystem;
   std::vector<std::string> written;
   const auto names = model.stackedStateNames();
@@ -70,14 +62,13 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
     savePng(f, path);
     written.push_back(path);
   }
-  // A plan view for models with a 2-D position (px, py): truth, estimates, beacons.
-  const auto ipx = std::find(names.begin(), names.end(), "px"), ipy = std::find(names.begin(), names.end(), "py");
-  if (ipx != names.end() && ipy != names.end()) {
-    const auto ix = static_cast<Eigen::Index>(ipx - names.begin()), iy = static_cast<Eigen::Index>(ipy - names.begin());
+  // The plan view: truth, estimates, landmarks.
+  if (plan) {
+    const Eigen::Index ix = plan->x, iy = plan->y;
     Figure f;
     f.title = "trajectory, plan view (" + scenario_label + ")";
-    f.xlabel = "px (m)";
-    f.ylabel = "py (m)";
+    f.xlabel = names.at(static_cast<std::size_t>(ix)) + " (m)";
+    f.ylabel = names.at(static_cast<std::size_t>(iy)) + " (m)";
     f.robust_quantile = 0.0;
     for (std::size_t r = 0; r < runs.size(); ++r) {
       Series s{display(runs[r].method), {}, {}, paletteColor(r), 2, false};
@@ -95,11 +86,11 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
       }
       f.series.push_back(std::move(t));
     }
-    if (const auto* nav = dynamic_cast<const models::Nav2D*>(&model)) {
-      for (std::size_t b = 0; b < nav->beacons().size(); ++b) {
-        // a small square marker per beacon, drawn as a closed series
-        const Eigen::Vector2d c = nav->beacons()[b];
-        Series m{b == 0 ? "beacons" : "", {c.x() - 3, c.x() + 3, c.x() + 3, c.x() - 3, c.x() - 3},
+    {
+      for (std::size_t b = 0; b < plan->landmarks.size(); ++b) {
+        // a small square marker per landmark, drawn as a closed series
+        const Eigen::Vector2d c = plan->landmarks[b];
+        Series m{b == 0 ? plan->landmark_label : "", {c.x() - 3, c.x() + 3, c.x() + 3, c.x() - 3, c.x() - 3},
                  {c.y() - 3, c.y() - 3, c.y() + 3, c.y() + 3, c.y() - 3}, Color{200, 0, 0}, 3, false};
         f.series.push_back(std::move(m));
       }

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "gssm/analysis.h"
-#include "gssm/io/dataset.h"
 #include "gssm/montecarlo.h"
 
 namespace gssm {
@@ -28,10 +27,11 @@ struct ScenarioAnalysis {
   std::string markdown() const;
 };
 
-/// `dataset` must hold truth.csv; `scenario` is its scenario.ini (used to
-/// simulate the Monte Carlo runs).
-ScenarioAnalysis analyzeScenario(const Model& model, const io::Dataset& dataset,
-                                 const io::IniDocument& scenario, const MonteCarloOptions& options,
+/// `recorded` is one run with its truth (a dataset with truth.csv, see
+/// io::recordedRun), evaluated with the scenario's truth model; the Monte
+/// Carlo simulates `scenario`.
+ScenarioAnalysis analyzeScenario(const MonteCarloScenario& scenario, const SimulatedRun& recorded,
+                                 const MonteCarloOptions& options,
                                  const std::function<NormalSampler(unsigned)>& sampler_for_seed);
 
 }  // namespace gssm

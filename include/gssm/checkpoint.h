@@ -9,7 +9,7 @@
 // continuing gives the same bits as the uninterrupted run, for the same
 // build.
 //
-//   auto est = gssm::makeEstimator(radar, {"fixed-lag"});
+//   auto est = gssm::makeEstimator(radar, {gssm::Method::FixedLag});
 //   ...                                  // feed data
 //   gssm::saveCheckpoint(*est, "run.ckpt");
 //   auto again = gssm::restoreCheckpoint(radar, "run.ckpt");   // continue
@@ -40,7 +40,7 @@ constexpr std::uint32_t kCheckpointVersion = 1;
 /// What a checkpoint says about itself (filled by restore).
 struct CheckpointInfo {
   std::uint32_t version = 0;
-  std::string method;        ///< estimator method
+  Method method = Method::FixedLag;  ///< estimator method
   std::string model;         ///< Model::name() of the model that wrote it
   std::int64_t step = 0;     ///< the estimator's step counter
   double time = 0;           ///< time of its newest state

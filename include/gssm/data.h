@@ -1,5 +1,6 @@
 #pragma once
-// Time-stamped inputs and measurements as they arrive from sensors.
+// Time-stamped inputs and measurements as they arrive from sensors, and the
+// true trajectory of a recorded or simulated run.
 #include <Eigen/Core>
 #include <vector>
 
@@ -14,6 +15,12 @@ struct Measurement {
 struct Input {
   double t = 0.0;
   Eigen::VectorXd u;
+};
+
+/// Ground truth: the stacked state [x_c; x_b] at known times (increasing).
+struct Truth {
+  std::vector<double> times;
+  std::vector<Eigen::VectorXd> states;
 };
 
 }  // namespace gssm

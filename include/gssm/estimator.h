@@ -5,7 +5,7 @@
 // the paper's window re-solve, so applications switch by name.
 //
 //   gssm::models::Radar2D radar;
-//   auto est = gssm::makeEstimator(radar, {"fixed-lag"});
+//   auto est = gssm::makeEstimator(radar, {gssm::Method::FixedLag});
 //   for (const auto& m : measurements) est->addMeasurement(m.t, m.y);
 //   std::cout << est->current().mean.transpose() << "\n";
 //
@@ -21,7 +21,9 @@
 #include <string>
 #include <vector>
 
+#include "gssm/batch_solver.h"
 #include "gssm/ekf.h"
+#include "gssm/method.h"
 #include "gssm/model.h"
 #include "gssm/smoothers.h"
 
@@ -36,7 +38,12 @@ struct StateEstimate {
 };
 
 struct EstimatorReport {
-  std::string method;
+  Method method = Method::FixedLag;
+  /// What the method was run with: the states it keeps (fixed-lag,
+  /// paper-window; 0 = all or not a window method) and, for the smoothers,
+  /// the elimination ordering (the fixed lag always orders by time).
+  int window = 0;
+  std::optional<EliminationOrdering> ordering;
   std::int64_t steps = 0;     ///< measurements processed
   double seconds = 0;         ///< wall time of the last addMeasurement
   int iterations = 0;         ///< solver iterations of the last update (1 for the EKF)
@@ -49,25 +56,40 @@ struct EstimatorReport {
   double nis = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// Settings of the methods that read them (the method table, method.h,
+/// says which; io::estimatorOptions reads each group from its INI section).
 struct EstimatorOptions {
-  /// ekf | incremental | fixed-lag | paper-window
-  std::string method = "fixed-lag";
-  int window = 10;            ///< fixed-lag and paper-window: states kept
-  ExtendedKalmanFilterOptions ekf;
-  SmootherOptions smoother;
+  Method method = Method::FixedLag;
   double t0 = 0.0;            ///< time of x_c(0)
   /// Compute the NIS of every measurement (costs one covariance query per update).
   bool compute_nis = false;
+
+  ExtendedKalmanFilterOptions ekf;  ///< ekf  [ekf]
+  SmootherOptions smoother;         ///< incremental, fixed-lag: relinearization  [smoother]
+  struct Incremental {
+    EliminationOrdering ordering = EliminationOrdering::ConstrainedColamd;  ///< [smoother] ordering
+  } incremental;
+  struct Window {
+    int window = 10;                ///< states x_c kept (the newest)
+  };
+  Window fixed_lag;                 ///< [fixed_lag] window; always time-ordered
+  Window paper_window;              ///< [paper_window] window
+  BatchSolverOptions batch;         ///< batch  [batch]
+
+  /// The window of a window method (fixed-lag, paper-window), else 0.
+  int window() const {
+    return method == Method::FixedLag ? fixed_lag.window : method == Method::PaperWindow ? paper_window.window : 0;
+  }
+  EstimatorOptions() = default;
+  EstimatorOptions(Method m) : method(m) {}  // NOLINT: {Method::Ekf} reads as intended
   bool validate(const Model& model, std::string* why = nullptr) const;
 };
-
-/// Names accepted by makeEstimator.
-std::vector<std::string> estimatorMethods();
 
 class Estimator {
  public:
   virtual ~Estimator() = default;
-  const std::string& method() const { return report_.method; }
+  Method method() const { return report_.method; }
+  const char* methodName() const { return gssm::methodName(report_.method); }
 
   /// Input u held from time t on (zero-order hold). A t after the newest
   /// state first advances the state to t (a step with no measurement, under
@@ -100,7 +122,7 @@ class Estimator {
   const EstimatorOptions& options() const { return options_; }
 
  protected:
-  Estimator(const Model& model, const std::string& method, double t0);
+  Estimator(const Model& model, Method method, double t0);
   /// Processes a validated step k−1 → k under input u, with the measurement
   /// y at x_c(k) when y is non-empty; must be strongly exception safe.
   virtual void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u,
@@ -133,8 +155,9 @@ class Estimator {
   mutable bool detail_stale_ = false;
 };
 
-/// Builds the estimator named by options.method; the model must outlive it.
-/// Throws InvalidArgument naming the option at fault.
+/// Builds the streaming estimator options.method names; the model must
+/// outlive it. Throws InvalidArgument naming the option at fault (and for
+/// Method::Batch, which needs the whole run: see runOffline, BatchSolver).
 std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOptions& options = {});
 
 }  // namespace gssm

@@ -4,13 +4,13 @@
 #include <string>
 #include <vector>
 
-#include "gssm/io/dataset.h"
+#include "gssm/data.h"
 #include "gssm/offline.h"
 
 namespace gssm {
 
 struct RunMetrics {
-  std::string method;
+  Method method = Method::Ekf;
   std::vector<std::string> names;  ///< stacked state names
   std::size_t rows = 0;            ///< estimates compared with the truth
   Eigen::VectorXd rmse;            ///< per stacked state (empty without truth)
@@ -24,7 +24,7 @@ struct RunMetrics {
 
 /// Matches rows to truth by time (to 1e-9 s); throws InvalidArgument if an
 /// estimate time has no truth row.
-RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const io::Truth* truth);
+RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth* truth);
 
 /// Percentile (0..100) of a sample, by linear interpolation; 0 for empty.
 double percentile(std::vector<double> v, double p);

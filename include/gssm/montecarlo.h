@@ -7,27 +7,38 @@
 #include <string>
 #include <vector>
 
-#include "gssm/io/ini.h"
+#include "gssm/estimator.h"
 #include "gssm/simulation.h"
 
 namespace gssm {
+
+/// What a Monte Carlo simulates and with what it estimates (io::
+/// monteCarloScenario builds one from a scenario.ini).
+struct MonteCarloScenario {
+  std::string name;
+  const Model* truth = nullptr;      ///< simulates every seed's run (must outlive the call)
+  SimulationSpec spec;
+  /// The estimators' own model and priors when they differ from the truth's
+  /// (e.g. a deliberately mis-tuned R); null: the truth's. Same dimensions.
+  const Model* estimator = nullptr;
+  /// Every method's settings (windows, [smoother], [ekf], [batch]); the
+  /// method is set per run.
+  EstimatorOptions options;
+};
 
 struct MonteCarloOptions {
   int seeds = 100;
   unsigned first_seed = 1;
   int threads = 2;
-  int window = 10;
-  std::vector<std::string> methods{"ekf", "fixed-lag", "incremental", "paper-window", "batch"};
-  /// The estimators' own model and priors ([model], [prior], [ekf]) when they
-  /// differ from the truth's, e.g. a deliberately mis-tuned R; empty: same.
-  std::optional<io::IniDocument> estimator_config;
+  std::vector<Method> methods{Method::Ekf, Method::FixedLag, Method::Incremental, Method::PaperWindow,
+                              Method::Batch};
   /// Called from worker threads after each seed (done, total); may be empty.
   std::function<void(int, int)> progress;
   bool validate(std::string* why = nullptr) const;
 };
 
 struct MethodSummary {
-  std::string method;
+  Method method = Method::Ekf;
   Eigen::VectorXd mean_rmse;        ///< per stacked state, mean over seeds of the run's RMSE
   Eigen::VectorXd rms_final_error;  ///< per stacked state, RMS over seeds of the last error
   double mean_nees = 0;             ///< average over seeds and steps
@@ -58,10 +69,9 @@ struct MonteCarloResult {
   std::string markdown() const;
 };
 
-/// Runs the scenario described by `scenario` (as builtinScenario or a
-/// dataset's scenario.ini) for seeds first_seed.. with every method.
+/// Runs the scenario for seeds first_seed.. with every method.
 /// `sampler_for_seed` makes the N(0, 1) source of one seed.
-MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarloOptions& options,
+MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
                                const std::function<NormalSampler(unsigned)>& sampler_for_seed);
 
 /// χ²_k quantile (Wilson–Hilferty; accurate to ~1% for k ≥ 10).

@@ -23,7 +23,7 @@ struct EstimateRow {
 };
 
 struct OfflineRun {
-  std::string method;
+  Method method = Method::Ekf;
   std::vector<EstimateRow> rows;       ///< one per measurement (plus none for t0)
   std::vector<double> update_seconds;  ///< wall time of each update
   std::vector<double> nis;             ///< NIS of each measurement (streaming runs with compute_nis)
@@ -55,10 +55,19 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::function<void(std::size_t, std::size_t)>& progress = {},
                         const StreamingCheckpoints& checkpoints = {});
 
-/// The batch MAP of the whole run; rows hold the smoothed estimate at each
-/// measurement time with its marginal covariance.
-OfflineRun runBatch(const Model& model, const BatchSolverOptions& options,
+/// The batch MAP of the whole run (from an EKF pass with default options);
+/// rows hold the smoothed estimate at each measurement time with its
+/// marginal covariance.
+OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
                     const std::vector<Measurement>& measurements,
                     const std::vector<Input>& inputs = {});
+
+/// options.method over the whole recording: runBatch for the batch,
+/// runStreaming for the others (progress and checkpoints apply to those).
+OfflineRun runOffline(const Model& model, const EstimatorOptions& options,
+                      const std::vector<Measurement>& measurements,
+                      const std::vector<Input>& inputs = {},
+                      const std::function<void(std::size_t, std::size_t)>& progress = {},
+                      const StreamingCheckpoints& checkpoints = {});
 
 }  // namespace gssm

@@ -47,8 +47,9 @@ enum class EliminationOrdering {
   TimeOrdered,
 };
 
+/// The relinearization policy both smoothers share (the ordering is the
+/// IncrementalSmoother's choice; the fixed lag always orders by time).
 struct SmootherOptions {
-  EliminationOrdering ordering = EliminationOrdering::ConstrainedColamd;
   /// false: every factor keeps the linearization it was added with
   /// (exact for linear models; the cheapest mode).
   bool relinearize = true;
@@ -119,14 +120,19 @@ class Smoother {
 
 class IncrementalSmoother final : public Smoother {
  public:
-  explicit IncrementalSmoother(SmootherOptions options = {});
+  explicit IncrementalSmoother(SmootherOptions options = {},
+                               EliminationOrdering ordering = EliminationOrdering::ConstrainedColamd);
   UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values) override;
   const SmootherOptions& options() const;
+  EliminationOrdering ordering() const { return ordering_; }
+
+ private:
+  EliminationOrdering ordering_;
 };
 
 struct FixedLagSmootherOptions {
   int window = 10;  ///< states x_c kept (the newest ones); constants are never marginalized
-  SmootherOptions smoother;  ///< its ordering is forced to TimeOrdered
+  SmootherOptions smoother;  ///< eliminated in time order (the oldest state is a leaf)
   bool validate(std::string* why = nullptr) const;
 };
 

@@ -16,6 +16,7 @@ struct FieldWriter {
   void operator()(const std::int64_t& v, const char*) { out.i64(v); }
   void operator()(const std::string& v, const char*) { out.str(v); }
   void operator()(const Eigen::VectorXd& v, const char*) { out.vec(v); }
+  void operator()(const Method& m, const char*) { out.str(methodName(m)); }  // by name: stable
   template <class Enum>
   void enumeration(const Enum& v, int, const char*) { out.u8(static_cast<std::uint8_t>(v)); }
 };
@@ -29,6 +30,12 @@ struct FieldReader {
   void operator()(std::int64_t& v, const char* what) { v = in.i64(what); }
   void operator()(std::string& v, const char* what) { v = in.str(what); }
   void operator()(Eigen::VectorXd& v, const char* what) { v = in.vec(what); }
+  void operator()(Method& m, const char* what) {
+    const std::string name = in.str(what);
+    const auto method = methodNamed(name);
+    if (!method || !methodInfo(*method).streaming) in.fail(std::string(what) + ": no streaming method '" + name + "'");
+    m = *method;
+  }
   template <class Enum>
   void enumeration(Enum& v, int max, const char* what) {
     const std::uint8_t raw = in.u8(what);
@@ -42,11 +49,12 @@ struct FieldReader {
 template <class Io>
 void fields(Io& io, EstimatorOptions& o) {
   io(o.method, "estimator method");
-  io(o.window, "window");
+  // Format v1 holds one window: the method's (read after the method).
+  io(o.method == Method::PaperWindow ? o.paper_window.window : o.fixed_lag.window, "window");
   io(o.ekf.constant_process_noise, "ekf constant_process_noise");
   io(o.ekf.joseph_form, "ekf joseph_form");
   SmootherOptions& s = o.smoother;
-  io.enumeration(s.ordering, 1, "smoother ordering");
+  io.enumeration(o.incremental.ordering, 1, "smoother ordering");
   io(s.relinearize, "smoother relinearize");
   io(s.relinearize_threshold, "smoother relinearize_threshold");
   io(s.constants_check_sigmas, "smoother constants_check_sigmas");
@@ -135,7 +143,9 @@ void CheckpointAccess::loadEstimator(Estimator& e, ByteReader& in) {
     in.fail("input in force has size " + std::to_string(input.size()) + ", the model's inputs " +
             std::to_string(e.model_.dims().nu));
   EstimatorReport r;
-  r.method = e.report_.method;
+  r.method = e.report_.method;  // what makeEstimator set from the options
+  r.window = e.report_.window;
+  r.ordering = e.report_.ordering;
   FieldReader reader{in};
   fields(reader, r);
   // The base state first: the method's loadState checks itself against it.

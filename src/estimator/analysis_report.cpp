@@ -11,34 +11,21 @@
 namespace gssm {
 
 namespace {
-SimulatedRun runFromDataset(const Model& model, const io::Dataset& ds) {
-  if (!ds.truth) throw InvalidArgument("analysis: the dataset " + ds.dir + " has no truth.csv");
-  SimulatedRun run;
-  const int nc = model.dims().nc, nb = model.dims().nb;
-  for (std::size_t k = 0; k < ds.truth->times.size(); ++k) {
-    run.times.push_back(ds.truth->times[k]);
-    run.states.push_back(ds.truth->states[k].head(nc));
-  }
-  run.constants = ds.truth->states.front().tail(nb);
-  run.measurements = ds.measurements;
-  run.inputs = ds.inputs;
-  return run;
-}
-
-const MethodSummary* find(const MonteCarloResult& r, const std::string& m) {
+const MethodSummary* find(const MonteCarloResult& r, Method m) {
   for (const auto& s : r.methods)
     if (s.method == m) return &s;
   return nullptr;
 }
 }  // namespace
 
-ScenarioAnalysis analyzeScenario(const Model& model, const io::Dataset& dataset, const io::IniDocument& scenario,
+ScenarioAnalysis analyzeScenario(const MonteCarloScenario& scenario, const SimulatedRun& run,
                                  const MonteCarloOptions& options,
                                  const std::function<NormalSampler(unsigned)>& sampler_for_seed) {
+  if (!scenario.truth) throw InvalidArgument("analysis: the scenario has no truth model");
+  const Model& model = *scenario.truth;
   ScenarioAnalysis a;
-  a.scenario = scenario.getString("scenario", "name", dataset.dir);
+  a.scenario = scenario.name;
   a.state_names = model.stackedStateNames();
-  const SimulatedRun run = runFromDataset(model, dataset);
   const int stride = std::max<int>(1, static_cast<int>(run.measurements.size() / 40));
   a.bound = posteriorCramerRao(model, run, stride);
   const int nc = model.dims().nc, nb = model.dims().nb;
@@ -74,7 +61,7 @@ std::string ScenarioAnalysis::markdown() const {
      << "The bound is evaluated along the dataset's one true trajectory; where the runs draw their own truth "
      << "(a `consistent` scenario) efficiencies a little above 1 are sampling, not a violation.\n\n";
   os << "| state | filtering bound sd | smoothing bound sd |";
-  for (const auto& m : mc.methods) os << " " << m.method << " RMS (efficiency) |";
+  for (const auto& m : mc.methods) os << " " << methodName(m.method) << " RMS (efficiency) |";
   os << "\n| --- | --- | --- |";
   for (std::size_t i = 0; i < mc.methods.size(); ++i) os << " --- |";
   os << "\n";
@@ -86,7 +73,7 @@ std::string ScenarioAnalysis::markdown() const {
     os << "| " << state_names[i] << " | " << f << " | " << s << " |";
     for (const auto& m : mc.methods) {
       const double rms = m.rms_final_error[ii];
-      os << " " << rms << " (" << std::setprecision(2) << (m.method == "batch" ? s : f) / rms
+      os << " " << rms << " (" << std::setprecision(2) << (methodInfo(m.method).streaming ? f : s) / rms
          << std::setprecision(3) << ") |";
     }
     os << "\n";
@@ -98,7 +85,7 @@ std::string ScenarioAnalysis::markdown() const {
      << " dof, interval [" << mc.nis_lo << ", " << mc.nis_hi << "]) | steps inside | verdict |\n"
      << "| --- | --- | --- | --- | --- | --- | --- |\n";
   for (const auto& m : mc.methods) {
-    os << "| " << m.method << " | " << m.mean_nees << " | " << std::lround(100 * m.nees_step_in_interval)
+    os << "| " << methodName(m.method) << " | " << m.mean_nees << " | " << std::lround(100 * m.nees_step_in_interval)
        << "% | " << m.consistency << " | ";
     if (std::isfinite(m.mean_nis))
       os << m.mean_nis << " | " << std::lround(100 * m.nis_step_in_interval) << "% | " << m.nis_consistency << " |\n";
@@ -130,11 +117,12 @@ std::string ScenarioAnalysis::markdown() const {
   }
 
   os << "\n## 4. Does the GSSM improve on the EKF here?\n\n";
-  const MethodSummary* ekf = find(mc, "ekf");
-  for (const std::string g : {"fixed-lag", "incremental", "batch"}) {
+  const MethodSummary* ekf = find(mc, Method::Ekf);
+  for (const Method g : {Method::FixedLag, Method::Incremental, Method::Batch}) {
     const MethodSummary* m = find(mc, g);
+    const bool smoother = !methodInfo(g).streaming;  // uses future data
     if (!ekf || !m) continue;
-    os << "* **" << g << "**: ";
+    os << "* **" << methodName(g) << "**: ";
     std::vector<std::string> better, same, worse;
     for (std::size_t i = 0; i < n; ++i) {
       const auto ii = static_cast<Eigen::Index>(i);
@@ -152,13 +140,13 @@ std::string ScenarioAnalysis::markdown() const {
     if (!better.empty()) os << "better on " << list(better) << ". ";
     if (!same.empty()) os << "same as the EKF (within 5%) on " << list(same) << ". ";
     if (!worse.empty()) os << "worse on " << list(worse) << ". ";
-    if (g == "batch" && !better.empty())
+    if (smoother && !better.empty())
       os << "Why: smoothing — every state uses the later measurements too (not available online).";
-    else if (g != "batch" && !better.empty())
+    else if (!smoother && !better.empty())
       os << "Why: the window's factors are relinearized at the current estimate (the EKF linearizes each "
             "measurement once, at its prediction), which matters where the model is nonlinear for the "
             "prior's error (e.g. a start-up).";
-    else if (g != "batch")
+    else if (!smoother)
       os << "Why: the EKF's linearization is adequate here; both are the same Bayesian filter.";
     os << "\n";
   }

@@ -15,34 +15,32 @@
 
 namespace gssm {
 
-std::vector<std::string> estimatorMethods() {
-  return {"ekf", "incremental", "fixed-lag", "paper-window"};
-}
-
 bool EstimatorOptions::validate(const Model& model, std::string* why) const {
   auto fail = [&](const std::string& m) {
     if (why) *why = "EstimatorOptions: " + m;
     return false;
   };
-  const auto methods = estimatorMethods();
-  if (std::find(methods.begin(), methods.end(), method) == methods.end())
-    return fail("unknown method '" + method + "' (known: ekf, incremental, fixed-lag, paper-window)");
-  if (window < 1) return fail("window must be >= 1, got " + std::to_string(window));
+  const unsigned reads = methodInfo(method).reads;  // throws for a value outside the enum
   if (!std::isfinite(t0)) return fail("t0 must be finite");
-  if (!ekf.validate(model.dims().nb, why)) return false;
-  return smoother.validate(why);
+  if ((reads & kFixedLagOptions) && fixed_lag.window < 1)
+    return fail("fixed_lag.window must be >= 1, got " + std::to_string(fixed_lag.window));
+  if ((reads & kPaperWindowOptions) && paper_window.window < 1)
+    return fail("paper_window.window must be >= 1, got " + std::to_string(paper_window.window));
+  if ((reads & kEkfOptions) && !ekf.validate(model.dims().nb, why)) return false;
+  if ((reads & kBatchOptions) && !batch.validate(why)) return false;
+  return !(reads & kSmootherOptions) || smoother.validate(why);
 }
 
-Estimator::Estimator(const Model& model, const std::string& method, double t0)
+Estimator::Estimator(const Model& model, Method method, double t0)
     : model_(model), t_(t0) {
   report_.method = method;
 }
 
 void Estimator::saveState(internal::ByteWriter&) const {
-  throw CheckpointError(method() + ": this estimator does not support checkpoints");
+  throw CheckpointError(std::string(methodName()) + ": this estimator does not support checkpoints");
 }
 void Estimator::loadState(internal::ByteReader&) {
-  throw CheckpointError(method() + ": this estimator does not support checkpoints");
+  throw CheckpointError(std::string(methodName()) + ": this estimator does not support checkpoints");
 }
 
 const EstimatorReport& Estimator::report() const {
@@ -54,13 +52,13 @@ const EstimatorReport& Estimator::report() const {
 }
 
 void Estimator::addInput(double t, const Eigen::VectorXd& u) {
-  requireVector(u, model_.dims().nu, method() + ": input u at t = " + std::to_string(t));
+  requireVector(u, model_.dims().nu, std::string(methodName()) + ": input u at t = " + std::to_string(t));
   // A time stamp within rounding of the newest state's (k·T computed two
   // ways) means "now".
   if (std::isfinite(t) && t < t_ && t_ - t <= 1e-9 * std::max(1.0, std::abs(t_))) t = t_;
   if (!std::isfinite(t) || t < t_) {
     std::ostringstream os;
-    os << method() << ": input at t = " << t << " must be at or after the newest state (t = " << t_ << ")";
+    os << methodName() << ": input at t = " << t << " must be at or after the newest state (t = " << t_ << ")";
     throw InvalidArgument(os.str());
   }
   if (t > t_) advance(t);  // strong guarantee: throws before changing anything
@@ -107,11 +105,11 @@ void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
   const auto start = std::chrono::steady_clock::now();
   if (!std::isfinite(t) || t < t_ || (t == t_ && k_ == 0)) {
     std::ostringstream os;
-    os << method() << ": measurement time " << t << " must be after the previous state (" << t_ << ")"
+    os << methodName() << ": measurement time " << t << " must be after the previous state (" << t_ << ")"
        << (k_ == 0 ? ", the start t0" : "");
     throw InvalidArgument(os.str());
   }
-  requireVector(y, model_.dims().ny, method() + ": measurement y at t = " + std::to_string(t));
+  requireVector(y, model_.dims().ny, std::string(methodName()) + ": measurement y at t = " + std::to_string(t));
   const double nis = options_.compute_nis ? innovationNis(t - t_, inputInForce(), y) : report_.nis;
   if (t == t_) {
     doMeasurement(k_, y);  // at the newest state
@@ -141,7 +139,7 @@ Eigen::VectorXd stack(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) {
 class EkfEstimator final : public Estimator {
  public:
   EkfEstimator(const Model& m, const EstimatorOptions& o)
-      : Estimator(m, "ekf", o.t0), ekf_(m, o.ekf, o.t0) {}
+      : Estimator(m, Method::Ekf, o.t0), ekf_(m, o.ekf, o.t0) {}
 
   StateEstimate current() override { return {time(), step(), ekf_.mean(), ekf_.covariance()}; }
   std::optional<StateEstimate> smoothed(std::int64_t k) override {
@@ -232,10 +230,10 @@ std::vector<FactorPtr> priorFactors(const Model& m, Values& initial) {
 template <class Smoother>
 class SmootherEstimator final : public Estimator {
  public:
-  template <class Options>
-  SmootherEstimator(const Model& m, const std::string& name, const Options& o, double t0,
-                    std::size_t keep_times)
-      : Estimator(m, name, t0), smoother_(o), keep_times_(keep_times) {
+  /// `args` construct the smoother; keep_times = 0 keeps every state's time.
+  template <class... Args>
+  SmootherEstimator(const Model& m, Method method, double t0, std::size_t keep_times, Args&&... args)
+      : Estimator(m, method, t0), smoother_(std::forward<Args>(args)...), keep_times_(keep_times) {
     Values initial;
     const auto priors = priorFactors(m, initial);
     report_.smoother = smoother_.update(priors, initial);
@@ -319,7 +317,7 @@ class SmootherEstimator final : public Estimator {
 class PaperWindowEstimator final : public Estimator {
  public:
   PaperWindowEstimator(const Model& m, const EstimatorOptions& o)
-      : Estimator(m, "paper-window", o.t0), window_(o.window) {
+      : Estimator(m, Method::PaperWindow, o.t0), window_(o.paper_window.window) {
     values_.insert(Key::state(0), m.priorState().mean);
     prior_state_ = m.priorState();
     if (m.dims().nb > 0) {
@@ -497,19 +495,29 @@ std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOpti
   std::string why;
   if (!options.validate(model, &why)) throw InvalidArgument(why);
   std::unique_ptr<Estimator> e;
-  if (options.method == "ekf") {
-    e = std::make_unique<EkfEstimator>(model, options);
-  } else if (options.method == "incremental") {
-    e = std::make_unique<SmootherEstimator<IncrementalSmoother>>(model, "incremental", options.smoother,
-                                                                 options.t0, 0);
-  } else if (options.method == "fixed-lag") {
-    FixedLagSmootherOptions o;
-    o.window = options.window;
-    o.smoother = options.smoother;
-    e = std::make_unique<SmootherEstimator<FixedLagSmoother>>(model, "fixed-lag", o, options.t0,
-                                                              static_cast<std::size_t>(options.window));
-  } else {
-    e = std::make_unique<PaperWindowEstimator>(model, options);
+  switch (options.method) {
+    case Method::Ekf:
+      e = std::make_unique<EkfEstimator>(model, options);
+      break;
+    case Method::Incremental:
+      e = std::make_unique<SmootherEstimator<IncrementalSmoother>>(
+          model, Method::Incremental, options.t0, 0, options.smoother, options.incremental.ordering);
+      e->report_.ordering = options.incremental.ordering;
+      break;
+    case Method::FixedLag:
+      e = std::make_unique<SmootherEstimator<FixedLagSmoother>>(
+          model, Method::FixedLag, options.t0, static_cast<std::size_t>(options.fixed_lag.window),
+          FixedLagSmootherOptions{options.fixed_lag.window, options.smoother});
+      e->report_.window = options.fixed_lag.window;
+      e->report_.ordering = EliminationOrdering::TimeOrdered;
+      break;
+    case Method::PaperWindow:
+      e = std::make_unique<PaperWindowEstimator>(model, options);
+      e->report_.window = options.paper_window.window;
+      break;
+    case Method::Batch:
+      throw InvalidArgument("makeEstimator: method 'batch' needs the whole run (runOffline, BatchSolver); "
+                            "streaming methods: " + methodNameList(true));
   }
   e->options_ = options;
   return e;

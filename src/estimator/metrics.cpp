@@ -19,7 +19,7 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const io::Truth* truth) {
+RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth* truth) {
   RunMetrics m;
   m.method = run.method;
   m.names = model.stackedStateNames();
@@ -76,7 +76,7 @@ std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& 
   os << "],\n  \"methods\": {";
   for (std::size_t r = 0; r < runs.size(); ++r) {
     const RunMetrics& m = runs[r];
-    os << (r ? "," : "") << "\n    " << quoted(m.method) << ": {\n";
+    os << (r ? "," : "") << "\n    " << quoted(methodName(m.method)) << ": {\n";
     os << "      \"rows\": " << m.rows << ",\n";
     if (m.has_truth) {
       os << "      \"rmse\": " << perState(m.names, m.rmse) << ",\n";

@@ -12,7 +12,6 @@
 
 #include "gssm/error.h"
 #include "gssm/estimator.h"
-#include "gssm/io/config.h"
 #include "gssm/offline.h"
 
 namespace gssm {
@@ -24,9 +23,8 @@ bool MonteCarloOptions::validate(std::string* why) const {
   };
   if (seeds < 1) return fail("seeds must be >= 1");
   if (threads < 1) return fail("threads must be >= 1");
-  if (window < 1) return fail("window must be >= 1");
   if (methods.empty()) return fail("no methods");
-  if (std::find(methods.begin(), methods.end(), "ekf") == methods.end())
+  if (std::find(methods.begin(), methods.end(), Method::Ekf) == methods.end())
     return fail("methods must include ekf (the baseline every method is compared with)");
   return true;
 }
@@ -71,16 +69,20 @@ struct SeedResult {
 };
 }  // namespace
 
-MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarloOptions& options,
+MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
                                const std::function<NormalSampler(unsigned)>& sampler_for_seed) {
   std::string why;
   if (!options.validate(&why)) throw InvalidArgument(why);
+  if (!scenario.truth) throw InvalidArgument("MonteCarlo: the scenario has no truth model");
   const auto start = std::chrono::steady_clock::now();
-  const auto model = io::makeModel(scenario);  // the truth's
-  const SimulationSpec spec = io::simulationSpec(scenario, *model);
-  const io::IniDocument& est_config = options.estimator_config ? *options.estimator_config : scenario;
-  const auto est_model = options.estimator_config ? io::makeModel(est_config) : nullptr;
-  const Model& estimator_model = est_model ? *est_model : *model;
+  const Model* model = scenario.truth;
+  const SimulationSpec& spec = scenario.spec;
+  const Model& estimator_model = scenario.estimator ? *scenario.estimator : *model;
+  for (const Method m : options.methods) {
+    EstimatorOptions eo = scenario.options;
+    eo.method = m;
+    if (!eo.validate(estimator_model, &why)) throw InvalidArgument("MonteCarlo: " + why);
+  }
   if (estimator_model.dims().nc != model->dims().nc || estimator_model.dims().nb != model->dims().nb ||
       estimator_model.dims().ny != model->dims().ny || estimator_model.dims().nu != model->dims().nu)
     throw InvalidArgument("MonteCarlo: the estimators' model must have the truth model's dimensions");
@@ -103,18 +105,11 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
       for (std::size_t mi = 0; mi < M; ++mi) {
         SeedResult& r = results[mi][static_cast<std::size_t>(s)];
         try {
-          OfflineRun out;
-          if (options.methods[mi] == "batch") {
-            out = runBatch(estimator_model, BatchSolverOptions{}, run.measurements, run.inputs);
-          } else {
-            EstimatorOptions eo;
-            eo.method = options.methods[mi];
-            eo.window = options.window;
-            eo.ekf = io::ekfOptions(est_config, estimator_model);
-            eo.compute_nis = true;
-            out = runStreaming(estimator_model, eo, run.measurements, run.inputs);
-            r.nis = out.nis;
-          }
+          EstimatorOptions eo = scenario.options;
+          eo.method = options.methods[mi];
+          eo.compute_nis = true;
+          const OfflineRun out = runOffline(estimator_model, eo, run.measurements, run.inputs);
+          r.nis = out.nis;
           Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
           std::size_t j = 0;  // truth row at the estimate's time (multi-rate: not every step)
           for (std::size_t k = 0; k < out.rows.size(); ++k) {
@@ -141,7 +136,7 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
   for (auto& t : pool) t.join();
 
   MonteCarloResult res;
-  res.scenario = scenario.getString("scenario", "name", "?");
+  res.scenario = scenario.name;
   res.seeds = options.seeds;
   res.steps = spec.steps;
   res.dof = n;
@@ -152,7 +147,7 @@ MonteCarloResult runMonteCarlo(const io::IniDocument& scenario, const MonteCarlo
   res.nis_lo = chiSquareQuantile(0.025, res.nis_dof * options.seeds) / options.seeds;
   res.nis_hi = chiSquareQuantile(0.975, res.nis_dof * options.seeds) / options.seeds;
   const std::size_t ekf = static_cast<std::size_t>(
-      std::find(options.methods.begin(), options.methods.end(), "ekf") - options.methods.begin());
+      std::find(options.methods.begin(), options.methods.end(), Method::Ekf) - options.methods.begin());
   for (std::size_t mi = 0; mi < M; ++mi) {
     MethodSummary m;
     m.method = options.methods[mi];
@@ -229,7 +224,7 @@ std::string MonteCarloResult::markdown() const {
   os << "| method | mean RMSE (" << names << ") | RMS final error (" << names << ") | mean NEES | verdict | steps with NEES in 95% interval | mean NIS (" << nis_dof << " dof) | seeds beating the EKF (" << names << ") | failures |\n";
   os << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const auto& m : methods) {
-    os << "| " << m.method << (m.method == "batch" ? " (smoother, uses future data)" : "") << " | "
+    os << "| " << methodName(m.method) << (methodInfo(m.method).streaming ? "" : " (smoother, uses future data)") << " | "
        << perState(m.mean_rmse, 3) << " | " << perState(m.rms_final_error, 3) << " | ";
     os.precision(2);
     os << m.mean_nees << " | " << m.consistency << " | " << std::lround(100 * m.nees_step_in_interval) << "% | ";
@@ -237,7 +232,7 @@ std::string MonteCarloResult::markdown() const {
       os << m.mean_nis << " (" << m.nis_consistency << ", " << std::lround(100 * m.nis_step_in_interval)
          << "% of steps inside) | ";
     else os << "— | ";
-    if (m.method == "ekf") os << "— | ";
+    if (m.method == Method::Ekf) os << "— | ";
     else {
       Eigen::VectorXd pct = 100 * m.beats_ekf;
       os << perState(pct, 0) << " % | ";

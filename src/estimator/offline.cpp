@@ -34,7 +34,7 @@ std::string encodeRun(const OfflineRun& run, std::size_t next_measurement, std::
   internal::ByteWriter w;
   w.str(kRunTag);
   w.u64(data_fingerprint);
-  w.str(run.method);
+  w.str(methodName(run.method));
   w.u64(next_measurement);
   w.u64(next_input);
   w.i32(run.iterations);
@@ -58,7 +58,9 @@ OfflineRun decodeRun(const std::string& bytes, const std::string& source, std::s
   if (r.str("run tag") != kRunTag) r.fail("not the checkpoint of an offline run (gssm-process)");
   data_fingerprint = r.u64("data fingerprint");
   OfflineRun run;
-  run.method = r.str("method");
+  const std::string method = r.str("method");
+  if (!methodNamed(method)) r.fail("unknown method '" + method + "'");
+  run.method = *methodNamed(method);
   next_measurement = r.u64("measurements consumed");
   next_input = r.u64("inputs consumed");
   run.iterations = r.i32("iterations");
@@ -104,10 +106,11 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
       throw CheckpointError(checkpoints.resume_from + ": cannot resume this run: " + why);
     };
     if (info.method != options.method || out.method != options.method)
-      fail("it was written by method '" + info.method + "', this run is '" + options.method + "'");
-    if (est->options().window != options.window && options.method != "ekf" && options.method != "incremental")
-      fail("it was written with window " + std::to_string(est->options().window) + ", this run asks for " +
-           std::to_string(options.window));
+      fail(std::string("it was written by method '") + methodName(info.method) + "', this run is '" +
+           methodName(options.method) + "'");
+    if (est->report().window != options.window())
+      fail("it was written with window " + std::to_string(est->report().window) + ", this run asks for " +
+           std::to_string(options.window()));
     if (first <= measurements.size())
       for (std::size_t i = 0; i < first; ++i) data_hash = foldMeasurement(data_hash, measurements[i]);
     if (first > measurements.size() || next_input > inputs.size() || data_hash != fingerprint)
@@ -143,15 +146,15 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
   return out;
 }
 
-OfflineRun runBatch(const Model& model, const BatchSolverOptions& options,
+OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
                     const std::vector<Measurement>& measurements,
                     const std::vector<Input>& inputs) {
   OfflineRun out;
-  out.method = "batch";
+  out.method = Method::Batch;
   const auto start = Clock::now();
-  Problem p = buildProblem(model, measurements, inputs);
-  Values x = ekfInitialGuess(model, ExtendedKalmanFilterOptions{}, measurements, inputs);
-  BatchSolver solver(options);
+  Problem p = buildProblem(model, measurements, inputs, options.t0);
+  Values x = ekfInitialGuess(model, ExtendedKalmanFilterOptions{}, measurements, inputs, options.t0);
+  BatchSolver solver(options.batch);
   const BatchSolverSummary sum = solver.solve(p.graph, x);
   out.iterations = sum.iterations;
   out.summary = sum.toString();
@@ -174,6 +177,18 @@ OfflineRun runBatch(const Model& model, const BatchSolverOptions& options,
   }
   out.total_seconds = since(start);
   return out;
+}
+
+OfflineRun runOffline(const Model& model, const EstimatorOptions& options,
+                      const std::vector<Measurement>& measurements, const std::vector<Input>& inputs,
+                      const std::function<void(std::size_t, std::size_t)>& progress,
+                      const StreamingCheckpoints& checkpoints) {
+  if (methodInfo(options.method).streaming)
+    return runStreaming(model, options, measurements, inputs, progress, checkpoints);
+  if (!checkpoints.path.empty() || !checkpoints.resume_from.empty())
+    throw InvalidArgument(std::string("runOffline: checkpoints apply to streaming methods, not '") +
+                          methodName(options.method) + "'");
+  return runBatch(model, options, measurements, inputs);
 }
 
 }  // namespace gssm

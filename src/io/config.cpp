@@ -89,6 +89,15 @@ std::unique_ptr<Model> makeModel(const IniDocument& ini) {
                    "': unknown model (known: radar2d, linear, nav2d)");
 }
 
+std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini) {
+  std::vector<Eigen::Vector2d> out;
+  if (!ini.has("model", "beacons")) return out;
+  const Eigen::MatrixXd B = ini.getMatrix("model", "beacons");
+  if (B.cols() != 2) throw InputError(ini.source() + ": [model] beacons: expected rows of 'x y', one per beacon");
+  for (Eigen::Index i = 0; i < B.rows(); ++i) out.emplace_back(B(i, 0), B(i, 1));
+  return out;
+}
+
 void writeModel(const Model& model, IniDocument& ini) {
   ini.set("model", "type", model.name());
   if (const auto* lin = dynamic_cast<const models::LinearModel*>(&model)) {
@@ -119,7 +128,9 @@ void writeModel(const Model& model, IniDocument& ini) {
   }
 }
 
+namespace {
 ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& model) {
+  ini.requireOnlyKeys("ekf", {"constant_process_noise", "joseph_form"});
   ExtendedKalmanFilterOptions o;
   if (ini.has("ekf", "constant_process_noise"))
     o.constant_process_noise = ini.getVector("ekf", "constant_process_noise", model.dims().nb);
@@ -129,12 +140,12 @@ ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& mode
   return o;
 }
 
-SmootherOptions smootherOptions(const IniDocument& ini) {
+void readSmoother(const IniDocument& ini, EstimatorOptions& eo) {
   ini.requireOnlyKeys("smoother", {"relinearize", "relinearize_threshold", "constants_check_sigmas",
                                    "max_local_iterations", "wildfire_threshold", "ordering",
                                    "iterate_to_convergence", "convergence_tolerance", "max_iterations",
                                    "newton_polish_steps"});
-  SmootherOptions o;
+  SmootherOptions& o = eo.smoother;
   o.relinearize = ini.getBool("smoother", "relinearize", o.relinearize);
   o.relinearize_threshold = ini.getDouble("smoother", "relinearize_threshold", o.relinearize_threshold);
   o.constants_check_sigmas = ini.getDouble("smoother", "constants_check_sigmas", o.constants_check_sigmas);
@@ -148,18 +159,48 @@ SmootherOptions smootherOptions(const IniDocument& ini) {
   const std::string ordering = ini.getString("smoother", "ordering", "colamd");
   if (ordering != "colamd" && ordering != "time")
     throw InputError(ini.source() + ": [smoother] ordering = '" + ordering + "': expected colamd or time");
-  o.ordering = ordering == "time" ? EliminationOrdering::TimeOrdered : EliminationOrdering::ConstrainedColamd;
+  eo.incremental.ordering =
+      ordering == "time" ? EliminationOrdering::TimeOrdered : EliminationOrdering::ConstrainedColamd;
   std::string why;
   if (!o.validate(&why)) throw InputError(ini.source() + ": [smoother] " + why);
-  return o;
 }
 
-int windowOption(const IniDocument& ini, const std::string& section, int fallback) {
+int readWindow(const IniDocument& ini, const std::string& section, int fallback) {
   ini.requireOnlyKeys(section, {"window"});
   const long long w = ini.getInt(section, "window", fallback);
   if (w < 1 || w > 10000000)
     throw InputError(ini.source() + ": [" + section + "] window = " + std::to_string(w) + ": expected >= 1");
   return static_cast<int>(w);
+}
+
+void readBatch(const IniDocument& ini, BatchSolverOptions& o) {
+  ini.requireOnlyKeys("batch", {"algorithm", "max_iterations", "newton_polish_steps"});
+  const std::string algorithm = ini.getString("batch", "algorithm", "levenberg-marquardt");
+  if (algorithm != "levenberg-marquardt" && algorithm != "gauss-newton")
+    throw InputError(ini.source() + ": [batch] algorithm = '" + algorithm +
+                     "': expected levenberg-marquardt or gauss-newton");
+  o.method = algorithm == "gauss-newton" ? BatchSolverOptions::Method::GaussNewton
+                                         : BatchSolverOptions::Method::LevenbergMarquardt;
+  o.max_iterations = static_cast<int>(ini.getInt("batch", "max_iterations", o.max_iterations));
+  o.newton_polish_steps = static_cast<int>(ini.getInt("batch", "newton_polish_steps", o.newton_polish_steps));
+  std::string why;
+  if (!o.validate(&why)) throw InputError(ini.source() + ": [batch] " + why);
+}
+}  // namespace
+
+Method parseMethod(const std::string& text, const std::string& where) {
+  if (const auto m = methodNamed(text)) return *m;
+  throw InputError(where + " = '" + text + "': unknown method (known: " + methodNameList() + ")");
+}
+
+EstimatorOptions estimatorOptions(const IniDocument& ini, const Model& model, Method method) {
+  EstimatorOptions o(method);
+  o.ekf = ekfOptions(ini, model);
+  readSmoother(ini, o);
+  o.fixed_lag.window = readWindow(ini, "fixed_lag", o.fixed_lag.window);
+  o.paper_window.window = readWindow(ini, "paper_window", o.paper_window.window);
+  readBatch(ini, o.batch);
+  return o;
 }
 
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {
@@ -192,6 +233,19 @@ SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {
     };
   }
   return s;
+}
+
+LoadedScenario loadScenario(const IniDocument& scenario, const IniDocument* estimator_config) {
+  LoadedScenario out;
+  out.truth = makeModel(scenario);
+  if (estimator_config) out.estimator = makeModel(*estimator_config);
+  const Model& est = out.estimator ? *out.estimator : *out.truth;
+  out.scenario.name = scenario.getString("scenario", "name", "?");
+  out.scenario.truth = out.truth.get();
+  out.scenario.spec = simulationSpec(scenario, *out.truth);
+  out.scenario.estimator = out.estimator.get();
+  out.scenario.options = estimatorOptions(estimator_config ? *estimator_config : scenario, est);
+  return out;
 }
 
 std::vector<std::string> scenarioNames() { return {"paper", "consistent", "nav-paper-like", "nav-consistent"}; }

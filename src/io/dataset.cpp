@@ -101,6 +101,20 @@ void readDatasetData(const std::string& dir, const Model& model, Dataset& out, B
   }
 }
 
+SimulatedRun recordedRun(const Model& model, const Dataset& ds) {
+  if (!ds.truth) throw InputError(ds.dir + ": no truth.csv: the analysis needs the true trajectory");
+  SimulatedRun run;
+  const int nc = model.dims().nc, nb = model.dims().nb;
+  for (std::size_t k = 0; k < ds.truth->times.size(); ++k) {
+    run.times.push_back(ds.truth->times[k]);
+    run.states.push_back(ds.truth->states[k].head(nc));
+  }
+  run.constants = ds.truth->states.front().tail(nb);
+  run.measurements = ds.measurements;
+  run.inputs = ds.inputs;
+  return run;
+}
+
 void writeDataset(const std::string& dir, const Model& model, const SimulatedRun& run,
                   const IniDocument& scenario) {
   fs::create_directories(dir);

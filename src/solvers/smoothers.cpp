@@ -259,8 +259,8 @@ std::size_t Smoother::numVariables() const { return core_->engine.numVariables()
 std::size_t Smoother::numFactors() const { return core_->engine.numFactors(); }
 
 // ---- IncrementalSmoother -------------------------------------------------------
-IncrementalSmoother::IncrementalSmoother(SmootherOptions options)
-    : Smoother(std::make_unique<SmootherCore>(options, toMode(options.ordering))) {}
+IncrementalSmoother::IncrementalSmoother(SmootherOptions options, EliminationOrdering ordering)
+    : Smoother(std::make_unique<SmootherCore>(options, toMode(ordering))), ordering_(ordering) {}
 UpdateReport IncrementalSmoother::update(const std::vector<FactorPtr>& f, const Values& v) {
   return core_->update(f, v);
 }
@@ -271,7 +271,6 @@ namespace {
 FixedLagSmootherOptions fixedLag(FixedLagSmootherOptions o) {
   std::string why;
   if (!o.validate(&why)) throw InvalidArgument(why);
-  o.smoother.ordering = EliminationOrdering::TimeOrdered;
   return o;
 }
 }  // namespace

@@ -16,13 +16,13 @@ int main(int argc, char** argv) {
   gssm::SimulationSpec spec;
   spec.steps = 8;
   const auto run = gssm::simulate(radar, spec, [&] { return normal(rng); });
-  for (const auto& method : gssm::estimatorMethods()) {
+  for (const auto& method : gssm::streamingMethods()) {
     gssm::EstimatorOptions o;
     o.method = method;
-    o.window = 3;
+    o.fixed_lag.window = o.paper_window.window = 3;
     auto est = gssm::makeEstimator(radar, o);
     for (int k = 0; k < 6; ++k) est->addMeasurement(run.measurements[k].t, run.measurements[k].y);
-    gssm::saveCheckpoint(*est, std::string(argv[1]) + "/radar-" + method + ".ckpt", "seed");
+    gssm::saveCheckpoint(*est, std::string(argv[1]) + "/radar-" + gssm::methodName(method) + ".ckpt", "seed");
   }
   return 0;
 }

@@ -25,8 +25,8 @@ TEST(Soak, FixedLagSmootherMemoryAndGraphStayBounded) {
   ASSERT_GE(steps, 20000);
   const gssm::models::Radar2D radar;
   gssm::EstimatorOptions o;
-  o.method = "fixed-lag";
-  o.window = 10;
+  o.method = gssm::Method::FixedLag;
+  o.fixed_lag.window = o.paper_window.window = 10;
   auto est = gssm::makeEstimator(radar, o);
   std::mt19937 rng(7);
   std::normal_distribution<double> n01(0, 1);

@@ -8,13 +8,14 @@
 //            measurement_noise
 //   [scenario] name, seed, steps
 //   [ekf]    constant_process_noise, joseph_form
-//   [smoother], [fixed_lag], [paper_window]  estimator settings (below)
+//   [smoother], [fixed_lag], [paper_window], [batch]  estimator settings (below)
 #include <memory>
 #include <string>
 
-#include "gssm/ekf.h"
+#include "gssm/estimator.h"
 #include "gssm/io/ini.h"
 #include "gssm/model.h"
+#include "gssm/montecarlo.h"
 #include "gssm/simulation.h"
 #include "gssm/smoothers.h"
 
@@ -23,16 +24,39 @@ namespace gssm::io {
 /// Builds the model described by [model] and [prior]. Throws InputError
 /// naming file, line and key for an unknown type or a bad value.
 std::unique_ptr<Model> makeModel(const IniDocument& ini);
+/// Positions of the model's landmarks ([model] beacons, rows of "x y");
+/// empty if it has none.
+std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini);
 /// Writes a model's [model] and [prior] sections (radar2d and linear).
 void writeModel(const Model& model, IniDocument& ini);
 
-ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& model);
-/// [smoother]: relinearize, relinearize_threshold, constants_check_sigmas,
-/// max_local_iterations, wildfire_threshold, ordering (colamd | time);
-/// [fixed_lag] / [paper_window]: window. Absent keys keep the defaults.
-SmootherOptions smootherOptions(const IniDocument& ini);
-int windowOption(const IniDocument& ini, const std::string& section, int fallback);
+/// The method named by `text`; InputError naming `where` (e.g. "option
+/// --method" or "s.ini: [run] method") and the known names otherwise.
+Method parseMethod(const std::string& text, const std::string& where);
+
+/// Every method's settings from its section, for a run of `method`:
+/// [ekf] constant_process_noise, joseph_form; [smoother] relinearize,
+/// relinearize_threshold, constants_check_sigmas, max_local_iterations,
+/// wildfire_threshold, iterate_to_convergence, convergence_tolerance,
+/// max_iterations, newton_polish_steps, ordering (colamd | time: the
+/// incremental smoother's); [fixed_lag] window; [paper_window] window;
+/// [batch] algorithm (levenberg-marquardt | gauss-newton), max_iterations,
+/// newton_polish_steps. Absent keys keep the defaults; an unknown key or a
+/// bad value is an InputError naming file, section and key.
+EstimatorOptions estimatorOptions(const IniDocument& ini, const Model& model,
+                                  Method method = Method::FixedLag);
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model);
+
+/// A Monte Carlo scenario from INI documents, with the models it points to.
+struct LoadedScenario {
+  std::unique_ptr<Model> truth;      ///< [model], [prior] of the scenario
+  std::unique_ptr<Model> estimator;  ///< of `estimator_config`; null: the truth's
+  MonteCarloScenario scenario;       ///< points into the models above
+};
+/// The scenario's truth model and simulation ([scenario], [truth]), and the
+/// estimators' model and every method's settings from `estimator_config`
+/// when given (a deliberately mis-tuned model), else from the scenario.
+LoadedScenario loadScenario(const IniDocument& scenario, const IniDocument* estimator_config = nullptr);
 
 /// Names of the built-in scenarios ("paper", "consistent").
 std::vector<std::string> scenarioNames();

@@ -14,11 +14,6 @@
 
 namespace gssm::io {
 
-struct Truth {
-  std::vector<double> times;
-  std::vector<Eigen::VectorXd> states;  ///< stacked [x_c(k); x_b] per row
-};
-
 struct Dataset {
   std::string dir;
   IniDocument scenario;
@@ -43,6 +38,11 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
 /// checks column names and increasing timestamps, naming file and line.
 void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
                      BadRows bad_rows = BadRows::Throw);
+
+/// The dataset as a run with its truth (true x_c(k) per truth row, x_b from
+/// the first row), for analyses that need the true trajectory. Throws
+/// InputError when the dataset has no truth.csv.
+SimulatedRun recordedRun(const Model& model, const Dataset& dataset);
 
 /// Writes measurements.csv, truth.csv and scenario.ini.
 void writeDataset(const std::string& dir, const Model& model, const SimulatedRun& run,

@@ -6,16 +6,29 @@
 #include <string>
 #include <vector>
 
-#include "gssm/io/dataset.h"
+#include <Eigen/Core>
+#include <optional>
+
+#include "gssm/data.h"
 #include "gssm/model.h"
 #include "gssm/offline.h"
 
 namespace gssm::plot {
 
-/// Writes fig-<constant>.png, fig-<state>-error.png (with truth) and
-/// fig-latency.png into `dir`; returns the paths written.
+/// A plan view (top-down map) of a 2-D position: which stacked-state
+/// components are x and y, and fixed landmarks to mark (e.g. beacons).
+struct PlanView {
+  Eigen::Index x = 0, y = 1;
+  std::vector<Eigen::Vector2d> landmarks;
+  std::string landmark_label = "beacons";
+};
+
+/// Writes fig-<constant>.png, fig-<state>-error.png (with truth),
+/// fig-trajectory.png (with a plan view) and fig-latency.png into `dir`;
+/// returns the paths written.
 std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
-                                         const io::Truth* truth, const std::string& dir,
-                                         const std::string& scenario_label);
+                                         const Truth* truth, const std::string& dir,
+                                         const std::string& scenario_label,
+                                         const std::optional<PlanView>& plan = std::nullopt);
 
 }  // namespace gssm::plot
