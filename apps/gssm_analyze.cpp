@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "cli.h"
-#include "gssm/analysis_report.h"
+#include "gssm/analysis/scenario_analysis.h"
 #include "gssm/io/config.h"
 #include "gssm/io/dataset.h"
 #include "gssm/plot/figure.h"

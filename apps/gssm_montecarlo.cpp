@@ -11,7 +11,7 @@
 
 #include "cli.h"
 #include "gssm/io/config.h"
-#include "gssm/montecarlo.h"
+#include "gssm/analysis/montecarlo.h"
 #include "gssm/plot/figure.h"
 
 namespace fs = std::filesystem;

@@ -11,11 +11,12 @@
 #include <unistd.h>
 
 #include "cli.h"
-#include "gssm/checkpoint.h"
+#include "gssm/checkpoint/checkpoint.h"
 #include "gssm/io/config.h"
 #include "gssm/io/csv.h"
 #include "gssm/io/dataset.h"
-#include "gssm/metrics.h"
+#include "gssm/io/metrics_json.h"
+#include "gssm/analysis/metrics.h"
 #include "gssm/plot/run_figures.h"
 
 namespace fs = std::filesystem;
@@ -81,7 +82,7 @@ int main(int argc, char** argv) {
     gssm::io::Dataset ds;
     const bool skip = cli.given("skip-bad-rows");
     gssm::io::readDatasetData(data, *model, ds, skip ? gssm::io::BadRows::Skip : gssm::io::BadRows::Stop);
-    gssm::DatasetStatus status;
+    gssm::io::DatasetStatus status;
     if (skip) status.skipped = ds.row_errors;
     else if (!ds.row_errors.empty()) status = {true, ds.row_errors.front(), {}};
     for (const auto& e : status.skipped) std::cerr << "gssm-process: skipped " << e << "\n";
@@ -126,7 +127,7 @@ int main(int argc, char** argv) {
       std::cout << "\n        " << run.summary << "\n";
       runs.push_back(std::move(run));
     }
-    std::ofstream((fs::path(out) / "metrics.json").string()) << gssm::metricsJson(metrics, data, status);
+    std::ofstream((fs::path(out) / "metrics.json").string()) << gssm::io::metricsJson(metrics, data, status);
     const std::string label = config.getString("scenario", "name", fs::path(data).filename().string());
     std::optional<gssm::plot::PlanView> plan;
     const auto names = model->stackedStateNames();

@@ -8,12 +8,12 @@
 #include <chrono>
 #include <random>
 
-#include "gssm/batch_solver.h"
-#include "gssm/estimator.h"
-#include "gssm/metrics.h"
+#include "gssm/solvers/batch_solver.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/analysis/metrics.h"
 #include "gssm/models/radar2d.h"
-#include "gssm/offline.h"
-#include "gssm/simulation.h"
+#include "gssm/analysis/offline.h"
+#include "gssm/model/simulation.h"
 
 namespace {
 

@@ -6,10 +6,10 @@
 #include <chrono>
 #include <random>
 
-#include "gssm/estimator.h"
-#include "gssm/metrics.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/analysis/metrics.h"
 #include "gssm/models/linear.h"
-#include "gssm/simulation.h"
+#include "gssm/model/simulation.h"
 
 namespace {
 

@@ -8,8 +8,8 @@
 #include <iostream>
 #include <random>
 
-#include "gssm/estimator.h"
-#include "gssm/metrics.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/analysis/metrics.h"
 #include "gssm/models/radar2d.h"
 #include "gssm/plot/figure.h"
 

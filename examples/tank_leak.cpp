@@ -9,7 +9,7 @@
 #include <iostream>
 #include <random>
 
-#include "gssm/estimator.h"
+#include "gssm/estimator/estimator.h"
 #include "gssm/models/function_model.h"
 
 int main() {

@@ -6,7 +6,7 @@
 #include <functional>
 #include <random>
 
-#include "gssm/model.h"
+#include "gssm/model/model.h"
 
 namespace gssm::testing {
 

@@ -7,9 +7,9 @@
 #include <random>
 #include <vector>
 
-#include "gssm/data.h"
+#include "gssm/core/data.h"
 #include "gssm/models/linear.h"
-#include "gssm/simulation.h"
+#include "gssm/model/simulation.h"
 
 namespace gssm::testing {
 

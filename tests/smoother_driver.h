@@ -3,8 +3,8 @@
 // adds per measurement), so tests can compare after every update.
 #include <vector>
 
-#include "gssm/factors.h"
-#include "gssm/model.h"
+#include "gssm/factors/factors.h"
+#include "gssm/model/model.h"
 
 namespace gssm::testing {
 

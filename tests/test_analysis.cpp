@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "gssm/analysis.h"
-#include "gssm/error.h"
+#include "gssm/analysis/bounds.h"
+#include "gssm/core/error.h"
 #include "gssm/models/linear.h"
 #include "reference_kalman.h"
 

@@ -3,13 +3,13 @@
 #include <Eigen/Eigenvalues>
 #include <random>
 
-#include "gssm/batch_solver.h"
-#include "gssm/ekf.h"
-#include "gssm/error.h"
+#include "gssm/solvers/batch_solver.h"
+#include "gssm/solvers/ekf.h"
+#include "gssm/core/error.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
-#include "gssm/problem.h"
-#include "gssm/simulation.h"
+#include "gssm/factors/problem.h"
+#include "gssm/model/simulation.h"
 #include "reference_kalman.h"
 #include "solvers/curvature.h"
 

@@ -7,13 +7,13 @@
 #include <cstring>
 #include <fstream>
 
-#include "checkpoint/byte_stream.h"
-#include "gssm/checkpoint.h"
-#include "gssm/estimator.h"
+#include "core/byte_stream.h"
+#include "gssm/checkpoint/checkpoint.h"
+#include "gssm/estimator/estimator.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/nav2d.h"
 #include "gssm/models/radar2d.h"
-#include "gssm/simulation.h"
+#include "gssm/model/simulation.h"
 #include "reference_kalman.h"
 
 using namespace gssm;

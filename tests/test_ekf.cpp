@@ -2,11 +2,11 @@
 
 #include <random>
 
-#include "gssm/ekf.h"
-#include "gssm/error.h"
+#include "gssm/solvers/ekf.h"
+#include "gssm/core/error.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
-#include "gssm/simulation.h"
+#include "gssm/model/simulation.h"
 #include "reference_kalman.h"
 
 using namespace gssm;

@@ -3,13 +3,13 @@
 
 #include <random>
 
-#include "gssm/batch_solver.h"
-#include "gssm/error.h"
-#include "gssm/problem.h"
-#include "gssm/estimator.h"
+#include "gssm/solvers/batch_solver.h"
+#include "gssm/core/error.h"
+#include "gssm/factors/problem.h"
+#include "gssm/estimator/estimator.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
-#include "gssm/simulation.h"
+#include "gssm/model/simulation.h"
 #include "reference_kalman.h"
 
 using namespace gssm;

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "gssm/io/config.h"
 #include "gssm/io/csv.h"
 #include "gssm/io/ini.h"

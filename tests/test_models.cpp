@@ -2,7 +2,7 @@
 
 #include <Eigen/Cholesky>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
 #include "jacobian_check.h"

@@ -2,9 +2,9 @@
 
 #include <random>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "gssm/io/config.h"
-#include "gssm/montecarlo.h"
+#include "gssm/analysis/montecarlo.h"
 
 using namespace gssm;
 
@@ -103,8 +103,8 @@ TEST(Consistency, KalmanFilterIsConsistentAndAnOverConfidentOneIsFlagged) {
   EXPECT_NE(bad.markdown().find("over-confident"), std::string::npos);
 }
 
-#include "gssm/ekf.h"
-#include "gssm/estimator.h"
+#include "gssm/solvers/ekf.h"
+#include "gssm/estimator/estimator.h"
 
 // The generic NIS (from the estimate before each update) is the EKF's own
 // innovation statistic, and the same for the exact GSSM filters on a linear model.

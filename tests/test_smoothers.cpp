@@ -6,14 +6,14 @@
 #include <map>
 #include <random>
 
-#include "gssm/batch_solver.h"
-#include "gssm/estimator.h"
-#include "gssm/error.h"
+#include "gssm/solvers/batch_solver.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/core/error.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
-#include "gssm/problem.h"
-#include "gssm/simulation.h"
-#include "gssm/smoothers.h"
+#include "gssm/factors/problem.h"
+#include "gssm/model/simulation.h"
+#include "gssm/solvers/smoothers.h"
 #include "reference_kalman.h"
 #include "smoother_driver.h"
 

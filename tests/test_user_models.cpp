@@ -2,13 +2,13 @@
 
 #include <random>
 
-#include "gssm/error.h"
-#include "gssm/estimator.h"
+#include "gssm/core/error.h"
+#include "gssm/estimator/estimator.h"
 #include "gssm/io/config.h"
 #include "gssm/models/function_model.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
-#include "gssm/simulation.h"
+#include "gssm/model/simulation.h"
 #include "jacobian_check.h"
 #include "reference_kalman.h"
 

@@ -1,12 +1,11 @@
-#include "gssm/checkpoint.h"
+#include "gssm/checkpoint/checkpoint.h"
 
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
-#include "checkpoint/access.h"
-#include "checkpoint/byte_stream.h"
+#include "core/byte_stream.h"
 
 namespace gssm {
 
@@ -58,9 +57,9 @@ void checkModelIdentity(internal::ByteReader& in, const Model& m, CheckpointInfo
 std::string checkpointBytes(const Estimator& estimator, const std::string& user_data) {
   internal::ByteWriter payload;
   writeModelIdentity(payload, estimator.model());
-  internal::CheckpointAccess::writeOptions(payload, estimator.options());
+  internal::writeOptions(payload, estimator.options());
   payload.str(user_data);
-  internal::CheckpointAccess::saveEstimator(estimator, payload);
+  estimator.save(payload);
   const std::string& p = payload.bytes();
   internal::ByteWriter header;
   header.u32(kCheckpointVersion);
@@ -110,13 +109,13 @@ std::unique_ptr<Estimator> restoreCheckpointBytes(const Model& model, const std:
   std::unique_ptr<Estimator> est;
   try {
     checkModelIdentity(in, model, info);
-    const EstimatorOptions options = internal::CheckpointAccess::readOptions(in);
+    const EstimatorOptions options = internal::readOptions(in);
     std::string why;
     if (!options.validate(model, &why)) in.fail("invalid estimator options: " + why);
     info.method = options.method;
     info.user_data = in.str("user data");
     est = makeEstimator(model, options);
-    internal::CheckpointAccess::loadEstimator(*est, in);
+    est->load(in);
     if (!in.atEnd()) in.fail("unexpected bytes after the estimator state");
   } catch (const CheckpointError&) {
     throw;

@@ -1,9 +1,9 @@
-#include "gssm/gaussian.h"
+#include "gssm/core/gaussian.h"
 
 #include <Eigen/Cholesky>
 #include <sstream>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 
 namespace gssm {
 

@@ -1,8 +1,8 @@
-#include "gssm/values.h"
+#include "gssm/core/values.h"
 
 #include <algorithm>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 
 namespace gssm {
 

@@ -1,4 +1,4 @@
-#include "gssm/estimator.h"
+#include "gssm/estimator/estimator.h"
 
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -6,12 +6,12 @@
 #include <deque>
 #include <sstream>
 
-#include "checkpoint/access.h"
-#include "checkpoint/factor_io.h"
-#include "gssm/batch_solver.h"
-#include "gssm/checkpoint.h"
-#include "gssm/error.h"
-#include "gssm/problem.h"
+#include "core/byte_stream.h"
+#include "factors/factor_io.h"
+#include "gssm/core/error.h"
+#include "gssm/factors/problem.h"
+#include "gssm/solvers/batch_solver.h"
+#include "solvers/option_fields.h"
 
 namespace gssm {
 
@@ -31,9 +31,83 @@ bool EstimatorOptions::validate(const Model& model, std::string* why) const {
   return !(reads & kSmootherOptions) || smoother.validate(why);
 }
 
-Estimator::Estimator(const Model& model, Method method, double t0)
-    : model_(model), t_(t0) {
-  report_.method = method;
+Estimator::Estimator(const Model& model, const EstimatorOptions& options)
+    : model_(model), t_(options.t0), options_(options) {
+  report_.method = options.method;
+  report_.window = options.window();
+  if (options.method == Method::Incremental) report_.ordering = options.incremental.ordering;
+  if (options.method == Method::FixedLag) report_.ordering = EliminationOrdering::TimeOrdered;
+}
+
+// ---- checkpoints ------------------------------------------------------------------
+namespace internal {
+template <class Io>
+void fields(Io& io, EstimatorOptions& o) {  // after the method, which goes by name
+  // Format v1 holds one window: the method's.
+  io(o.method == Method::PaperWindow ? o.paper_window.window : o.fixed_lag.window, "window");
+  fields(io, o.ekf);
+  io.enumeration(o.incremental.ordering, 1, "smoother ordering");
+  fields(io, o.smoother);
+  io(o.t0, "t0");
+  io(o.compute_nis, "compute_nis");
+}
+
+template <class Io>
+void fields(Io& io, EstimatorReport& r) {  // all but what the options determine
+  io(r.steps, "report steps");
+  io(r.seconds, "report seconds");
+  io(r.iterations, "report iterations");
+  fields(io, r.smoother);
+  io(r.detail, "report detail");
+  io(r.nis, "report nis", true);  // NaN without compute_nis
+}
+
+void writeOptions(ByteWriter& out, const EstimatorOptions& options) {
+  out.str(methodName(options.method));  // by name: stable across enum changes
+  FieldWriter w{out};
+  EstimatorOptions copy = options;
+  fields(w, copy);
+}
+
+EstimatorOptions readOptions(ByteReader& in) {
+  const std::string name = in.str("estimator method");
+  const auto method = methodNamed(name);
+  if (!method || !methodInfo(*method).streaming) in.fail("estimator method: no streaming method '" + name + "'");
+  EstimatorOptions o(*method);
+  FieldReader r{in};
+  fields(r, o);
+  return o;
+}
+}  // namespace internal
+
+void Estimator::save(internal::ByteWriter& out) const {
+  out.f64(t_);
+  out.i64(k_);
+  out.vec(input_);
+  EstimatorReport r = report();  // formats a pending detail line
+  internal::FieldWriter w{out};
+  internal::fields(w, r);
+  saveState(out);
+}
+
+void Estimator::load(internal::ByteReader& in) {
+  const double t = in.f64("estimator time");
+  const std::int64_t k = in.i64("estimator step");
+  if (k < 0 || k > (std::int64_t(1) << 53)) in.fail("step counter " + std::to_string(k) + " out of range");
+  Eigen::VectorXd input = in.vec("input in force");
+  if (input.size() != 0 && input.size() != model_.dims().nu)
+    in.fail("input in force has size " + std::to_string(input.size()) + ", the model's inputs " +
+            std::to_string(model_.dims().nu));
+  EstimatorReport r = report_;  // method, window, ordering: from the options
+  internal::FieldReader reader{in};
+  internal::fields(reader, r);
+  // The base state first: the method's loadState checks itself against it.
+  t_ = t;
+  k_ = k;
+  input_ = std::move(input);
+  report_ = std::move(r);
+  detail_stale_ = false;
+  loadState(in);
 }
 
 void Estimator::saveState(internal::ByteWriter&) const {
@@ -139,7 +213,7 @@ Eigen::VectorXd stack(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) {
 class EkfEstimator final : public Estimator {
  public:
   EkfEstimator(const Model& m, const EstimatorOptions& o)
-      : Estimator(m, Method::Ekf, o.t0), ekf_(m, o.ekf, o.t0) {}
+      : Estimator(m, o), ekf_(m, o.ekf, o.t0) {}
 
   StateEstimate current() override { return {time(), step(), ekf_.mean(), ekf_.covariance()}; }
   std::optional<StateEstimate> smoothed(std::int64_t k) override {
@@ -188,8 +262,8 @@ class EkfEstimator final : public Estimator {
     return updated_ ? "EKF update, NIS " + std::to_string(ekf_.lastNis()) : "EKF prediction";
   }
   bool updated_ = false;  // the last step had a measurement
-  void saveState(internal::ByteWriter& out) const override { internal::CheckpointAccess::saveEkf(ekf_, out); }
-  void loadState(internal::ByteReader& in) override { internal::CheckpointAccess::loadEkf(ekf_, in); }
+  void saveState(internal::ByteWriter& out) const override { ekf_.save(out); }
+  void loadState(internal::ByteReader& in) override { ekf_.load(in); }
   ExtendedKalmanFilter ekf_;
 };
 
@@ -232,12 +306,12 @@ class SmootherEstimator final : public Estimator {
  public:
   /// `args` construct the smoother; keep_times = 0 keeps every state's time.
   template <class... Args>
-  SmootherEstimator(const Model& m, Method method, double t0, std::size_t keep_times, Args&&... args)
-      : Estimator(m, method, t0), smoother_(std::forward<Args>(args)...), keep_times_(keep_times) {
+  SmootherEstimator(const Model& m, const EstimatorOptions& o, std::size_t keep_times, Args&&... args)
+      : Estimator(m, o), smoother_(std::forward<Args>(args)...), keep_times_(keep_times) {
     Values initial;
     const auto priors = priorFactors(m, initial);
     report_.smoother = smoother_.update(priors, initial);
-    times_.push_back(t0);
+    times_.push_back(o.t0);
   }
 
   StateEstimate current() override { return *smoothed(step()); }
@@ -283,11 +357,11 @@ class SmootherEstimator final : public Estimator {
 
  private:
   void saveState(internal::ByteWriter& out) const override {
-    internal::CheckpointAccess::saveSmoother(smoother_, out);
+    smoother_.save(out);
     out.times(times_);
   }
   void loadState(internal::ByteReader& in) override {
-    internal::CheckpointAccess::loadSmoother(smoother_, in, model_);
+    smoother_.load(in, model_);
     std::deque<double> times = in.times("state times");
     const auto held = static_cast<std::size_t>(step()) + 1;
     const std::size_t expect = keep_times_ ? std::min(held, keep_times_) : held;
@@ -317,7 +391,7 @@ class SmootherEstimator final : public Estimator {
 class PaperWindowEstimator final : public Estimator {
  public:
   PaperWindowEstimator(const Model& m, const EstimatorOptions& o)
-      : Estimator(m, Method::PaperWindow, o.t0), window_(o.paper_window.window) {
+      : Estimator(m, o), window_(o.paper_window.window) {
     values_.insert(Key::state(0), m.priorState().mean);
     prior_state_ = m.priorState();
     if (m.dims().nb > 0) {
@@ -500,26 +574,21 @@ std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOpti
       e = std::make_unique<EkfEstimator>(model, options);
       break;
     case Method::Incremental:
-      e = std::make_unique<SmootherEstimator<IncrementalSmoother>>(
-          model, Method::Incremental, options.t0, 0, options.smoother, options.incremental.ordering);
-      e->report_.ordering = options.incremental.ordering;
+      e = std::make_unique<SmootherEstimator<IncrementalSmoother>>(model, options, 0, options.smoother,
+                                                                   options.incremental.ordering);
       break;
     case Method::FixedLag:
       e = std::make_unique<SmootherEstimator<FixedLagSmoother>>(
-          model, Method::FixedLag, options.t0, static_cast<std::size_t>(options.fixed_lag.window),
+          model, options, static_cast<std::size_t>(options.fixed_lag.window),
           FixedLagSmootherOptions{options.fixed_lag.window, options.smoother});
-      e->report_.window = options.fixed_lag.window;
-      e->report_.ordering = EliminationOrdering::TimeOrdered;
       break;
     case Method::PaperWindow:
       e = std::make_unique<PaperWindowEstimator>(model, options);
-      e->report_.window = options.paper_window.window;
       break;
     case Method::Batch:
       throw InvalidArgument("makeEstimator: method 'batch' needs the whole run (runOffline, BatchSolver); "
                             "streaming methods: " + methodNameList(true));
   }
-  e->options_ = options;
   return e;
 }
 

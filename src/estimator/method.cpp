@@ -1,4 +1,4 @@
-#include "gssm/method.h"
+#include "gssm/estimator/method.h"
 
 #include <ostream>
 #include <stdexcept>

@@ -1,8 +1,8 @@
-#include "gssm/factors.h"
+#include "gssm/factors/factors.h"
 
 #include <sstream>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 
 namespace gssm {
 

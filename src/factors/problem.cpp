@@ -1,10 +1,10 @@
-#include "gssm/problem.h"
+#include "gssm/factors/problem.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 
 namespace gssm {
 

@@ -1,6 +1,6 @@
 #include "gssm/io/config.h"
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/nav2d.h"
 #include "gssm/models/radar2d.h"

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "gssm/io/ini.h"
 
 namespace gssm::io {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "gssm/io/csv.h"
 
 namespace gssm::io {

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 
 namespace gssm::io {
 

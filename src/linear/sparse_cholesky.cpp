@@ -4,7 +4,7 @@
 #include <cstring>
 #include <numeric>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 
 namespace gssm::internal {
 

@@ -1,4 +1,4 @@
-#include "gssm/model.h"
+#include "gssm/model/model.h"
 
 #include <algorithm>
 #include <array>
@@ -6,7 +6,7 @@
 #include <set>
 #include <sstream>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "model/central_differences.h"
 
 namespace gssm {

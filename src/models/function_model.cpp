@@ -1,6 +1,6 @@
 #include "gssm/models/function_model.h"
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "model/central_differences.h"
 
 namespace gssm::models {

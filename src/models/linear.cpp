@@ -2,7 +2,7 @@
 
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 
 namespace gssm::models {
 

@@ -1,6 +1,6 @@
 #include "gssm/models/nav2d.h"
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 
 namespace gssm::models {
 

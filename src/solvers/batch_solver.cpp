@@ -1,4 +1,4 @@
-#include "gssm/batch_solver.h"
+#include "gssm/solvers/batch_solver.h"
 
 #include <chrono>
 #include <limits>
@@ -6,7 +6,7 @@
 #include <optional>
 #include <sstream>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "linear/normal_equations.h"
 #include "linear/sparse_cholesky.h"
 #include "solvers/newton.h"

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "solvers/newton.h"
 
 namespace gssm::internal {

@@ -16,7 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "gssm/factors.h"
+#include "gssm/factors/factors.h"
 
 namespace gssm {
 class Model;

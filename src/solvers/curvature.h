@@ -3,7 +3,7 @@
 // (solvers/newton.h).
 #include <Eigen/Core>
 
-#include "gssm/factors.h"
+#include "gssm/factors/factors.h"
 
 namespace gssm::internal {
 

@@ -1,12 +1,13 @@
-#include "gssm/ekf.h"
+#include "gssm/solvers/ekf.h"
 
 #include <Eigen/Cholesky>
 #include <sstream>
 
-#include "gssm/error.h"
-#include "gssm/gaussian.h"
-#include "gssm/key.h"
-#include "gssm/problem.h"
+#include "core/byte_stream.h"
+#include "gssm/core/error.h"
+#include "gssm/core/gaussian.h"
+#include "gssm/core/key.h"
+#include "gssm/factors/problem.h"
 
 namespace gssm {
 
@@ -114,6 +115,28 @@ Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& op
   }
   if (d.nb > 0) x.insert(Key::constants(), ekf.mean().tail(d.nb));
   return x;
+}
+
+void ExtendedKalmanFilter::save(internal::ByteWriter& out) const {
+  out.f64(t_);
+  out.vec(z_);
+  out.mat(P_);
+  out.f64(nis_);
+}
+
+void ExtendedKalmanFilter::load(internal::ByteReader& in) {
+  const double t = in.f64("EKF time");
+  Eigen::VectorXd z = in.vec("EKF mean");
+  Eigen::MatrixXd P = in.mat("EKF covariance");
+  const double nis = in.f64("EKF NIS", true);
+  const Eigen::Index n = model_->dims().nc + model_->dims().nb;
+  if (z.size() != n || P.rows() != n || P.cols() != n)
+    in.fail("EKF state has size " + std::to_string(z.size()) + " (covariance " + std::to_string(P.rows()) +
+            " x " + std::to_string(P.cols()) + "), the model's stacked state " + std::to_string(n));
+  t_ = t;
+  z_ = std::move(z);
+  P_ = std::move(P);
+  nis_ = nis;
 }
 
 }  // namespace gssm

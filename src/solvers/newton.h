@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "gssm/factors.h"
+#include "gssm/factors/factors.h"
 #include "linear/sparse_cholesky.h"
 #include "solvers/curvature.h"
 

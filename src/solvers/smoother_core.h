@@ -1,7 +1,7 @@
 #pragma once
 // Internal: the relinearization policy and reporting shared by
 // IncrementalSmoother and FixedLagSmoother, over the Bayes tree engine.
-#include "gssm/smoothers.h"
+#include "gssm/solvers/smoothers.h"
 #include "solvers/bayes_tree.h"
 
 namespace gssm {

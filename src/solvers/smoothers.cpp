@@ -2,9 +2,10 @@
 #include <chrono>
 #include <sstream>
 
-#include "gssm/error.h"
-#include "gssm/smoothers.h"
+#include "gssm/core/error.h"
+#include "gssm/solvers/smoothers.h"
 #include "solvers/newton.h"
+#include "solvers/option_fields.h"
 #include "solvers/smoother_core.h"
 
 namespace gssm {
@@ -300,6 +301,52 @@ UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Val
   rep.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   core_->last = rep;
   return rep;
+}
+
+// ---- checkpoints ----------------------------------------------------------------
+void SmootherCore::save(internal::ByteWriter& out) const {
+  engine.save(out);
+  internal::FieldWriter w{out};
+  UpdateReport copy = last;
+  internal::fields(w, copy);
+  out.vec(constants_at_last_check_);
+}
+
+void SmootherCore::load(internal::ByteReader& in, const Model& model) {
+  internal::BayesTreeEngine e = engine;
+  e.load(in, model);
+  UpdateReport r;
+  internal::FieldReader reader{in};
+  internal::fields(reader, r);
+  Eigen::VectorXd c = in.vec("constants at the last relinearization check");
+  if (c.size() != 0 && c.size() != model.dims().nb) in.fail("constants at the last check have the wrong size");
+  engine = std::move(e);
+  last = std::move(r);
+  constants_at_last_check_ = std::move(c);
+}
+
+void Smoother::save(internal::ByteWriter& out) const { core_->save(out); }
+void Smoother::load(internal::ByteReader& in, const Model& model) { core_->load(in, model); }
+
+void FixedLagSmoother::save(internal::ByteWriter& out) const {
+  Smoother::save(out);
+  out.i64(oldest_);
+  out.i64(newest_);
+}
+
+void FixedLagSmoother::load(internal::ByteReader& in, const Model& model) {
+  // Read and check everything before changing anything.
+  auto core = std::make_unique<SmootherCore>(*core_);
+  core->load(in, model);
+  const std::int64_t oldest = in.i64("fixed-lag oldest step"), newest = in.i64("fixed-lag newest step");
+  const auto has = [&](std::int64_t k) { return core->engine.hasVariable(Key::state(k)); };
+  if (oldest < -1 || newest < oldest || newest > (std::int64_t(1) << 53) || newest - oldest >= options_.window ||
+      (oldest >= 0 && (!has(oldest) || !has(newest))))
+    in.fail("fixed-lag window [" + std::to_string(oldest) + ", " + std::to_string(newest) +
+            "] does not match its variables or window " + std::to_string(options_.window));
+  core_ = std::move(core);
+  oldest_ = oldest;
+  newest_ = newest;
 }
 
 }  // namespace gssm

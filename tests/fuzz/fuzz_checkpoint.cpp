@@ -7,8 +7,8 @@
 #include <cstring>
 #include <string>
 
-#include "checkpoint/byte_stream.h"
-#include "gssm/checkpoint.h"
+#include "core/byte_stream.h"
+#include "gssm/checkpoint/checkpoint.h"
 #include "gssm/models/radar2d.h"
 
 namespace {

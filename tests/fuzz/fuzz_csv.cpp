@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "gssm/io/csv.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

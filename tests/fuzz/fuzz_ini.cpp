@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-#include "gssm/error.h"
+#include "gssm/core/error.h"
 #include "gssm/io/ini.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -4,9 +4,9 @@
 #include <random>
 #include <string>
 
-#include "gssm/checkpoint.h"
+#include "gssm/checkpoint/checkpoint.h"
 #include "gssm/models/radar2d.h"
-#include "gssm/simulation.h"
+#include "gssm/model/simulation.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) return 2;

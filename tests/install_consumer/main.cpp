@@ -1,5 +1,6 @@
 // Built against an installed gssm through find_package(gssm).
-#include <gssm/ekf.h>
+#include <gssm/solvers/ekf.h>
+#include <gssm/io/config.h>
 #include <gssm/models/radar2d.h>
 
 #include <iostream>
@@ -10,5 +11,8 @@ int main() {
   ekf.predict(0.05, Eigen::VectorXd(0));
   ekf.update(Eigen::VectorXd::Constant(1, 2236.0));
   std::cout << "consumer: h = " << ekf.mean()[2] << "\n";
-  return ekf.mean().allFinite() ? 0 : 1;
+  // The upper libraries are exported too (gssm::io links gssm::analysis and gssm::gssm).
+  const gssm::Method m = gssm::io::parseMethod("fixed-lag", "consumer");
+  std::cout << "consumer: method " << m << "\n";
+  return ekf.mean().allFinite() && m == gssm::Method::FixedLag ? 0 : 1;
 }

@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <random>
 
-#include "gssm/estimator.h"
+#include "gssm/estimator/estimator.h"
 #include "gssm/models/radar2d.h"
 
 namespace {

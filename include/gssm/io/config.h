@@ -12,12 +12,12 @@
 #include <memory>
 #include <string>
 
-#include "gssm/estimator.h"
+#include "gssm/estimator/estimator.h"
 #include "gssm/io/ini.h"
-#include "gssm/model.h"
-#include "gssm/montecarlo.h"
-#include "gssm/simulation.h"
-#include "gssm/smoothers.h"
+#include "gssm/model/model.h"
+#include "gssm/analysis/montecarlo.h"
+#include "gssm/model/simulation.h"
+#include "gssm/solvers/smoothers.h"
 
 namespace gssm::io {
 

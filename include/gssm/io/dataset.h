@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "gssm/data.h"
+#include "gssm/core/data.h"
 #include "gssm/io/ini.h"
-#include "gssm/model.h"
-#include "gssm/simulation.h"
+#include "gssm/model/model.h"
+#include "gssm/model/simulation.h"
 
 namespace gssm::io {
 

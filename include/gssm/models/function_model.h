@@ -7,7 +7,7 @@
 #include <functional>
 #include <mutex>
 
-#include "gssm/model.h"
+#include "gssm/model/model.h"
 
 namespace gssm::models {
 

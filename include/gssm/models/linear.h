@@ -4,7 +4,7 @@
 // discretized with F_c = I + A_c T, F_b = A_b T, B_k = B T (Euler, the
 // paper's choice) or exactly with the matrix exponential of the augmented
 // system [[A_c, A_b, B], [0, 0, 0], [0, 0, 0]]·T.
-#include "gssm/model.h"
+#include "gssm/model/model.h"
 
 namespace gssm::models {
 

@@ -8,7 +8,7 @@
 //   y_i = ‖p − beacon_i‖ + brho, i = 1..4
 #include <vector>
 
-#include "gssm/model.h"
+#include "gssm/model/model.h"
 
 namespace gssm::models {
 

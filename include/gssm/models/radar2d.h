@@ -2,7 +2,7 @@
 // The paper's 2-D radar example (DESIGN.md §2): horizontal distance x is a
 // time series; horizontal velocity xdot and altitude h are constants.
 //   x(k+1) = x(k) + xdot·T + q,   range = sqrt(x² + h²) + r
-#include "gssm/model.h"
+#include "gssm/model/model.h"
 
 namespace gssm::models {
 

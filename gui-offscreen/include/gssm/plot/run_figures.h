@@ -9,9 +9,9 @@
 #include <Eigen/Core>
 #include <optional>
 
-#include "gssm/data.h"
-#include "gssm/model.h"
-#include "gssm/offline.h"
+#include "gssm/core/data.h"
+#include "gssm/model/model.h"
+#include "gssm/analysis/offline.h"
 
 namespace gssm::plot {
 

@@ -1,0 +1,73 @@
+#pragma once
+// Runs an estimator over a recorded sequence of measurements in streaming
+// order and collects what it reports after each one: the common back end of
+// the dataset processor and the Monte Carlo runner.
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "gssm/solvers/batch_solver.h"
+#include "gssm/core/data.h"
+#include "gssm/solvers/ekf.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/model/model.h"
+
+namespace gssm {
+
+/// The estimate of the stacked state [x_c(k); x_b] at one measurement time.
+struct EstimateRow {
+  double t = 0;
+  Eigen::VectorXd mean;        ///< stacked [x_c; x_b]
+  Eigen::MatrixXd covariance;  ///< stacked, (n_c + n_b)²
+};
+
+struct OfflineRun {
+  Method method = Method::Ekf;
+  std::vector<EstimateRow> rows;       ///< one per measurement (plus none for t0)
+  std::vector<double> update_seconds;  ///< wall time of each update
+  std::vector<double> nis;             ///< NIS of each measurement (streaming runs with compute_nis)
+  double total_seconds = 0;
+  int iterations = 0;                  ///< solver iterations (batch), 0 for filters
+  std::string summary;                 ///< the solver's own report line
+};
+
+/// Checkpoints of a streaming run (checkpoint.h): each holds the estimator
+/// and the run so far (rows, latencies, NIS), so a resumed run ends with the
+/// same rows, bit for bit, as an uninterrupted one. A checkpoint stores every
+/// row so far, (1 + n + n²)·8 bytes each for a stacked state of size n.
+struct StreamingCheckpoints {
+  std::string path;         ///< file written every `every` measurements ("" = none)
+  std::size_t every = 0;
+  std::string resume_from;  ///< checkpoint to continue from ("" = start at the beginning)
+};
+
+/// Streams the measurements (and inputs, in time order) through a streaming
+/// estimator made by makeEstimator(model, options); rows hold current()
+/// after each measurement.
+/// `progress(done, total)`, if set, is called every 1% of the measurements.
+/// With `checkpoints.resume_from`, the estimator and the rows so far come
+/// from that checkpoint, which must have been written by a run of the same
+/// method on the same measurements (CheckpointError otherwise).
+OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
+                        const std::vector<Measurement>& measurements,
+                        const std::vector<Input>& inputs = {},
+                        const std::function<void(std::size_t, std::size_t)>& progress = {},
+                        const StreamingCheckpoints& checkpoints = {});
+
+/// The batch MAP of the whole run (from an EKF pass with default options);
+/// rows hold the smoothed estimate at each measurement time with its
+/// marginal covariance.
+OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
+                    const std::vector<Measurement>& measurements,
+                    const std::vector<Input>& inputs = {});
+
+/// options.method over the whole recording: runBatch for the batch,
+/// runStreaming for the others (progress and checkpoints apply to those).
+OfflineRun runOffline(const Model& model, const EstimatorOptions& options,
+                      const std::vector<Measurement>& measurements,
+                      const std::vector<Input>& inputs = {},
+                      const std::function<void(std::size_t, std::size_t)>& progress = {},
+                      const StreamingCheckpoints& checkpoints = {});
+
+}  // namespace gssm

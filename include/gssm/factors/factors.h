@@ -1,0 +1,141 @@
+#pragma once
+// Factors of the GSSM graph (DESIGN.md §1). Each returns a whitened residual
+// r = L⁻¹ e (Σ = L Lᵀ) and one Jacobian block per variable, so that the MAP
+// estimate minimizes ½ Σ ‖r_i‖² over all factors.
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gssm/core/gaussian.h"
+#include "gssm/core/key.h"
+#include "gssm/model/model.h"
+#include "gssm/core/values.h"
+
+namespace gssm {
+
+class Factor {
+ public:
+  virtual ~Factor() = default;
+  const std::vector<Key>& keys() const { return keys_; }
+  /// Residual dimension.
+  int dim() const { return dim_; }
+
+  /// Whitened residual at `x`; when J is non-null it receives one block per
+  /// key, J[i] of size dim() × dim(keys()[i]).
+  virtual void linearize(const Values& x, Eigen::VectorXd& r,
+                         std::vector<Eigen::MatrixXd>* J) const = 0;
+  /// ½‖r(x)‖².
+  double cost(const Values& x) const;
+  /// Human-readable description naming the variables ("range at x_c(12)").
+  virtual std::string describe() const = 0;
+
+ protected:
+  Factor(std::vector<Key> keys, int dim) : keys_(std::move(keys)), dim_(dim) {}
+
+ private:
+  std::vector<Key> keys_;
+  int dim_;
+};
+
+using FactorPtr = std::shared_ptr<const Factor>;
+
+/// E[x] = mean with covariance Σ: r = L⁻¹ (x − mean).
+class PriorFactor final : public Factor {
+ public:
+  PriorFactor(Key key, const Gaussian& prior);
+  void linearize(const Values& x, Eigen::VectorXd& r,
+                 std::vector<Eigen::MatrixXd>* J) const override;
+  std::string describe() const override;
+  const Eigen::VectorXd& mean() const { return mean_; }
+  const GaussianNoise& noise() const { return noise_; }
+
+ private:
+  Eigen::VectorXd mean_;
+  GaussianNoise noise_;
+};
+
+/// x_c(k+1) = f(x_c(k), x_b, u_k, dt) + q:  r = L_Q⁻¹ (x_c(k+1) − f(...)).
+/// The model must outlive the factor.
+class ProcessFactor final : public Factor {
+ public:
+  ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt);
+  void linearize(const Values& x, Eigen::VectorXd& r,
+                 std::vector<Eigen::MatrixXd>* J) const override;
+  std::string describe() const override;
+  double dt() const { return dt_; }
+  const Eigen::VectorXd& input() const { return u_; }
+
+ private:
+  const Model* model_;
+  Eigen::VectorXd u_;
+  double dt_;
+  GaussianNoise noise_;
+};
+
+/// y = h(x_c(k), x_b) + r:  r = L_R⁻¹ (h(...) − y).
+class MeasurementFactor final : public Factor {
+ public:
+  MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y);
+  MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y,
+                    const GaussianNoise& noise);
+  void linearize(const Values& x, Eigen::VectorXd& r,
+                 std::vector<Eigen::MatrixXd>* J) const override;
+  std::string describe() const override;
+  const Eigen::VectorXd& measurement() const { return y_; }
+  const GaussianNoise& noise() const { return noise_; }
+
+ private:
+  const Model* model_;
+  Eigen::VectorXd y_;
+  GaussianNoise noise_;
+};
+
+/// A dense Gaussian on several variables in whitened linear form
+/// r = A (x ⊟ x̄) − b, where x̄ is a fixed linearization point. This is what
+/// marginalization leaves behind (a Schur-complement prior on the separator).
+class LinearGaussianFactor final : public Factor {
+ public:
+  LinearGaussianFactor(std::vector<Key> keys, std::vector<Eigen::MatrixXd> A, Eigen::VectorXd b,
+                       Values linearization_point);
+  void linearize(const Values& x, Eigen::VectorXd& r,
+                 std::vector<Eigen::MatrixXd>* J) const override;
+  std::string describe() const override;
+  const std::vector<Eigen::MatrixXd>& A() const { return A_; }
+  const Eigen::VectorXd& b() const { return b_; }
+  const Values& linearizationPoint() const { return x0_; }
+
+ private:
+  std::vector<Eigen::MatrixXd> A_;
+  Eigen::VectorXd b_;
+  Values x0_;
+};
+
+/// An ordered collection of factors.
+class FactorGraph {
+ public:
+  void add(FactorPtr f) { factors_.push_back(std::move(f)); }
+  std::size_t size() const { return factors_.size(); }
+  const FactorPtr& operator[](std::size_t i) const { return factors_[i]; }
+  auto begin() const { return factors_.begin(); }
+  auto end() const { return factors_.end(); }
+  /// ½ Σ ‖r_i(x)‖².
+  double cost(const Values& x) const;
+
+ private:
+  std::vector<FactorPtr> factors_;
+};
+
+/// The variables of the stacked state [x_c(k); x_b] of `model` (x_b only if
+/// the model has constants), e.g. for its joint marginal covariance.
+inline std::vector<Key> stackedKeys(const Model& model, std::int64_t k) {
+  if (model.dims().nb > 0) return {Key::state(k), Key::constants()};
+  return {Key::state(k)};
+}
+
+/// Dimension of a variable of `model`.
+inline int variableDim(const Model& model, const Key& k) {
+  return k.isConstants() ? model.dims().nb : model.dims().nc;
+}
+
+}  // namespace gssm

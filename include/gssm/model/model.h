@@ -1,0 +1,114 @@
+#pragma once
+// The GSSM model interface (DESIGN.md §1). A model splits its state into a
+// time-series part x_c (dim n_c) and a constant part x_b (dim n_b):
+//
+//   x_c(k+1) = f(x_c(k), x_b, u_k, T) + q_c(k),   q_c ~ N(0, Q(T))
+//   y(k)     = h(x_c(k), x_b) + r(k),             r   ~ N(0, R)
+//   x_c(0) ~ N(x_c⁺, P_c),  x_b ~ N(x_b⁺, P_b)
+//
+// The same model object drives the EKF, the batch solver and the smoothers.
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gssm/core/gaussian.h"
+
+namespace gssm {
+
+struct ModelDims {
+  int nc = 0;  ///< time-series state x_c
+  int nb = 0;  ///< constant state x_b
+  int nu = 0;  ///< input u
+  int ny = 0;  ///< measurement y
+};
+
+/// Component names, used as CSV column names (must be unique, no commas).
+struct ModelNames {
+  std::vector<std::string> state;        ///< n_c names
+  std::vector<std::string> constants;    ///< n_b names
+  std::vector<std::string> input;        ///< n_u names
+  std::vector<std::string> measurement;  ///< n_y names
+};
+
+/// Noise and priors shared by every model.
+struct ModelNoise {
+  double T = 1.0;           ///< nominal step (s)
+  Eigen::MatrixXd Q;        ///< process noise covariance of one nominal step (n_c×n_c)
+  Eigen::MatrixXd R;        ///< measurement noise covariance (n_y×n_y)
+  Gaussian prior_state;     ///< prior on x_c(0)
+  Gaussian prior_constants; ///< prior on x_b
+};
+
+class Model {
+ public:
+  virtual ~Model() = default;
+
+  /// Short identifier ("radar2d", "linear").
+  virtual std::string name() const = 0;
+
+  /// Discrete process model x_c(k+1) = f(x_c(k), x_b, u_k, dt); fills the
+  /// Jacobians J_f_xc (n_c×n_c) and J_f_xb (n_c×n_b) when non-null.
+  virtual Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                            const Eigen::VectorXd& u, double dt,
+                            Eigen::MatrixXd* J_f_xc = nullptr,
+                            Eigen::MatrixXd* J_f_xb = nullptr) const = 0;
+
+  /// Measurement model y = h(x_c, x_b); fills J_h_xc (n_y×n_c) and J_h_xb
+  /// (n_y×n_b) when non-null.
+  virtual Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                            Eigen::MatrixXd* J_h_xc = nullptr,
+                            Eigen::MatrixXd* J_h_xb = nullptr) const = 0;
+
+  /// Process noise covariance of a step of length dt. Default: Q·dt/T (a
+  /// white-noise-driven state), which is Q itself at the nominal step.
+  virtual Eigen::MatrixXd processNoise(double dt) const;
+
+  const ModelDims& dims() const { return dims_; }
+  const ModelNames& names() const { return names_; }
+  const ModelNoise& noise() const { return noise_; }
+  double nominalStep() const { return noise_.T; }
+  const Eigen::MatrixXd& measurementNoise() const { return noise_.R; }
+  /// R as a whitening noise model, factored once per model.
+  const GaussianNoise& measurementNoiseModel() const { return r_model_; }
+  /// Q(dt) as a noise model, factored once per distinct dt among the last
+  /// few asked for (time stamps k·T differenced give a handful of dt values
+  /// that differ in the last bits) and shared; processNoise must be a pure
+  /// function of dt. `what` names it in the error if Q(dt) is not positive
+  /// definite.
+  GaussianNoise processNoiseModel(double dt, const std::string& what) const;
+  const Gaussian& priorState() const { return noise_.prior_state; }
+  const Gaussian& priorConstants() const { return noise_.prior_constants; }
+
+  /// All state names in the stacked order [x_c; x_b].
+  std::vector<std::string> stackedStateNames() const;
+
+ protected:
+  /// Validates every dimension, name and covariance; throws InvalidArgument
+  /// or NumericalError naming the offending field.
+  Model(ModelDims dims, ModelNames names, ModelNoise noise);
+
+ private:
+  ModelDims dims_;
+  ModelNames names_;
+  ModelNoise noise_;
+  GaussianNoise r_model_;
+  struct NoiseCache;
+  std::shared_ptr<NoiseCache> q_cache_;  // shared by copies (same parameters); thread-safe
+};
+
+/// Result of comparing a model's analytic Jacobians with central differences.
+struct JacobianCheck {
+  double max_abs_error = 0.0;  ///< worst |analytic − numeric| over all entries
+  double max_rel_error = 0.0;  ///< same, relative to max(1, |numeric|)
+  std::string worst;           ///< e.g. "J_h_xb(0,1): analytic 0.5, numeric 0.49"
+  bool ok(double tol) const { return max_rel_error <= tol; }
+};
+
+/// Compares J_f_xc, J_f_xb, J_h_xc and J_h_xb at one point with central
+/// differences of step `eps` (scaled by max(1, |x_i|)).
+JacobianCheck checkJacobians(const Model& model, const Eigen::VectorXd& xc,
+                             const Eigen::VectorXd& xb, const Eigen::VectorXd& u, double dt,
+                             double eps = 1e-6);
+
+}  // namespace gssm

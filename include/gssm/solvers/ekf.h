@@ -1,0 +1,73 @@
+#pragma once
+// ExtendedKalmanFilter: the baseline (DESIGN.md §1, "Kalman / EKF
+// discretization"). One stacked state z = [x_c; x_b] evolves step by step
+// with x_b(k+1) = x_b(k); the constants are carried as a random walk with
+// zero (or a small, optional) process noise and marginalized every step.
+#include <Eigen/Core>
+#include <string>
+
+#include <vector>
+
+#include "gssm/core/serialization_fwd.h"
+#include "gssm/core/data.h"
+#include "gssm/model/model.h"
+#include "gssm/core/values.h"
+
+namespace gssm {
+
+struct ExtendedKalmanFilterOptions {
+  /// Optional process noise variance per constant per nominal step (size n_b,
+  /// or empty for zeros). The paper's EKF uses diag(0.005², 0) on [xdot, h].
+  Eigen::VectorXd constant_process_noise;
+  /// Joseph-form covariance update (numerically safer; same result in exact
+  /// arithmetic).
+  bool joseph_form = true;
+  bool validate(int nb, std::string* why = nullptr) const;
+};
+
+class ExtendedKalmanFilter {
+ public:
+  /// Starts at the model's priors at time t0. The model must outlive the filter.
+  explicit ExtendedKalmanFilter(const Model& model, ExtendedKalmanFilterOptions options = {},
+                                double t0 = 0.0);
+
+  /// Propagates to time t > time() with input u held over the interval.
+  /// Throws InvalidArgument (filter unchanged) on bad time or input.
+  void predict(double t, const Eigen::VectorXd& u);
+  /// Measurement update at the current time; throws (filter unchanged) on
+  /// a bad measurement or a non-positive-definite innovation covariance.
+  void update(const Eigen::VectorXd& y);
+
+  double time() const { return t_; }
+  /// Stacked mean [x_c; x_b] and covariance.
+  const Eigen::VectorXd& mean() const { return z_; }
+  const Eigen::MatrixXd& covariance() const { return P_; }
+  /// Normalized innovation squared of the last update (NIS).
+  double lastNis() const { return nis_; }
+  const Model& model() const { return *model_; }
+
+  /// Checkpoint: time, mean, covariance, last NIS (the options are the
+  /// owner's). load() checks the sizes against the model and changes
+  /// nothing unless all is well.
+  void save(internal::ByteWriter& out) const;
+  void load(internal::ByteReader& in);
+
+ private:
+  const Model* model_;
+  ExtendedKalmanFilterOptions options_;
+  double t_;
+  Eigen::VectorXd z_;
+  Eigen::MatrixXd P_;
+  double nis_ = 0.0;
+};
+
+/// An initial guess for a batch solve from one EKF pass: x_c(k) from the
+/// filtered estimates, x_b from the filter's final estimate. From a poor
+/// prior, dead reckoning drifts without bound over a long run (e.g. x off by
+/// 5·10⁵ m after 10⁵ radar steps), which LM cannot recover from; the filter's
+/// estimates stay near the data.
+Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
+                       const std::vector<Measurement>& measurements,
+                       const std::vector<Input>& inputs = {}, double t0 = 0.0);
+
+}  // namespace gssm

@@ -1,0 +1,245 @@
+#include "gssm/analysis/montecarlo.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "gssm/core/error.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/analysis/offline.h"
+
+namespace gssm {
+
+bool MonteCarloOptions::validate(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = "MonteCarloOptions: " + m;
+    return false;
+  };
+  if (seeds < 1) return fail("seeds must be >= 1");
+  if (threads < 1) return fail("threads must be >= 1");
+  if (methods.empty()) return fail("no methods");
+  if (std::find(methods.begin(), methods.end(), Method::Ekf) == methods.end())
+    return fail("methods must include ekf (the baseline every method is compared with)");
+  return true;
+}
+
+double chiSquareQuantile(double p, int k) {
+  // Inverse normal by Acklam's rational approximation (|error| < 1.2e-9).
+  auto probit = [](double q) {
+    static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                               1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
+    static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                               6.680131188771972e+01, -1.328068155288572e+01};
+    static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                               -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
+    static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                               3.754408661907416e+00};
+    if (q < 0.02425) {
+      const double t = std::sqrt(-2 * std::log(q));
+      return (((((c[0] * t + c[1]) * t + c[2]) * t + c[3]) * t + c[4]) * t + c[5]) /
+             ((((d[0] * t + d[1]) * t + d[2]) * t + d[3]) * t + 1);
+    }
+    if (q > 1 - 0.02425) {
+      const double t = std::sqrt(-2 * std::log(1 - q));
+      return -(((((c[0] * t + c[1]) * t + c[2]) * t + c[3]) * t + c[4]) * t + c[5]) /
+             ((((d[0] * t + d[1]) * t + d[2]) * t + d[3]) * t + 1);
+    }
+    const double t = q - 0.5, r = t * t;
+    return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * t /
+           (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
+  };
+  const double z = probit(p), h = 2.0 / (9.0 * k);
+  return k * std::pow(1 - h + z * std::sqrt(h), 3);
+}
+
+namespace {
+// Per seed and method: squared errors and NEES at every step.
+struct SeedResult {
+  bool ok = false;
+  std::string error;
+  std::vector<Eigen::VectorXd> sq;  // per step
+  std::vector<double> nees, nis;
+  Eigen::VectorXd rmse, final_error;
+};
+}  // namespace
+
+MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
+                               const std::function<NormalSampler(unsigned)>& sampler_for_seed) {
+  std::string why;
+  if (!options.validate(&why)) throw InvalidArgument(why);
+  if (!scenario.truth) throw InvalidArgument("MonteCarlo: the scenario has no truth model");
+  const auto start = std::chrono::steady_clock::now();
+  const Model* model = scenario.truth;
+  const SimulationSpec& spec = scenario.spec;
+  const Model& estimator_model = scenario.estimator ? *scenario.estimator : *model;
+  for (const Method m : options.methods) {
+    EstimatorOptions eo = scenario.options;
+    eo.method = m;
+    if (!eo.validate(estimator_model, &why)) throw InvalidArgument("MonteCarlo: " + why);
+  }
+  if (estimator_model.dims().nc != model->dims().nc || estimator_model.dims().nb != model->dims().nb ||
+      estimator_model.dims().ny != model->dims().ny || estimator_model.dims().nu != model->dims().nu)
+    throw InvalidArgument("MonteCarlo: the estimators' model must have the truth model's dimensions");
+  const std::size_t M = options.methods.size(), S = static_cast<std::size_t>(options.seeds);
+  const int n = model->dims().nc + model->dims().nb;
+  std::vector<std::vector<SeedResult>> results(M, std::vector<SeedResult>(S));
+  std::vector<double> times;
+  std::mutex times_mutex;
+  std::atomic<int> next{0}, done{0};
+
+  auto worker = [&] {
+    for (int s = next++; s < options.seeds; s = next++) {
+      const unsigned seed = options.first_seed + static_cast<unsigned>(s);
+      const SimulatedRun run = simulate(*model, spec, sampler_for_seed(seed));
+      {
+        std::lock_guard<std::mutex> lock(times_mutex);
+        if (times.empty())
+          for (const auto& m : run.measurements) times.push_back(m.t);
+      }
+      for (std::size_t mi = 0; mi < M; ++mi) {
+        SeedResult& r = results[mi][static_cast<std::size_t>(s)];
+        try {
+          EstimatorOptions eo = scenario.options;
+          eo.method = options.methods[mi];
+          eo.compute_nis = true;
+          const OfflineRun out = runOffline(estimator_model, eo, run.measurements, run.inputs);
+          r.nis = out.nis;
+          Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
+          std::size_t j = 0;  // truth row at the estimate's time (multi-rate: not every step)
+          for (std::size_t k = 0; k < out.rows.size(); ++k) {
+            while (j + 1 < run.times.size() && run.times[j] < out.rows[k].t - 1e-9) ++j;
+            Eigen::VectorXd truth(n);
+            truth << run.states[j], run.constants;
+            const Eigen::VectorXd e = out.rows[k].mean - truth;
+            r.sq.push_back(e.cwiseAbs2());
+            r.nees.push_back(e.dot(out.rows[k].covariance.ldlt().solve(e)));
+            sum += e.cwiseAbs2();
+            r.final_error = e;
+          }
+          r.rmse = (sum / static_cast<double>(out.rows.size())).cwiseSqrt();
+          r.ok = true;
+        } catch (const std::exception& e) {
+          r.error = e.what();
+        }
+      }
+      if (options.progress) options.progress(++done, options.seeds);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < std::min(options.threads, options.seeds); ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+
+  MonteCarloResult res;
+  res.scenario = scenario.name;
+  res.seeds = options.seeds;
+  res.steps = spec.steps;
+  res.dof = n;
+  res.state_names = model->stackedStateNames();
+  res.nees_lo = chiSquareQuantile(0.025, n * options.seeds) / options.seeds;
+  res.nees_hi = chiSquareQuantile(0.975, n * options.seeds) / options.seeds;
+  res.nis_dof = model->dims().ny;
+  res.nis_lo = chiSquareQuantile(0.025, res.nis_dof * options.seeds) / options.seeds;
+  res.nis_hi = chiSquareQuantile(0.975, res.nis_dof * options.seeds) / options.seeds;
+  const std::size_t ekf = static_cast<std::size_t>(
+      std::find(options.methods.begin(), options.methods.end(), Method::Ekf) - options.methods.begin());
+  for (std::size_t mi = 0; mi < M; ++mi) {
+    MethodSummary m;
+    m.method = options.methods[mi];
+    m.times = times;
+    m.mean_rmse = m.rms_final_error = m.beats_ekf = Eigen::VectorXd::Zero(n);
+    const std::size_t rows = static_cast<std::size_t>(spec.steps / spec.measure_every);
+    std::vector<Eigen::VectorXd> sq_t(rows, Eigen::VectorXd::Zero(n));
+    std::vector<double> nees_t(rows, 0.0), nis_t(rows, 0.0);
+    int ok = 0;
+    for (std::size_t s = 0; s < S; ++s) {
+      const SeedResult& r = results[mi][s];
+      if (!r.ok) {
+        if (m.failures++ == 0) m.first_failure = "seed " + std::to_string(options.first_seed + s) + ": " + r.error;
+        continue;
+      }
+      ++ok;
+      m.mean_rmse += r.rmse;
+      m.rms_final_error += r.final_error.cwiseAbs2();
+      if (results[ekf][s].ok)
+        for (int i = 0; i < n; ++i) m.beats_ekf[i] += r.rmse[i] < results[ekf][s].rmse[i] ? 1.0 : 0.0;
+      for (std::size_t k = 0; k < r.sq.size() && k < sq_t.size(); ++k) {
+        sq_t[k] += r.sq[k];
+        nees_t[k] += r.nees[k];
+        nis_t[k] += k < r.nis.size() ? r.nis[k] : std::numeric_limits<double>::quiet_NaN();
+      }
+    }
+    if (ok > 0) {
+      m.mean_rmse /= ok;
+      m.rms_final_error = (m.rms_final_error / ok).cwiseSqrt();
+      m.beats_ekf /= ok;
+      int inside = 0;
+      for (std::size_t k = 0; k < sq_t.size(); ++k) {
+        m.rmse_over_time.push_back((sq_t[k] / ok).cwiseSqrt());
+        const double avg = nees_t[k] / ok;
+        m.mean_nees += avg / static_cast<double>(sq_t.size());
+        inside += (avg >= res.nees_lo && avg <= res.nees_hi) ? 1 : 0;
+      }
+      m.nees_step_in_interval = static_cast<double>(inside) / static_cast<double>(sq_t.size());
+      m.consistency = m.mean_nees > res.nees_hi ? "over-confident"
+                      : m.mean_nees < res.nees_lo ? "under-confident" : "consistent";
+      m.mean_nis = 0;
+      int nis_inside = 0;
+      for (double v : nis_t) {
+        m.mean_nis += v / ok / static_cast<double>(nis_t.size());
+        nis_inside += (v / ok >= res.nis_lo && v / ok <= res.nis_hi) ? 1 : 0;
+      }
+      m.nis_step_in_interval = static_cast<double>(nis_inside) / static_cast<double>(nis_t.size());
+      if (std::isfinite(m.mean_nis))
+        m.nis_consistency = m.mean_nis > res.nis_hi ? "over-confident"
+                            : m.mean_nis < res.nis_lo ? "under-confident" : "consistent";
+    }
+    res.methods.push_back(std::move(m));
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return res;
+}
+
+std::string MonteCarloResult::markdown() const {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  auto perState = [&](const Eigen::VectorXd& v, int prec) {
+    std::ostringstream o;
+    o.setf(std::ios::fixed);
+    o.precision(prec);
+    for (Eigen::Index i = 0; i < v.size(); ++i) o << (i ? " / " : "") << v[i];
+    return o.str();
+  };
+  std::string names;
+  for (const auto& s : state_names) names += (names.empty() ? "" : " / ") + s;
+  os.precision(2);
+  os << "Scenario `" << scenario << "`, " << seeds << " seeds × " << steps << " steps; NEES has " << dof
+     << " dof, 95% interval of a " << seeds << "-seed average at one step: [" << nees_lo << ", " << nees_hi
+     << "].\n\n";
+  os << "| method | mean RMSE (" << names << ") | RMS final error (" << names << ") | mean NEES | verdict | steps with NEES in 95% interval | mean NIS (" << nis_dof << " dof) | seeds beating the EKF (" << names << ") | failures |\n";
+  os << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& m : methods) {
+    os << "| " << methodName(m.method) << (methodInfo(m.method).streaming ? "" : " (smoother, uses future data)") << " | "
+       << perState(m.mean_rmse, 3) << " | " << perState(m.rms_final_error, 3) << " | ";
+    os.precision(2);
+    os << m.mean_nees << " | " << m.consistency << " | " << std::lround(100 * m.nees_step_in_interval) << "% | ";
+    if (std::isfinite(m.mean_nis))
+      os << m.mean_nis << " (" << m.nis_consistency << ", " << std::lround(100 * m.nis_step_in_interval)
+         << "% of steps inside) | ";
+    else os << "— | ";
+    if (m.method == Method::Ekf) os << "— | ";
+    else {
+      Eigen::VectorXd pct = 100 * m.beats_ekf;
+      os << perState(pct, 0) << " % | ";
+    }
+    os << m.failures << " |\n";
+  }
+  return os.str();
+}
+
+}  // namespace gssm

@@ -1,0 +1,55 @@
+#include "gssm/io/metrics_json.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "gssm/io/ini.h"
+
+namespace gssm::io {
+
+namespace {
+std::string num(double v) { return std::isfinite(v) ? io::formatDouble(v) : "null"; }
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+std::string perState(const std::vector<std::string>& names, const Eigen::VectorXd& v) {
+  std::string out = "{";
+  for (std::size_t i = 0; i < names.size(); ++i)
+    out += (i ? ", " : "") + quoted(names[i]) + ": " + num(v[static_cast<Eigen::Index>(i)]);
+  return out + "}";
+}
+}  // namespace
+
+std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& dataset,
+                        const DatasetStatus& status) {
+  std::ostringstream os;
+  os << "{\n  \"dataset\": " << quoted(dataset) << ",\n  \"partial\": " << (status.partial ? "true" : "false");
+  if (status.partial) os << ",\n  \"stopped_at\": " << quoted(status.stopped_at);
+  os << ",\n  \"skipped_rows\": " << status.skipped.size() << ",\n  \"skipped\": [";
+  for (std::size_t i = 0; i < status.skipped.size(); ++i) os << (i ? ", " : "") << quoted(status.skipped[i]);
+  os << "],\n  \"methods\": {";
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const RunMetrics& m = runs[r];
+    os << (r ? "," : "") << "\n    " << quoted(methodName(m.method)) << ": {\n";
+    os << "      \"rows\": " << m.rows << ",\n";
+    if (m.has_truth) {
+      os << "      \"rmse\": " << perState(m.names, m.rmse) << ",\n";
+      os << "      \"final_error\": " << perState(m.names, m.final_error) << ",\n";
+      os << "      \"mean_nees\": " << num(m.mean_nees) << ",\n";
+      os << "      \"nees_dof\": " << m.names.size() << ",\n";
+    }
+    os << "      \"latency_median_s\": " << num(m.latency_median) << ",\n";
+    os << "      \"latency_p99_s\": " << num(m.latency_p99) << ",\n";
+    os << "      \"total_s\": " << num(m.total_seconds) << ",\n";
+    os << "      \"iterations\": " << m.iterations << "\n    }";
+  }
+  os << "\n  }\n}\n";
+  return os.str();
+}
+
+}  // namespace gssm::io

@@ -1,0 +1,54 @@
+#include "gssm/model/simulation.h"
+
+#include <Eigen/Cholesky>
+
+#include "gssm/core/error.h"
+
+namespace gssm {
+
+Eigen::VectorXd sampleGaussian(const Eigen::VectorXd& mean, const Eigen::MatrixXd& cov,
+                               const NormalSampler& draw) {
+  Eigen::VectorXd e(mean.size());
+  for (Eigen::Index i = 0; i < e.size(); ++i) e[i] = draw();
+  if (mean.size() == 0) return mean;
+  const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(cov).matrixL();
+  return mean + L * e;
+}
+
+SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const NormalSampler& draw) {
+  if (spec.steps < 0) throw InvalidArgument("simulate: steps must be >= 0");
+  if (spec.measure_every < 1) throw InvalidArgument("simulate: measure_every must be >= 1");
+  const ModelDims& d = model.dims();
+  SimulatedRun run;
+  // Draw order is fixed (x0, xb, then per step q then r) so a seed gives one run.
+  run.states.push_back(spec.x0 ? *spec.x0
+                               : sampleGaussian(model.priorState().mean,
+                                                model.priorState().covariance, draw));
+  run.constants = spec.xb ? *spec.xb
+                          : sampleGaussian(model.priorConstants().mean,
+                                           model.priorConstants().covariance, draw);
+  requireVector(run.states[0], d.nc, "simulate: true x_c(0)");
+  requireVector(run.constants, d.nb, "simulate: true x_b");
+  const double T = model.nominalStep();
+  const Eigen::VectorXd zc = Eigen::VectorXd::Zero(d.nc), zy = Eigen::VectorXd::Zero(d.ny);
+  run.times.push_back(0.0);
+  for (int k = 1; k <= spec.steps; ++k) {
+    const double t_prev = (k - 1) * T;
+    const Eigen::VectorXd u = spec.input ? spec.input(t_prev, run.constants) : Eigen::VectorXd(Eigen::VectorXd::Zero(d.nu));
+    requireVector(u, d.nu, "simulate: input at t = " + std::to_string(t_prev));
+    if (spec.input) run.inputs.push_back({t_prev, u});
+    Eigen::VectorXd x = model.f(run.states.back(), run.constants, u, T);
+    if (spec.process_noise) x += sampleGaussian(zc, model.processNoise(T), draw);
+    const double t = k * T;
+    if (k % spec.measure_every == 0) {
+      Eigen::VectorXd y = model.h(x, run.constants);
+      if (spec.measurement_noise) y += sampleGaussian(zy, model.measurementNoise(), draw);
+      run.measurements.push_back({t, std::move(y)});
+    }
+    run.times.push_back(t);
+    run.states.push_back(std::move(x));
+  }
+  return run;
+}
+
+}  // namespace gssm

@@ -1,0 +1,252 @@
+// Checkpoint of the Bayes tree engine: everything it holds, dead slots and
+// cliques as empty placeholders (their indices stay free), so allocation
+// after a restore picks the same indices as the uninterrupted run.
+#include <algorithm>
+#include <unordered_set>
+
+#include "core/byte_stream.h"
+#include "factors/factor_io.h"
+#include "solvers/bayes_tree.h"
+
+namespace gssm::internal {
+
+namespace {
+void writeLinear(ByteWriter& out, const LinearFactor& f) {
+  out.keys(f.keys);
+  out.u64(f.A.size());
+  for (const auto& a : f.A) out.mat(a);
+  out.vec(f.b);
+}
+LinearFactor readLinear(ByteReader& in, const std::string& what) {
+  LinearFactor f;
+  f.keys = in.keys(what + " keys");
+  const std::size_t n = in.count(what + " blocks", 16);
+  if (n != f.keys.size())
+    in.fail(what + ": " + std::to_string(n) + " blocks for " + std::to_string(f.keys.size()) + " keys");
+  f.A.resize(n);
+  for (std::size_t i = 0; i < n; ++i) f.A[i] = in.mat(what + " block " + std::to_string(i));
+  f.b = in.vec(what + " b");
+  return f;
+}
+}  // namespace
+
+void BayesTreeEngine::save(ByteWriter& out) const {
+  out.u8(static_cast<std::uint8_t>(mode_));
+  out.f64(wildfire_);
+  out.u64(vars_.size());
+  // In key order, so the same state always gives the same bytes.
+  std::vector<Key> keys;
+  for (const auto& kv : vars_) keys.push_back(kv.first);
+  std::sort(keys.begin(), keys.end());
+  for (const auto& k : keys) {
+    const Var& v = vars_.at(k);
+    out.key(k);
+    out.vec(v.anchor);
+    out.vec(v.delta);
+    out.i32(v.clique);
+    out.i64(v.rank);
+  }
+  out.u64(slots_.size());
+  for (const auto& s : slots_) {
+    out.boolean(s.alive);
+    if (!s.alive) continue;
+    out.boolean(s.nonlinear != nullptr);
+    if (s.nonlinear) writeFactor(out, *s.nonlinear);
+    writeLinear(out, s.linear);
+    out.i32(s.owner);
+  }
+  out.ints(free_slots_);
+  out.u64(cliques_.size());
+  for (std::size_t c = 0; c < cliques_.size(); ++c) {
+    out.boolean(clique_alive_[c]);
+    if (!clique_alive_[c]) continue;
+    const Clique& cl = cliques_[c];
+    out.key(cl.frontal);
+    out.keys(cl.separator);
+    out.mat(cl.R);
+    out.mat(cl.S);
+    out.vec(cl.d);
+    writeLinear(out, cl.marginal);
+    out.ints(cl.owned);
+    out.i32(cl.parent);
+    out.ints(cl.children);
+  }
+  out.ints(free_cliques_);
+  std::vector<Key> indexed;
+  for (const auto& kv : slots_by_key_) indexed.push_back(kv.first);
+  std::sort(indexed.begin(), indexed.end());
+  out.u64(indexed.size());
+  for (const auto& k : indexed) {
+    out.key(k);
+    out.ints(slots_by_key_.at(k));
+  }
+  out.i64(next_rank_);
+  out.i32(root_);
+}
+
+void BayesTreeEngine::load(ByteReader& in, const Model& model) {
+  BayesTreeEngine e(mode_, wildfire_);
+  const std::uint8_t mode = in.u8("engine ordering mode");
+  if (mode != static_cast<std::uint8_t>(mode_))
+    in.fail("engine ordering mode " + std::to_string(mode) + " differs from the estimator options'");
+  const double wildfire = in.f64("engine wildfire threshold", true);
+  if (!(wildfire == wildfire_)) in.fail("engine wildfire threshold differs from the estimator options'");
+  const std::size_t nvars = in.count("engine variables", 9 + 16 + 12);
+  for (std::size_t i = 0; i < nvars; ++i) {
+    const Key k = in.key("engine variable key");
+    const std::string name = "variable " + k.toString();
+    if (e.vars_.count(k)) in.fail(name + " appears twice");
+    Var v;
+    v.anchor = in.vec(name + " anchor");
+    v.delta = in.vec(name + " delta");
+    if (v.anchor.size() != variableDim(model, k) || v.delta.size() != v.anchor.size())
+      in.fail(name + " has size " + std::to_string(v.anchor.size()) + " but the model's is " +
+              std::to_string(variableDim(model, k)));
+    v.clique = in.i32((name + " clique").c_str());
+    v.rank = in.i64((name + " rank").c_str());
+    e.vars_[k] = std::move(v);
+  }
+  e.slots_.resize(in.count("engine factor slots", 1));
+  for (std::size_t s = 0; s < e.slots_.size(); ++s) {
+    const std::string name = "factor slot " + std::to_string(s);
+    Slot& slot = e.slots_[s];
+    slot.alive = in.boolean((name + " alive").c_str());
+    if (!slot.alive) continue;
+    ++e.slots_alive_;
+    if (in.boolean((name + " has a nonlinear factor").c_str())) slot.nonlinear = readFactor(in, model, name);
+    slot.linear = readLinear(in, name + " linearization");
+    slot.owner = in.i32((name + " owner").c_str());
+  }
+  e.free_slots_ = in.ints("engine free slots");
+  e.cliques_.resize(in.count("engine cliques", 1));
+  e.clique_alive_.assign(e.cliques_.size(), false);
+  for (std::size_t c = 0; c < e.cliques_.size(); ++c) {
+    const std::string name = "clique " + std::to_string(c);
+    if (!in.boolean((name + " alive").c_str())) continue;
+    e.clique_alive_[c] = true;
+    ++e.cliques_alive_;
+    Clique& cl = e.cliques_[c];
+    cl.frontal = in.key(name + " frontal");
+    cl.separator = in.keys(name + " separator");
+    cl.R = in.mat(name + " R");
+    cl.S = in.mat(name + " S");
+    cl.d = in.vec(name + " d");
+    cl.marginal = readLinear(in, name + " marginal");
+    cl.owned = in.ints(name + " owned slots");
+    cl.parent = in.i32((name + " parent").c_str());
+    cl.children = in.ints(name + " children");
+  }
+  e.free_cliques_ = in.ints("engine free cliques");
+  const std::size_t nindexed = in.count("engine slot index", 9 + 8);
+  for (std::size_t i = 0; i < nindexed; ++i) {
+    const Key k = in.key("slot index key");
+    if (k.isConstants() || e.slots_by_key_.count(k)) in.fail("slot index: " + k.toString() + " not allowed or twice");
+    e.slots_by_key_[k] = in.ints("slots of " + k.toString());
+  }
+  e.next_rank_ = in.i64("engine next rank");
+  e.root_ = in.i32("engine root");
+  const std::string bad = e.invariantViolation();
+  if (!bad.empty()) in.fail("inconsistent Bayes tree: " + bad);
+  *this = std::move(e);
+}
+
+std::string BayesTreeEngine::invariantViolation() const {
+  const auto nc = static_cast<int>(cliques_.size()), ns = static_cast<int>(slots_.size());
+  auto aliveClique = [&](int c) { return c >= 0 && c < nc && clique_alive_[static_cast<std::size_t>(c)]; };
+  auto aliveSlot = [&](int s) { return s >= 0 && s < ns && slots_[static_cast<std::size_t>(s)].alive; };
+  auto dim = [&](const Key& k) -> Eigen::Index {
+    auto it = vars_.find(k);
+    return it == vars_.end() ? -1 : it->second.anchor.size();
+  };
+  auto linearOk = [&](const LinearFactor& f, const std::string& what) -> std::string {
+    if (f.A.size() != f.keys.size()) return what + ": blocks and keys differ in number";
+    for (std::size_t i = 0; i < f.keys.size(); ++i) {
+      if (dim(f.keys[i]) < 0) return what + " uses " + f.keys[i].toString() + ", which is not a variable";
+      if (f.A[i].rows() != f.b.size() || f.A[i].cols() != dim(f.keys[i]))
+        return what + ": block for " + f.keys[i].toString() + " has the wrong size";
+    }
+    return "";
+  };
+  if (clique_alive_.size() != cliques_.size()) return "clique flags and cliques differ in number";
+  std::size_t alive_slots = 0, alive_cliques = 0;
+  for (const auto& kv : vars_) {
+    const Var& v = kv.second;
+    if (v.anchor.size() == 0 || v.delta.size() != v.anchor.size()) return kv.first.toString() + " has an empty or mismatched value";
+    if (!aliveClique(v.clique)) return kv.first.toString() + " points to no live clique";
+    if (cliques_[static_cast<std::size_t>(v.clique)].frontal != kv.first)
+      return kv.first.toString() + "'s clique has another frontal variable";
+    if (v.rank < 0 || v.rank >= next_rank_) return kv.first.toString() + " has an elimination rank out of range";
+  }
+  for (int s = 0; s < ns; ++s) {
+    const Slot& slot = slots_[static_cast<std::size_t>(s)];
+    if (!slot.alive) continue;
+    ++alive_slots;
+    const std::string what = "factor slot " + std::to_string(s);
+    const std::string lin = linearOk(slot.linear, what);
+    if (!lin.empty()) return lin;
+    if (slot.nonlinear && (slot.nonlinear->keys() != slot.linear.keys ||
+                           slot.nonlinear->dim() != slot.linear.b.size()))
+      return what + ": its linearization does not match its factor";
+    if (!aliveClique(slot.owner)) return what + " is owned by no live clique";
+    const auto& owned = cliques_[static_cast<std::size_t>(slot.owner)].owned;
+    if (std::find(owned.begin(), owned.end(), s) == owned.end()) return what + ": its owner does not list it";
+  }
+  std::unordered_set<int> free_seen;
+  for (int s : free_slots_)
+    if (s < 0 || s >= ns || slots_[static_cast<std::size_t>(s)].alive || !free_seen.insert(s).second)
+      return "free slot " + std::to_string(s) + " is out of range, alive or listed twice";
+  if (free_seen.size() + alive_slots != slots_.size()) return "a dead factor slot is not on the free list";
+  for (const auto& kv : slots_by_key_)
+    for (int s : kv.second)
+      if (s < 0 || s >= ns) return "slot index of " + kv.first.toString() + " is out of range";
+  for (int c = 0; c < nc; ++c) {
+    if (!clique_alive_[static_cast<std::size_t>(c)]) continue;
+    ++alive_cliques;
+    const Clique& cl = cliques_[static_cast<std::size_t>(c)];
+    const std::string what = "clique " + std::to_string(c);
+    const Eigen::Index df = dim(cl.frontal);
+    if (df < 0 || vars_.at(cl.frontal).clique != c) return what + ": its frontal variable does not point back to it";
+    Eigen::Index dsep = 0;
+    for (const auto& k : cl.separator) {
+      if (dim(k) < 0 || k == cl.frontal) return what + ": separator variable " + k.toString() + " is invalid";
+      dsep += dim(k);
+    }
+    if (cl.R.rows() != df || cl.R.cols() != df || cl.S.rows() != df || cl.S.cols() != dsep || cl.d.size() != df)
+      return what + ": conditional has the wrong size";
+    if (cl.marginal.keys != cl.separator && !cl.marginal.keys.empty())
+      return what + ": marginal is not on its separator";
+    const std::string lin = linearOk(cl.marginal, what + " marginal");
+    if (!lin.empty()) return lin;
+    for (int s : cl.owned)
+      if (!aliveSlot(s) || slots_[static_cast<std::size_t>(s)].owner != c) return what + " owns slot " + std::to_string(s) + " that is not its own";
+    if (cl.parent != -1) {
+      if (!aliveClique(cl.parent)) return what + ": parent is not a live clique";
+      const auto& ch = cliques_[static_cast<std::size_t>(cl.parent)].children;
+      if (std::count(ch.begin(), ch.end(), c) != 1) return what + ": its parent does not list it once";
+      if (cl.separator.empty()) return what + " has a parent but no separator";
+    } else if (!cl.separator.empty()) {
+      return what + " has a separator but no parent";
+    }
+    for (int ch : cl.children)
+      if (!aliveClique(ch) || cliques_[static_cast<std::size_t>(ch)].parent != c) return what + ": child " + std::to_string(ch) + " does not point back";
+  }
+  // No cycles (every parent checked above): each chain reaches a root within nc steps.
+  for (int c = 0; c < nc; ++c) {
+    if (!clique_alive_[static_cast<std::size_t>(c)]) continue;
+    int steps = 0;
+    for (int p = cliques_[static_cast<std::size_t>(c)].parent; p >= 0; p = cliques_[static_cast<std::size_t>(p)].parent)
+      if (++steps > nc) return "clique " + std::to_string(c) + ": its parent chain has a cycle";
+  }
+  free_seen.clear();
+  for (int c : free_cliques_)
+    if (c < 0 || c >= nc || clique_alive_[static_cast<std::size_t>(c)] || !free_seen.insert(c).second)
+      return "free clique " + std::to_string(c) + " is out of range, alive or listed twice";
+  if (free_seen.size() + alive_cliques != cliques_.size()) return "a dead clique is not on the free list";
+  if (alive_slots != slots_alive_ || alive_cliques != cliques_alive_) return "live counts disagree";
+  if (alive_cliques != vars_.size()) return "cliques and variables differ in number";
+  if (root_ != -1 && (!aliveClique(root_) || cliques_[static_cast<std::size_t>(root_)].parent != -1))
+    return "the root is not a live parentless clique";
+  return "";
+}
+
+}  // namespace gssm::internal
