@@ -9,6 +9,7 @@
 #include "gssm/core/error.h"
 #include "linear/normal_equations.h"
 #include "linear/sparse_cholesky.h"
+#include "solvers/damping.h"
 #include "solvers/newton.h"
 
 namespace gssm {
@@ -184,7 +185,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   double cost = s.linearize(graph, x, g, diag, true);
   sum.initial_cost = cost;
   const bool lm = options_.method == BatchSolverOptions::Method::LevenbergMarquardt;
-  double lambda = lm ? options_.initial_lambda : 0.0;
+  internal::LevenbergMarquardtPolicy policy(options_.initial_lambda, options_.max_lambda, lm);
   Eigen::VectorXd delta;
 
   // candidate = from + d, written in place (both hold the same keys in the
@@ -200,17 +201,8 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     }
   };
 
-  // LM leaves a damping bias of order λ in its last steps, so whenever a
-  // convergence test passes while damped, the solver switches to undamped
-  // Gauss–Newton ("polish") and stops at the next convergence test: on a
-  // linear problem the result is the exact least-squares solution.
-  bool polishing = !lm;
   auto converge = [&](T reason) {
-    if (!polishing) {
-      polishing = true;
-      lambda = 0.0;
-      return false;  // keep going, undamped
-    }
+    if (!policy.converged()) return false;  // keep going, undamped
     sum.termination = reason;
     return true;
   };
@@ -224,13 +216,12 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       sum.termination = T::MaxIterations;
       break;
     }
-    s.setDamping(diag, lambda);
+    s.setDamping(diag, policy.lambda());
     ++sum.factorizations;
     const Eigen::Index bad = s.chol.factorize();
     if (bad >= 0) {
-      if (!lm || lambda >= options_.max_lambda) s.throwSingular(bad);
-      polishing = false;  // back to damped steps
-      lambda = std::max(lambda * 10, 1e-6);
+      if (!policy.canDampMore()) s.throwSingular(bad);
+      policy.singular();
       ++sum.rejected_steps;
       continue;
     }
@@ -241,7 +232,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       for (const auto& kv : x) xflat.segment(s.offset[i++], kv.second.size()) = kv.second;
     }
     if (delta.norm() <= options_.step_tolerance * (xflat.norm() + options_.step_tolerance)) {
-      if (polishing) {  // a tiny undamped step is still the exact correction: take it
+      if (policy.undamped()) {  // a tiny undamped step is still the exact correction: take it
         applyStep(x, delta, candidate);
         std::swap(x, candidate);
         cost = s.linearize(graph, x, g, diag, false);
@@ -256,18 +247,14 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     const double new_cost = s.linearize(graph, candidate, g_new, diag_new, false, true);
     if (!std::isfinite(new_cost) && !lm)  // Gauss–Newton cannot back off: say which factor
       s.linearize(graph, candidate, g_new, diag_new, false);
-    // Near the minimum the cost change (∝ ‖δ‖²) is below rounding, so an
-    // undamped polish step is kept unless it makes the cost clearly worse.
-    const bool accept = polishing ? (lm ? new_cost <= cost * (1 + 1e-10) : true) : new_cost < cost;
-    if (!accept) {
+    if (!policy.accept(new_cost, cost)) {
       ++sum.rejected_steps;
       cost = s.linearize(graph, x, g, diag, false);
-      if (polishing) {  // the damped solution was already converged
+      if (policy.undamped()) {  // the damped solution was already converged
         sum.termination = T::CostConverged;
         break;
       }
-      lambda *= 10;
-      if (lambda > options_.max_lambda) {
+      if (!policy.rejected()) {
         sum.termination = T::NoProgress;
         break;
       }
@@ -279,7 +266,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     std::swap(diag, diag_new);
     const double old_cost = cost;
     cost = new_cost;
-    if (!polishing) lambda = std::max(lambda / 10, 1e-12);
+    policy.accepted();
     if (g.lpNorm<Eigen::Infinity>() <= options_.gradient_tolerance) {
       if (converge(T::GradientConverged)) break;
     } else if (old_cost - cost <= options_.relative_cost_tolerance * old_cost) {
@@ -289,27 +276,32 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   const bool converged = sum.termination == T::CostConverged || sum.termination == T::StepConverged ||
                          sum.termination == T::GradientConverged;
   if (converged && options_.newton_polish_steps > 0) {
-    for (int it = 0; it < options_.newton_polish_steps; ++it) {
-      internal::NewtonSystem sys(x);
-      Eigen::VectorXd r;
-      std::vector<Eigen::MatrixXd> J;
-      for (const auto& f : graph) {
-        f->linearize(x, r, &J);
-        const Eigen::MatrixXd C = internal::residualCurvature(*f, x, r);
-        sys.add(f->keys(), r, J, &C);
-      }
-      Eigen::VectorXd d;
-      if (!sys.solve(d)) break;  // not near a minimum: keep the LM answer
-      Values xn = internal::addStep(x, d);
-      const double c = graph.cost(xn);
-      if (!(c <= cost * (1 + 1e-10))) break;
-      x = std::move(xn);
-      cost = c;
-      ++sum.newton_steps;
-      double xnorm = 0;
-      for (const auto& kv : x) xnorm += kv.second.squaredNorm();
-      if (d.norm() <= options_.step_tolerance * (std::sqrt(xnorm) + options_.step_tolerance)) break;
-    }
+    Values trial_x;
+    const internal::NewtonPolishResult polish = internal::newtonPolish(
+        x, cost, options_.newton_polish_steps,
+        [&](internal::NewtonSystem& sys, const Values& at) {
+          Eigen::VectorXd r;
+          std::vector<Eigen::MatrixXd> J;
+          for (const auto& f : graph) {
+            f->linearize(at, r, &J);
+            const Eigen::MatrixXd C = internal::residualCurvature(*f, at, r);
+            sys.add(f->keys(), r, J, &C);
+          }
+        },
+        [&](Values& next) {
+          trial_x = next;
+          return graph.cost(next);
+        },
+        [&](bool keep) {
+          if (keep) x = std::move(trial_x);
+        },
+        [&](const Values&, const Values& next, const Eigen::VectorXd& d) {
+          double xnorm = 0;
+          for (const auto& kv : next) xnorm += kv.second.squaredNorm();
+          return d.norm() <= options_.step_tolerance * (std::sqrt(xnorm) + options_.step_tolerance);
+        });
+    sum.newton_steps = polish.steps;
+    cost = polish.cost;
     if (sum.newton_steps > 0) cost = s.linearize(graph, x, g, diag, false);  // JᵀJ at the solution
   }
   // Factor the undamped information matrix at the solution: it gives the

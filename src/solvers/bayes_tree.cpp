@@ -4,6 +4,7 @@
 #include <Eigen/QR>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <optional>
 #include <ccolamd.h>
 #include <sstream>
 #include <unordered_set>
@@ -173,119 +174,164 @@ std::vector<Key> BayesTreeEngine::order(const std::vector<Key>& keys,
   return out;
 }
 
-void BayesTreeEngine::update(const Values& new_variables, const std::vector<FactorPtr>& new_factors,
-                             const std::vector<LinearFactor>& new_linear,
-                             const std::vector<int>& relinearize, EngineCounts& counts,
-                             double damping) {
-  // ---- 1. validate and linearize (nothing modified yet) -------------------
-  for (const auto& kv : new_variables) {
+// Where an input of the elimination comes from, so that commit() can give
+// each consumed factor its slot.
+struct InputSource {
+  enum class Kind { Slot, NewFactor, NewLinear, Orphan };
+  Kind kind;
+  int index;  // slot, or index into the new factors / new linear factors; unused for Orphan
+};
+
+struct BayesTreeEngine::UpdatePlan {
+  explicit UpdatePlan(const EngineUpdate& u)
+      : update(u),
+        new_variables(u.new_variables ? *u.new_variables : none),
+        new_factors(u.new_factors ? *u.new_factors : no_factors),
+        new_linear(u.new_linear ? *u.new_linear : no_linear) {}
+  const EngineUpdate& update;
+  const Values none{};
+  const std::vector<FactorPtr> no_factors{};
+  const std::vector<LinearFactor> no_linear{};
+  const Values& new_variables;
+  const std::vector<FactorPtr>& new_factors;
+  const std::vector<LinearFactor>& new_linear;
+  // linearizeInputs
+  std::vector<LinearFactor> linearized_new;         // of new_factors, same order
+  std::unordered_map<int, LinearFactor> relinearized;  // by slot
+  // detachTop
+  std::unordered_set<int> removed;
+  std::vector<int> removed_order;                   // cliques of the top, leaf to root
+  std::vector<int> orphans;                         // subtrees hanging below the top
+  std::vector<Key> keys;                            // variables to eliminate
+  std::vector<std::pair<const LinearFactor*, InputSource>> inputs;
+  // eliminateTop
+  std::vector<Key> ordering;
+  std::vector<Clique> fresh;                        // one per ordering entry
+  std::vector<std::vector<InputSource>> fresh_owned;  // factor inputs each fresh clique consumed
+  // commit
+  std::vector<int> fresh_id;
+};
+
+void BayesTreeEngine::update(const EngineUpdate& u, EngineCounts& counts) {
+  UpdatePlan plan(u);
+  linearizeInputs(plan);  // validates; nothing modified until commit()
+  detachTop(plan);
+  eliminateTop(plan);
+  commit(plan, counts);
+  backSubstituteTop(plan, counts);
+}
+
+// Phase 1: validate the new variables and factors, linearize the new
+// factors and the slots to relinearize at the current estimate.
+void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
+  for (const auto& kv : p.new_variables) {
     if (vars_.count(kv.first))
       throw InvalidArgument("variable " + kv.first.toString() + " already exists");
     if (!kv.second.allFinite())
       throw InvalidArgument("initial value of " + kv.first.toString() + " is not finite");
   }
-  auto known = [&](const Key& k) { return vars_.count(k) || new_variables.contains(k); };
-  std::vector<LinearFactor> lin_new;
-  for (const auto& f : new_factors) {
+  auto known = [&](const Key& k) { return vars_.count(k) || p.new_variables.contains(k); };
+  for (const auto& f : p.new_factors) {
     for (const auto& k : f->keys())
       if (!known(k))
         throw InvalidArgument("factor '" + f->describe() + "' uses " + k.toString() +
                               ", which is neither in the smoother nor added with it");
-    lin_new.push_back(linearize(*f, new_variables));
+    p.linearized_new.push_back(linearize(*f, p.new_variables));
   }
-  for (const auto& lf : new_linear)
+  for (const auto& lf : p.new_linear)
     for (const auto& k : lf.keys)
       if (!known(k)) throw InvalidArgument("linear factor uses unknown variable " + k.toString());
-  std::unordered_map<int, LinearFactor> relin;
-  for (int s : relinearize) {
+  for (int s : p.update.relinearize) {
     const Slot& slot = slots_.at(static_cast<std::size_t>(s));
-    if (slot.alive && slot.nonlinear) relin[s] = linearize(*slot.nonlinear, new_variables);
+    if (slot.alive && slot.nonlinear) p.relinearized[s] = linearize(*slot.nonlinear, p.new_variables);
   }
+}
 
-  // ---- 2. the top of the tree to re-eliminate ------------------------------
-  std::unordered_set<int> removed;
-  std::vector<int> removed_order;
+// Phase 2: the top of the tree to re-eliminate — every clique on the path
+// from a touched variable to the root — and what it consumes: the factors
+// its cliques owned (relinearized where asked), the new factors, and the
+// marginals of the orphaned subtrees below it.
+void BayesTreeEngine::detachTop(UpdatePlan& p) const {
   auto markUp = [&](const Key& k) {
     auto it = vars_.find(k);
     if (it == vars_.end()) return;
-    for (int c = it->second.clique; c >= 0 && !removed.count(c);
+    for (int c = it->second.clique; c >= 0 && !p.removed.count(c);
          c = cliques_[static_cast<std::size_t>(c)].parent) {
-      removed.insert(c);
-      removed_order.push_back(c);
+      p.removed.insert(c);
+      p.removed_order.push_back(c);
     }
   };
-  for (const auto& lf : lin_new)
+  for (const auto& lf : p.linearized_new)
     for (const auto& k : lf.keys) markUp(k);
-  for (const auto& lf : new_linear)
+  for (const auto& lf : p.new_linear)
     for (const auto& k : lf.keys) markUp(k);
-  for (const auto& kv : relin)
+  for (const auto& kv : p.relinearized)
     for (const auto& k : kv.second.keys) markUp(k);
 
-  // Inputs: factors owned by removed cliques, new factors, orphans' marginals.
-  struct Input {
-    const LinearFactor* f;
-    int slot;  // >= 0: an existing slot; -1 - i: new nonlinear i; -1000000 - i: new linear i; orphan: INT_MIN
-  };
-  constexpr int kOrphan = std::numeric_limits<int>::min();
-  constexpr int kNewLinearBase = -1000000000;
-  std::vector<Input> inputs;
-  std::vector<Key> keys;
-  std::vector<int> orphans;
-  for (int c : removed_order) {
+  using Kind = InputSource::Kind;
+  for (int c : p.removed_order) {
     const Clique& cl = cliques_[static_cast<std::size_t>(c)];
-    keys.push_back(cl.frontal);
+    p.keys.push_back(cl.frontal);
     for (int s : cl.owned) {
-      auto it = relin.find(s);
-      inputs.push_back({it != relin.end() ? &it->second : &slots_[static_cast<std::size_t>(s)].linear, s});
+      auto it = p.relinearized.find(s);
+      p.inputs.push_back({it != p.relinearized.end() ? &it->second : &slots_[static_cast<std::size_t>(s)].linear,
+                          {Kind::Slot, s}});
     }
     for (int ch : cl.children)
-      if (!removed.count(ch)) orphans.push_back(ch);
+      if (!p.removed.count(ch)) p.orphans.push_back(ch);
   }
-  for (const auto& kv : new_variables) keys.push_back(kv.first);
-  for (std::size_t i = 0; i < lin_new.size(); ++i) inputs.push_back({&lin_new[i], -1 - static_cast<int>(i)});
-  for (std::size_t i = 0; i < new_linear.size(); ++i)
-    inputs.push_back({&new_linear[i], kNewLinearBase + static_cast<int>(i)});
-  for (int o : orphans) inputs.push_back({&cliques_[static_cast<std::size_t>(o)].marginal, kOrphan});
+  for (const auto& kv : p.new_variables) p.keys.push_back(kv.first);
+  for (std::size_t i = 0; i < p.linearized_new.size(); ++i)
+    p.inputs.push_back({&p.linearized_new[i], {Kind::NewFactor, static_cast<int>(i)}});
+  for (std::size_t i = 0; i < p.new_linear.size(); ++i)
+    p.inputs.push_back({&p.new_linear[i], {Kind::NewLinear, static_cast<int>(i)}});
+  for (int o : p.orphans) p.inputs.push_back({&cliques_[static_cast<std::size_t>(o)].marginal, {Kind::Orphan, o}});
+}
 
+// Phase 3: order the top's variables and eliminate them one at a time into
+// new cliques (still nothing modified). Dense elimination of one variable
+// at a time (the paper's window system A_w X_w = b_w, solved by QR clique by
+// clique): stack the factors [A | b] with v first, triangularize, split R
+// into the conditional on v and the marginal factor on its separator.
+void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   std::vector<const LinearFactor*> fptrs;
-  for (const auto& in : inputs) fptrs.push_back(in.f);
-  const std::vector<Key> ordering = order(keys, fptrs, new_variables);
+  for (const auto& in : p.inputs) fptrs.push_back(in.first);
+  p.ordering = order(p.keys, fptrs, p.new_variables);
+  const std::vector<Key>& ordering = p.ordering;
   KeyTable<std::size_t> pos;
   for (std::size_t i = 0; i < ordering.size(); ++i) pos.set(ordering[i], i);
   KeyTable<Eigen::Index> dims;
   for (const auto& k : ordering) {
     const auto it = vars_.find(k);
-    dims.set(k, it != vars_.end() ? it->second.anchor.size() : new_variables.at(k).size());
+    dims.set(k, it != vars_.end() ? it->second.anchor.size() : p.new_variables.at(k).size());
   }
 
-  // ---- 3. eliminate in order into new cliques (still nothing modified) ----
-  // Dense elimination of one variable at a time (the paper's window system
-  // A_w X_w = b_w, solved by QR clique by clique): stack the factors [A | b]
-  // with v first, triangularize, split R into the conditional on v and the
-  // marginal factor on its separator.
+  // Each pending factor waits at the first of its variables in the ordering;
+  // the marginal a clique leaves on its separator joins the queue.
   std::vector<std::vector<std::size_t>> pending_of(ordering.size());
   std::vector<const LinearFactor*> pend;
-  std::vector<int> pend_slot;
-  std::vector<bool> used;
-  auto addPending = [&](const LinearFactor* f, int slot) {
+  std::vector<std::optional<InputSource>> pend_source;  // nullopt: a marginal made here
+  auto addPending = [&](const LinearFactor* f, std::optional<InputSource> source) {
     const std::size_t id = pend.size();
     pend.push_back(f);
-    pend_slot.push_back(slot);
-    used.push_back(false);
+    pend_source.push_back(source);
     std::size_t first = ordering.size();
     for (const auto& k : f->keys) first = std::min(first, pos.at(k));
     if (first < ordering.size()) pending_of[first].push_back(id);
   };
-  for (const auto& in : inputs) {
+  for (const auto& in : p.inputs) {
     bool empty = true;
-    for (const auto& k : in.f->keys) empty = empty && !pos.count(k);
+    for (const auto& k : in.first->keys) empty = empty && !pos.count(k);
     if (empty) continue;  // cannot happen for a consistent tree
-    addPending(in.f, in.slot);
+    addPending(in.first, in.second.kind == InputSource::Kind::Orphan ? std::nullopt
+                                                                      : std::optional<InputSource>(in.second));
   }
-  std::vector<Clique> fresh(ordering.size());
+  p.fresh.assign(ordering.size(), Clique{});
+  p.fresh_owned.assign(ordering.size(), {});
+  const double damping = p.update.damping;
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
     const Key& v = ordering[vi];
-    Clique& cl = fresh[vi];
+    Clique& cl = p.fresh[vi];
     cl.frontal = v;
     // Union of keys, v first then by position.
     std::vector<Key> sep;
@@ -313,7 +359,7 @@ void BayesTreeEngine::update(const Values& new_variables, const std::vector<Fact
         M.block(r0, colOf.at(f.keys[i]), f.b.size(), f.A[i].cols()) = f.A[i];
       M.block(r0, ncols, f.b.size(), 1) = f.b;
       r0 += f.b.size();
-      if (pend_slot[id] != kOrphan) cl.owned.push_back(pend_slot[id]);
+      if (pend_source[id]) p.fresh_owned[vi].push_back(*pend_source[id]);
     }
     if (damp_rows > 0) {
       // Marquardt rows pull δ_v toward its current value: √λ·D (δ_v − δ̂_v) = 0.
@@ -363,21 +409,25 @@ void BayesTreeEngine::update(const Values& new_variables, const std::vector<Fact
     const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
     m.b = Rfull.block(dv, ncols, mrows, 1);
     for (const auto& k : sep) m.A.push_back(Rfull.block(dv, colOf.at(k), mrows, dims.at(k)));
-    if (!sep.empty() && mrows > 0) addPending(&m, kOrphan);
+    if (!sep.empty() && mrows > 0) addPending(&m, std::nullopt);
   }
+}
 
-  // ---- 4. commit ----------------------------------------------------------
-  for (auto& kv : relin) {
+// Phase 4: replace the top by the new cliques, give new factors their
+// slots, and re-attach the orphans below the lowest of their separator's
+// cliques. Nothing here throws short of memory.
+void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
+  for (auto& kv : p.relinearized) {
     slots_[static_cast<std::size_t>(kv.first)].linear = std::move(kv.second);
     ++counts.factors_relinearized;
   }
-  for (int c : removed_order) {
+  for (int c : p.removed_order) {
     clique_alive_[static_cast<std::size_t>(c)] = false;
     cliques_[static_cast<std::size_t>(c)] = Clique{};
     free_cliques_.push_back(c);
     --cliques_alive_;
   }
-  for (const auto& kv : new_variables) {
+  for (const auto& kv : p.new_variables) {
     Var v;
     v.anchor = kv.second;
     v.delta = Eigen::VectorXd::Zero(kv.second.size());
@@ -387,28 +437,30 @@ void BayesTreeEngine::update(const Values& new_variables, const std::vector<Fact
     for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys)
       if (!k.isConstants()) slots_by_key_[k].push_back(s);
   };
-  std::vector<int> new_slot_of(lin_new.size()), new_lin_slot_of(new_linear.size());
-  for (std::size_t i = 0; i < lin_new.size(); ++i) {
+  std::vector<int> new_slot_of(p.linearized_new.size()), new_lin_slot_of(p.new_linear.size());
+  for (std::size_t i = 0; i < p.linearized_new.size(); ++i) {
     const int s = allocSlot();
-    slots_[static_cast<std::size_t>(s)] = Slot{new_factors[i], std::move(lin_new[i]), -1, true};
+    slots_[static_cast<std::size_t>(s)] = Slot{p.new_factors[i], std::move(p.linearized_new[i]), -1, true};
     new_slot_of[i] = s;
     registerSlot(s);
   }
-  for (std::size_t i = 0; i < new_linear.size(); ++i) {
+  for (std::size_t i = 0; i < p.new_linear.size(); ++i) {
     const int s = allocSlot();
-    slots_[static_cast<std::size_t>(s)] = Slot{nullptr, new_linear[i], -1, true};
+    slots_[static_cast<std::size_t>(s)] = Slot{nullptr, p.new_linear[i], -1, true};
     new_lin_slot_of[i] = s;
     registerSlot(s);
   }
-  std::vector<int> fresh_id(ordering.size());
+  const std::vector<Key>& ordering = p.ordering;
+  p.fresh_id.resize(ordering.size());
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
     const int c = allocClique();
-    fresh_id[vi] = c;
-    for (int& s : fresh[vi].owned) {
-      if (s <= kNewLinearBase + static_cast<int>(new_linear.size()) && s >= kNewLinearBase)
-        s = new_lin_slot_of[static_cast<std::size_t>(s - kNewLinearBase)];
-      else if (s < 0)
-        s = new_slot_of[static_cast<std::size_t>(-1 - s)];
+    p.fresh_id[vi] = c;
+    for (const InputSource& src : p.fresh_owned[vi]) {
+      using Kind = InputSource::Kind;
+      const int s = src.kind == Kind::Slot        ? src.index
+                    : src.kind == Kind::NewFactor ? new_slot_of[static_cast<std::size_t>(src.index)]
+                                                  : new_lin_slot_of[static_cast<std::size_t>(src.index)];
+      p.fresh[vi].owned.push_back(s);
       slots_[static_cast<std::size_t>(s)].owner = c;
     }
     Var& var = vars_.at(ordering[vi]);
@@ -416,18 +468,18 @@ void BayesTreeEngine::update(const Values& new_variables, const std::vector<Fact
     var.rank = next_rank_++;
   }
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
-    Clique& cl = fresh[vi];
+    Clique& cl = p.fresh[vi];
     cl.parent = cl.separator.empty() ? -1 : vars_.at(cl.separator.front()).clique;
-    cliques_[static_cast<std::size_t>(fresh_id[vi])] = std::move(cl);
+    cliques_[static_cast<std::size_t>(p.fresh_id[vi])] = std::move(cl);
   }
   root_ = -1;
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
-    const int c = fresh_id[vi];
-    const int p = cliques_[static_cast<std::size_t>(c)].parent;
-    if (p >= 0) cliques_[static_cast<std::size_t>(p)].children.push_back(c);
+    const int c = p.fresh_id[vi];
+    const int parent = cliques_[static_cast<std::size_t>(c)].parent;
+    if (parent >= 0) cliques_[static_cast<std::size_t>(parent)].children.push_back(c);
     else root_ = c;
   }
-  for (int o : orphans) {
+  for (int o : p.orphans) {
     Clique& oc = cliques_[static_cast<std::size_t>(o)];
     int best = -1;
     std::int64_t best_rank = 0;
@@ -446,17 +498,17 @@ void BayesTreeEngine::update(const Values& new_variables, const std::vector<Fact
       if (clique_alive_[c] && cliques_[c].parent < 0) root_ = static_cast<int>(c);
   counts.cliques_reeliminated += static_cast<int>(ordering.size());
   counts.top = ordering;
-  counts.orphans += static_cast<int>(orphans.size());
+  counts.orphans += static_cast<int>(p.orphans.size());
+}
 
-  // ---- 5. back-substitution: the new top, then wildfire into orphans ------
-  std::unordered_set<int> changed;
-  for (std::size_t vi = ordering.size(); vi-- > 0;) {
-    backSubstitute(fresh_id[vi]);
+// Phase 5: back-substitution of the new top, then wildfire into orphans
+// while a separator variable moved more than the threshold.
+void BayesTreeEngine::backSubstituteTop(const UpdatePlan& p, EngineCounts& counts) {
+  for (std::size_t vi = p.ordering.size(); vi-- > 0;) {
+    backSubstitute(p.fresh_id[vi]);
     ++counts.variables_backsubstituted;
   }
-  // Wildfire: descend into subtrees while a separator variable moved more
-  // than the threshold since that subtree was last solved.
-  std::vector<int> stack(orphans.begin(), orphans.end());
+  std::vector<int> stack(p.orphans.begin(), p.orphans.end());
   while (!stack.empty()) {
     const int c = stack.back();
     stack.pop_back();

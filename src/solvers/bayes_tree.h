@@ -59,20 +59,40 @@ struct EngineCounts {
   int variables_backsubstituted = 0;
 };
 
+/// What one engine update adds and relinearizes; every part may be empty.
+struct EngineUpdate {
+  const Values* new_variables = nullptr;                 ///< initial values become their anchors
+  const std::vector<FactorPtr>* new_factors = nullptr;   ///< nonlinear factors
+  const std::vector<LinearFactor>* new_linear = nullptr; ///< fixed linear factors
+  std::vector<int> relinearize;  ///< factor slots to relinearize at the current estimate
+  /// λ > 0 adds Levenberg–Marquardt rows √λ·diag(‖A_v‖)(δ_v − δ̂_v) to every
+  /// variable eliminated (the iterate-to-convergence mode).
+  double damping = 0.0;
+
+  static EngineUpdate adding(const std::vector<FactorPtr>& factors, const Values& variables) {
+    EngineUpdate u;
+    u.new_factors = &factors;
+    u.new_variables = &variables;
+    return u;
+  }
+  static EngineUpdate relinearizing(std::vector<int> slots, double damping = 0.0) {
+    EngineUpdate u;
+    u.relinearize = std::move(slots);
+    u.damping = damping;
+    return u;
+  }
+};
+
 class BayesTreeEngine {
  public:
   explicit BayesTreeEngine(OrderingMode mode, double wildfire_threshold)
       : mode_(mode), wildfire_(wildfire_threshold) {}
 
-  /// Adds variables (initial values become their anchors), nonlinear and
-  /// fixed linear factors, and relinearizes the given factor slots at the
-  /// current estimate; re-eliminates the affected top of the tree and
-  /// back-substitutes. Strong exception guarantee.
-  /// `damping` λ > 0 adds Levenberg–Marquardt rows √λ·diag(‖A_v‖)(δ_v − δ̂_v)
-  /// to every variable eliminated (used by the iterate-to-convergence mode).
-  void update(const Values& new_variables, const std::vector<FactorPtr>& new_factors,
-              const std::vector<LinearFactor>& new_linear, const std::vector<int>& relinearize,
-              EngineCounts& counts, double damping = 0.0);
+  /// Re-eliminates the top of the tree that the update's factors touch and
+  /// back-substitutes it, in phases: linearize the inputs, detach the top,
+  /// eliminate it into new cliques (nothing modified until here), commit,
+  /// back-substitute. Strong exception guarantee.
+  void update(const EngineUpdate& u, EngineCounts& counts);
 
 
   /// Removes a variable whose clique is a leaf; its subtree's marginal on the
@@ -139,6 +159,13 @@ class BayesTreeEngine {
     int owner = -1;
     bool alive = false;
   };
+
+  struct UpdatePlan;  // the work of one update before it is committed (bayes_tree.cpp)
+  void linearizeInputs(UpdatePlan& plan) const;
+  void detachTop(UpdatePlan& plan) const;
+  void eliminateTop(UpdatePlan& plan) const;
+  void commit(UpdatePlan& plan, EngineCounts& counts);
+  void backSubstituteTop(const UpdatePlan& plan, EngineCounts& counts);
 
   LinearFactor linearize(const Factor& f, const Values& extra) const;
   std::vector<Key> order(const std::vector<Key>& keys, const std::vector<const LinearFactor*>& factors,

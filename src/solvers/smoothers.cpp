@@ -1,9 +1,11 @@
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <sstream>
 
 #include "gssm/core/error.h"
 #include "gssm/solvers/smoothers.h"
+#include "solvers/damping.h"
 #include "solvers/newton.h"
 #include "solvers/option_fields.h"
 #include "solvers/smoother_core.h"
@@ -80,7 +82,7 @@ void SmootherCore::relinearize(const std::vector<int>& candidates, double thresh
   rep.factors_checked += static_cast<int>(candidates.size());
   if (stale.empty()) return;
   try {
-    engine.update(Values{}, {}, {}, stale, counts);
+    engine.update(internal::EngineUpdate::relinearizing(std::move(stale)), counts);
     ++rep.iterations;
   } catch (const NumericalError& e) {
     // The engine is unchanged: keep the previous linearization and say so.
@@ -107,33 +109,29 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
   counts.variables_backsubstituted += engine.solveAll();
   Values previous = engine.allEstimates();
   double previous_cost = engine.cost();
-  double lambda = 1e-4;
-  bool polishing = false;  // as in BatchSolver: converged while damped → finish undamped
+  internal::LevenbergMarquardtPolicy policy;  // the batch solver's policy and defaults
   for (int it = 0; it < options.max_iterations; ++it) {
     const std::vector<int> all = engine.nonlinearSlots();
     if (all.empty()) break;
     internal::BayesTreeEngine snapshot = engine;
     internal::EngineCounts trial = counts;
     try {
-      engine.update(Values{}, {}, {}, all, trial, polishing ? 0.0 : lambda);
+      engine.update(internal::EngineUpdate::relinearizing(all, policy.lambda()), trial);
     } catch (const NumericalError& e) {
       engine = std::move(snapshot);
-      if (polishing || lambda > 1e10) {
+      if (policy.undamped() || !policy.rejected()) {
         rep.note = std::string("iteration stopped: ") + e.what();
         break;
       }
-      lambda *= 10;
       continue;
     }
     ++rep.iterations;
     rep.factors_checked += static_cast<int>(all.size());
     trial.variables_backsubstituted += engine.solveAll();
     const double cost = engine.cost();
-    if (!(cost <= previous_cost * (1 + (polishing ? 1e-10 : 0.0)))) {
+    if (!policy.accept(cost, previous_cost)) {
       engine = std::move(snapshot);  // worse: undo, damp more
-      if (polishing) break;
-      lambda *= 10;
-      if (lambda > 1e10) break;
+      if (policy.undamped() || !policy.rejected()) break;
       continue;
     }
     counts = trial;
@@ -141,45 +139,43 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
     const double change = relChange(now, previous);
     previous = std::move(now);
     previous_cost = cost;
-    if (!polishing) lambda = std::max(lambda / 10, 1e-12);
-    if (change <= options.convergence_tolerance) {
-      if (polishing) break;
-      polishing = true;
-    }
+    policy.accepted();
+    if (change <= options.convergence_tolerance && policy.converged()) break;
   }
   // Newton polish: quadratic convergence where the iteration above crawls.
-  for (int it = 0; it < options.newton_polish_steps; ++it) {
-    const Values x = engine.allEstimates();
-    internal::NewtonSystem sys(x);
-    engine.addToNewton(sys, x);
-    Eigen::VectorXd d;
-    if (!sys.solve(d)) {
-      rep.note = "Newton polish skipped: the Hessian is not positive definite here";
-      break;
-    }
-    internal::BayesTreeEngine snapshot = engine;
-    internal::EngineCounts trial = counts;
-    try {
-      engine.setEstimates(internal::addStep(x, d));
-      engine.update(Values{}, {}, {}, engine.nonlinearSlots(), trial, 0.0);  // the tree at the new point
-    } catch (const NumericalError& e) {
-      engine = std::move(snapshot);
-      rep.note = std::string("Newton polish stopped: ") + e.what();
-      break;
-    }
-    trial.variables_backsubstituted += engine.solveAll();
-    const double cost = engine.cost();
-    if (!(cost <= previous_cost * (1 + 1e-10))) {
-      engine = std::move(snapshot);
-      break;
-    }
-    counts = trial;
-    ++rep.iterations;
-    Values now = engine.allEstimates();
-    const double change = relChange(now, x);
-    previous_cost = cost;
-    if (change <= options.convergence_tolerance) break;
-  }
+  internal::BayesTreeEngine snapshot = engine;
+  internal::EngineCounts trial = counts;
+  std::string failure;
+  const internal::NewtonPolishResult polish = internal::newtonPolish(
+      engine.allEstimates(), previous_cost, options.newton_polish_steps,
+      [&](internal::NewtonSystem& sys, const Values& x) { engine.addToNewton(sys, x); },
+      [&](Values& next) {
+        snapshot = engine;
+        trial = counts;
+        try {
+          engine.setEstimates(next);
+          engine.update(internal::EngineUpdate::relinearizing(engine.nonlinearSlots(), 0.0), trial);  // the tree there
+        } catch (const NumericalError& e) {
+          failure = e.what();
+          return std::numeric_limits<double>::infinity();
+        }
+        trial.variables_backsubstituted += engine.solveAll();
+        next = engine.allEstimates();  // the re-elimination moved on from the Newton point
+        return engine.cost();
+      },
+      [&](bool keep) {
+        if (!keep) {
+          engine = std::move(snapshot);
+          return;
+        }
+        counts = trial;
+        ++rep.iterations;
+      },
+      [&](const Values& from, const Values& to, const Eigen::VectorXd&) {
+        return relChange(to, from) <= options.convergence_tolerance;
+      });
+  if (polish.indefinite) rep.note = "Newton polish skipped: the Hessian is not positive definite here";
+  else if (!failure.empty()) rep.note = "Newton polish stopped: " + failure;
 }
 
 UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, const Values& new_values) {
@@ -188,7 +184,7 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
   rep.new_factors = static_cast<int>(new_factors.size());
   rep.new_variables = static_cast<int>(new_values.size());
   internal::EngineCounts counts;
-  engine.update(new_values, new_factors, {}, {}, counts);  // may throw: nothing changed
+  engine.update(internal::EngineUpdate::adding(new_factors, new_values), counts);  // may throw: nothing changed
   rep.iterations = 1;
 
   if (!options.relinearize) {
