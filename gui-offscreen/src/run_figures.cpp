@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "gssm/core/time.h"
 #include "gssm/plot/figure.h"
 
 namespace gssm::plot {
@@ -32,13 +33,14 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
       const Color c = paletteColor(r);
       Series s{display(runs[r].method), {}, {}, c, 2, false};
       Band b{{}, {}, {}, c, 0.15};
-      std::size_t j = 0;
+      std::optional<TimeMatcher> match;
+      if (truth) match.emplace(truth->times);
       for (const auto& row : runs[r].rows) {
         double ref = 0;
         if (!constant) {
-          while (j < truth->times.size() && truth->times[j] < row.t - 1e-9) ++j;
-          if (j == truth->times.size()) break;
-          ref = truth->states[j][idx];
+          const auto j = match->find(row.t);
+          if (!j) continue;  // no truth at this time: no error to draw
+          ref = truth->states[*j][idx];
         }
         const double v = row.mean[idx] - ref, sd = std::sqrt(row.covariance(idx, idx));
         s.x.push_back(row.t);

@@ -8,6 +8,7 @@
 
 #include "gssm/solvers/batch_solver.h"
 #include "gssm/core/error.h"
+#include "gssm/core/time.h"
 #include "gssm/factors/problem.h"
 
 namespace gssm {
@@ -17,12 +18,11 @@ namespace {
 // measurements: states at the problem's step times, constants.
 Values truthAt(const Problem& p, const SimulatedRun& run, const Model& model) {
   Values v;
-  std::size_t j = 0;
+  TimeMatcher match(run.times);
   for (std::size_t k = 0; k < p.times.size(); ++k) {
-    while (j + 1 < run.times.size() && run.times[j] < p.times[k] - 1e-9) ++j;
-    if (std::abs(run.times[j] - p.times[k]) > 1e-9)
-      throw InvalidArgument("posteriorCramerRao: no true state at t = " + std::to_string(p.times[k]));
-    v.insert(Key::state(static_cast<std::int64_t>(k)), run.states[j]);
+    const auto j = match.find(p.times[k]);
+    if (!j) throw InvalidArgument("posteriorCramerRao: no true state at t = " + std::to_string(p.times[k]));
+    v.insert(Key::state(static_cast<std::int64_t>(k)), run.states[*j]);
   }
   if (model.dims().nb > 0) v.insert(Key::constants(), run.constants);
   return v;
@@ -30,9 +30,9 @@ Values truthAt(const Problem& p, const SimulatedRun& run, const Model& model) {
 
 // Step index of the state at time t.
 std::int64_t stepAt(const Problem& p, double t) {
-  for (std::size_t k = p.times.size(); k-- > 0;)
-    if (std::abs(p.times[k] - t) <= 1e-9) return static_cast<std::int64_t>(k);
-  throw InvalidArgument("posteriorCramerRao: no step at t = " + std::to_string(t));
+  const auto k = TimeMatcher(p.times).find(t);
+  if (!k) throw InvalidArgument("posteriorCramerRao: no step at t = " + std::to_string(t));
+  return static_cast<std::int64_t>(*k);
 }
 
 Eigen::MatrixXd boundAt(BatchSolver& solver, const Model& model, std::int64_t k) {

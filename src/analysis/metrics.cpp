@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "gssm/analysis/errors.h"
 #include "gssm/core/error.h"
 
 namespace gssm {
@@ -29,25 +30,12 @@ RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth
   m.iterations = run.iterations;
   if (!truth || run.rows.empty()) return m;
   m.has_truth = true;
-  const Eigen::Index n = static_cast<Eigen::Index>(m.names.size());
-  Eigen::VectorXd sq = Eigen::VectorXd::Zero(n);
+  const RunErrors errors = runErrors(run, *truth);
+  m.rows = errors.error.size();
+  m.rmse = errors.rmse();
+  m.final_error = errors.error.back();
   double nees = 0;
-  std::size_t j = 0;
-  for (const auto& row : run.rows) {
-    while (j < truth->times.size() && truth->times[j] < row.t - 1e-9) ++j;
-    if (j == truth->times.size() || std::abs(truth->times[j] - row.t) > 1e-9)
-      {
-      std::ostringstream os;
-      os << std::setprecision(17) << "metrics: no truth row at t = " << row.t;
-      throw InvalidArgument(os.str());
-    }
-    const Eigen::VectorXd e = row.mean - truth->states[j];
-    sq += e.cwiseAbs2();
-    nees += e.dot(row.covariance.ldlt().solve(e));
-    m.final_error = e;
-    ++m.rows;
-  }
-  m.rmse = (sq / static_cast<double>(m.rows)).cwiseSqrt();
+  for (double v : errors.nees) nees += v;
   m.mean_nees = nees / static_cast<double>(m.rows);
   return m;
 }

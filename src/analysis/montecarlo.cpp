@@ -10,6 +10,7 @@
 #include <sstream>
 #include <thread>
 
+#include "gssm/analysis/errors.h"
 #include "gssm/core/error.h"
 #include "gssm/estimator/estimator.h"
 #include "gssm/analysis/offline.h"
@@ -97,6 +98,7 @@ MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCa
     for (int s = next++; s < options.seeds; s = next++) {
       const unsigned seed = options.first_seed + static_cast<unsigned>(s);
       const SimulatedRun run = simulate(*model, spec, sampler_for_seed(seed));
+      const Truth truth = run.truth();
       {
         std::lock_guard<std::mutex> lock(times_mutex);
         if (times.empty())
@@ -110,19 +112,11 @@ MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCa
           eo.compute_nis = true;
           const OfflineRun out = runOffline(estimator_model, eo, run.measurements, run.inputs);
           r.nis = out.nis;
-          Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
-          std::size_t j = 0;  // truth row at the estimate's time (multi-rate: not every step)
-          for (std::size_t k = 0; k < out.rows.size(); ++k) {
-            while (j + 1 < run.times.size() && run.times[j] < out.rows[k].t - 1e-9) ++j;
-            Eigen::VectorXd truth(n);
-            truth << run.states[j], run.constants;
-            const Eigen::VectorXd e = out.rows[k].mean - truth;
-            r.sq.push_back(e.cwiseAbs2());
-            r.nees.push_back(e.dot(out.rows[k].covariance.ldlt().solve(e)));
-            sum += e.cwiseAbs2();
-            r.final_error = e;
-          }
-          r.rmse = (sum / static_cast<double>(out.rows.size())).cwiseSqrt();
+          const RunErrors errors = runErrors(out, truth);
+          for (const auto& e : errors.error) r.sq.push_back(e.cwiseAbs2());
+          r.nees = errors.nees;
+          r.rmse = errors.rmse();
+          r.final_error = errors.error.back();
           r.ok = true;
         } catch (const std::exception& e) {
           r.error = e.what();

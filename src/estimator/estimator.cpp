@@ -9,6 +9,7 @@
 #include "core/byte_stream.h"
 #include "factors/factor_io.h"
 #include "gssm/core/error.h"
+#include "gssm/core/time.h"
 #include "gssm/factors/problem.h"
 #include "gssm/solvers/batch_solver.h"
 #include "solvers/option_fields.h"
@@ -129,7 +130,7 @@ void Estimator::addInput(double t, const Eigen::VectorXd& u) {
   requireVector(u, model_.dims().nu, std::string(methodName()) + ": input u at t = " + std::to_string(t));
   // A time stamp within rounding of the newest state's (k·T computed two
   // ways) means "now".
-  if (std::isfinite(t) && t < t_ && t_ - t <= 1e-9 * std::max(1.0, std::abs(t_))) t = t_;
+  if (std::isfinite(t) && t < t_ && sameTime(t, t_)) t = t_;
   if (!std::isfinite(t) || t < t_) {
     std::ostringstream os;
     os << methodName() << ": input at t = " << t << " must be at or after the newest state (t = " << t_ << ")";
@@ -199,10 +200,6 @@ void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
 
 namespace {
 
-// State times are accumulated step by step (t_k + dt), so the newest may
-// differ from the estimator's time by rounding.
-bool sameTime(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); }
-
 Eigen::VectorXd stack(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) {
   Eigen::VectorXd z(xc.size() + xb.size());
   z << xc, xb;
@@ -268,15 +265,6 @@ class EkfEstimator final : public Estimator {
 };
 
 // ---- IncrementalSmoother / FixedLagSmoother --------------------------------------
-// The factors one GSSM step adds: process x_c(k−1) → x_c(k) (touching x_b)
-// and the measurement at x_c(k); x_c(k) starts at its prediction.
-std::vector<FactorPtr> stepFactors(const Model& m, std::int64_t k, double dt,
-                                   const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
-  std::vector<FactorPtr> f{std::make_shared<ProcessFactor>(m, k - 1, u, dt)};
-  if (y.size()) f.push_back(std::make_shared<MeasurementFactor>(m, k, y));
-  return f;
-}
-
 // x_c(k) starts at the model's prediction; a non-finite one is a numerical
 // failure of the model, reported before anything changes.
 Eigen::VectorXd predictState(const Model& m, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
@@ -291,14 +279,11 @@ Eigen::VectorXd predictState(const Model& m, const Eigen::VectorXd& xc, const Ei
   return x;
 }
 
-std::vector<FactorPtr> priorFactors(const Model& m, Values& initial) {
-  std::vector<FactorPtr> f{std::make_shared<PriorFactor>(Key::state(0), m.priorState())};
+// The model's priors with their means as initial values.
+std::vector<FactorPtr> modelPriors(const Model& m, Values& initial) {
   initial.insert(Key::state(0), m.priorState().mean);
-  if (m.dims().nb > 0) {
-    f.push_back(std::make_shared<PriorFactor>(Key::constants(), m.priorConstants()));
-    initial.insert(Key::constants(), m.priorConstants().mean);
-  }
-  return f;
+  if (m.dims().nb > 0) initial.insert(Key::constants(), m.priorConstants().mean);
+  return priorFactors(m, m.priorState(), m.priorConstants());
 }
 
 template <class Smoother>
@@ -309,7 +294,7 @@ class SmootherEstimator final : public Estimator {
   SmootherEstimator(const Model& m, const EstimatorOptions& o, std::size_t keep_times, Args&&... args)
       : Estimator(m, o), smoother_(std::forward<Args>(args)...), keep_times_(keep_times) {
     Values initial;
-    const auto priors = priorFactors(m, initial);
+    const auto priors = modelPriors(m, initial);
     report_.smoother = smoother_.update(priors, initial);
     times_.push_back(o.t0);
   }
@@ -399,7 +384,7 @@ class PaperWindowEstimator final : public Estimator {
       prior_constants_ = m.priorConstants();
     }
     times_.push_back(o.t0);
-    solve(values_, solver_);
+    solver_.solve(graph(), values_);
   }
 
   StateEstimate current() override { return *smoothed(step()); }
@@ -432,7 +417,7 @@ class PaperWindowEstimator final : public Estimator {
     values.insert(Key::state(k), predictState(model_, values.at(Key::state(k - 1)), xb, u, dt, k));
     times.push_back(times.back() + dt);
     BatchSolver solver(gaussNewton());
-    const BatchSolverSummary sum = solve(values, solver, &steps, &prior_state, &prior_constants, oldest);
+    const BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state, prior_constants, oldest), values);
     if (static_cast<int>(steps.size()) + 1 > window_) {
       // Window full: drop the oldest state, new 1-D priors from this solve.
       const Key next = Key::state(oldest + 1);
@@ -444,7 +429,7 @@ class PaperWindowEstimator final : public Estimator {
       times.pop_front();
       ++oldest;
       // Re-solve so the reported covariances belong to the new window.
-      solve(values, solver, &steps, &prior_state, &prior_constants, oldest);
+      solver.solve(windowGraph(steps, prior_state, prior_constants, oldest), values);
     }
     steps_ = std::move(steps);
     times_ = std::move(times);
@@ -464,7 +449,7 @@ class PaperWindowEstimator final : public Estimator {
     Values values = values_;
     steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, y));
     BatchSolver solver(gaussNewton());
-    const BatchSolverSummary sum = solve(values, solver, &steps, &prior_state_, &prior_constants_, oldest_);
+    const BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state_, prior_constants_, oldest_), values);
     steps_ = std::move(steps);
     values_ = std::move(values);
     solver_ = std::move(solver);
@@ -481,24 +466,17 @@ class PaperWindowEstimator final : public Estimator {
   static Gaussian diagonalPrior(const Eigen::VectorXd& mean, const Eigen::MatrixXd& cov) {
     return {mean, Eigen::MatrixXd(cov.diagonal().asDiagonal())};
   }
-  BatchSolverSummary solve(Values& values, BatchSolver& solver,
-                           const std::deque<std::vector<FactorPtr>>* steps = nullptr,
-                           const Gaussian* ps = nullptr, const Gaussian* pb = nullptr,
-                           std::int64_t oldest = 0) {
-    if (!steps) {
-      steps = &steps_;
-      ps = &prior_state_;
-      pb = &prior_constants_;
-      oldest = oldest_;
-      solver = BatchSolver(gaussNewton());
-    }
+  // The window's graph: the priors on its oldest state and the constants,
+  // then every step's factors.
+  FactorGraph windowGraph(const std::deque<std::vector<FactorPtr>>& steps, const Gaussian& prior_state,
+                          const Gaussian& prior_constants, std::int64_t oldest) const {
     FactorGraph g;
-    g.add(std::make_shared<PriorFactor>(Key::state(oldest), *ps));
-    if (model_.dims().nb > 0) g.add(std::make_shared<PriorFactor>(Key::constants(), *pb));
-    for (const auto& s : *steps)
+    for (const auto& f : priorFactors(model_, prior_state, prior_constants, oldest)) g.add(f);
+    for (const auto& s : steps)
       for (const auto& f : s) g.add(f);
-    return solver.solve(g, values);
+    return g;
   }
+  FactorGraph graph() const { return windowGraph(steps_, prior_state_, prior_constants_, oldest_); }
 
   void saveState(internal::ByteWriter& out) const override {
     out.u64(steps_.size());
@@ -543,15 +521,6 @@ class PaperWindowEstimator final : public Estimator {
     oldest_ = oldest;
     solver_.evaluateAt(graph(), values_);
   }
-  FactorGraph graph() const {
-    FactorGraph g;
-    g.add(std::make_shared<PriorFactor>(Key::state(oldest_), prior_state_));
-    if (model_.dims().nb > 0) g.add(std::make_shared<PriorFactor>(Key::constants(), prior_constants_));
-    for (const auto& s : steps_)
-      for (const auto& f : s) g.add(f);
-    return g;
-  }
-
   std::string formatDetail() const override { return last_summary_.toString(); }
   BatchSolverSummary last_summary_;
   int window_;

@@ -30,6 +30,20 @@ std::vector<ScheduledStep> stepSchedule(const std::vector<Measurement>& measurem
   return steps;
 }
 
+std::vector<FactorPtr> priorFactors(const Model& model, const Gaussian& state_prior,
+                                    const Gaussian& constants_prior, std::int64_t step) {
+  std::vector<FactorPtr> f{std::make_shared<PriorFactor>(Key::state(step), state_prior)};
+  if (model.dims().nb > 0) f.push_back(std::make_shared<PriorFactor>(Key::constants(), constants_prior));
+  return f;
+}
+
+std::vector<FactorPtr> stepFactors(const Model& model, std::int64_t k, double dt, const Eigen::VectorXd& u,
+                                   const Eigen::VectorXd& y) {
+  std::vector<FactorPtr> f{std::make_shared<ProcessFactor>(model, k - 1, u, dt)};
+  if (y.size()) f.push_back(std::make_shared<MeasurementFactor>(model, k, y));
+  return f;
+}
+
 Problem buildProblem(const Model& model, const std::vector<Measurement>& measurements,
                      const std::vector<Input>& inputs, double t0) {
   for (std::size_t i = 0; i < inputs.size(); ++i) {
@@ -51,18 +65,15 @@ Problem buildProblem(const Model& model, const std::vector<Measurement>& measure
   Problem p;
   p.times.push_back(t0);
   const bool has_constants = model.dims().nb > 0;
-  p.graph.add(std::make_shared<PriorFactor>(Key::state(0), model.priorState()));
+  for (const auto& f : priorFactors(model, model.priorState(), model.priorConstants())) p.graph.add(f);
   p.initial.insert(Key::state(0), model.priorState().mean);
-  if (has_constants) {
-    p.graph.add(std::make_shared<PriorFactor>(Key::constants(), model.priorConstants()));
-    p.initial.insert(Key::constants(), model.priorConstants().mean);
-  }
+  if (has_constants) p.initial.insert(Key::constants(), model.priorConstants().mean);
   const Eigen::VectorXd xb0 = has_constants ? model.priorConstants().mean : Eigen::VectorXd();
   for (const ScheduledStep& step : stepSchedule(measurements, inputs, t0)) {
     const double prev = p.times.back();
     const auto k = static_cast<std::int64_t>(p.times.size()) - 1;
     const Eigen::VectorXd u = inputAt(model, inputs, prev);
-    p.graph.add(std::make_shared<ProcessFactor>(model, k, u, step.t - prev));
+    for (const auto& f : stepFactors(model, k + 1, step.t - prev, u)) p.graph.add(f);
     p.initial.insert(Key::state(k + 1), model.f(p.initial.at(Key::state(k)), xb0, u, step.t - prev));
     p.times.push_back(step.t);
     for (std::size_t i : step.measurements)

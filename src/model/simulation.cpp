@@ -51,4 +51,15 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
   return run;
 }
 
+Truth SimulatedRun::truth() const {
+  Truth t;
+  t.times = times;
+  for (const auto& x : states) {
+    Eigen::VectorXd z(x.size() + constants.size());
+    z << x, constants;
+    t.states.push_back(std::move(z));
+  }
+  return t;
+}
+
 }  // namespace gssm

@@ -22,7 +22,7 @@ struct RunMetrics {
   bool has_truth = false;
 };
 
-/// Matches rows to truth by time (to 1e-9 s); throws InvalidArgument if an
+/// Matches rows to truth by time (runErrors); throws InvalidArgument if an
 /// estimate time has no truth row.
 RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth* truth);
 

@@ -16,6 +16,18 @@ struct Problem {
   std::vector<double> times;  ///< t_k of x_c(k), k = 0..N
 };
 
+/// Priors on x_c(step) and, when the model has constants, on x_b (in that
+/// order). The model's own priors are priorFactors(m, m.priorState(),
+/// m.priorConstants()); the paper window re-prioritizes its oldest state.
+std::vector<FactorPtr> priorFactors(const Model& model, const Gaussian& state_prior,
+                                    const Gaussian& constants_prior, std::int64_t step = 0);
+
+/// What the step k−1 → k adds to the graph: its process factor x_c(k−1) →
+/// x_c(k) under input u over dt (touching x_b), and the measurement y at
+/// x_c(k) when y is non-empty (DESIGN.md §1 eqs. (2)–(3)).
+std::vector<FactorPtr> stepFactors(const Model& model, std::int64_t k, double dt, const Eigen::VectorXd& u,
+                                   const Eigen::VectorXd& y = Eigen::VectorXd());
+
 /// x_c(0) sits at t0; each measurement opens a new step. Inputs are held
 /// (zero-order hold) from their time on; before the first input u = 0.
 /// Throws InvalidArgument naming the measurement index when a time is not

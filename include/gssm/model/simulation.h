@@ -33,6 +33,8 @@ struct SimulatedRun {
   Eigen::VectorXd constants;             ///< true x_b
   std::vector<Measurement> measurements; ///< y(k) at every measure_every-th step
   std::vector<Input> inputs;             ///< u at t_k, k = 0..steps−1 (empty without an input profile)
+  /// The true stacked [x_c(k); x_b] at every t_k.
+  Truth truth() const;
 };
 
 /// Draws x ~ N(mean, cov) with `draw`.
