@@ -1,6 +1,5 @@
 #pragma once
-// Internal: the byte streams of the checkpoint format (docs/DESIGN.md,
-// "Checkpoints"). Each stateful class writes and reads its own fields with
+// Internal: the byte streams of the checkpoint format (docs/DESIGN.md §7). Each stateful class writes and reads its own fields with
 // them; the checkpoint layer only frames the bytes. Scalars are written in the machine's native representation
 // (little-endian IEEE-754 on every platform we build for), so a value read
 // back has the same bits as the one written — what bit-identical continuation

@@ -8,7 +8,7 @@
 // engine is left exactly as before.
 //
 // Each nonlinear factor keeps its own linearization (per-factor, not
-// per-variable, relinearization: DESIGN.md §5). Anchors never move, so
+// per-variable, relinearization: docs/DESIGN.md §6). Anchors never move, so
 // relinearizing one factor changes only that factor's rows.
 #include <Eigen/Core>
 #include <cstdint>

@@ -1,7 +1,7 @@
 #pragma once
 // Internal: the one Levenberg–Marquardt / Newton policy of every iterative
-// solver (the batch solver and the iterated incremental smoother; docs/
-// DESIGN.md, "Solving"). It owns what used to drift between two copies:
+// solver (the batch solver and the iterated incremental smoother;
+// docs/DESIGN.md §5, eq. 6). It owns what used to drift between two copies:
 // the damping schedule, which steps are accepted, the switch to undamped
 // steps once a convergence test passes, and the Newton polish loop.
 #include <algorithm>

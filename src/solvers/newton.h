@@ -1,5 +1,5 @@
 #pragma once
-// Internal: full Newton steps for ½Σ‖r_i(x)‖² (DESIGN.md §2, "solving").
+// Internal: full Newton steps for ½Σ‖r_i(x)‖² (docs/DESIGN.md §5, eq. 5).
 // Gauss–Newton drops the second-order terms Σ_j r_ij ∇²r_ij of the Hessian;
 // where residuals stay large at the optimum (the radar start-up, whose prior
 // is 143σ off) it converges only linearly, with a rate near 1. A few Newton

@@ -1,5 +1,5 @@
 #pragma once
-// Checkpoint and restore of a streaming estimator (DESIGN.md §6).
+// Checkpoint and restore of a streaming estimator (docs/DESIGN.md §7).
 //
 // A checkpoint holds the estimator's whole state: its options, the step
 // counter and time, the input in force, and the method's state (EKF: mean

@@ -1,5 +1,5 @@
 #pragma once
-// The streaming estimator API (DESIGN.md §3, layer 6): feed inputs and
+// The streaming estimator API (docs/DESIGN.md §3, layer 5; §4): feed inputs and
 // measurements as they arrive, read the current estimate at any time. One
 // interface over the EKF, the IncrementalSmoother, the FixedLagSmoother and
 // the paper's window re-solve, so applications switch by name.

@@ -1,5 +1,5 @@
 #pragma once
-// Factors of the GSSM graph (DESIGN.md §1). Each returns a whitened residual
+// Factors of the GSSM graph (docs/DESIGN.md §1, eqs. 2–4). Each returns a whitened residual
 // r = L⁻¹ e (Σ = L Lᵀ) and one Jacobian block per variable, so that the MAP
 // estimate minimizes ½ Σ ‖r_i‖² over all factors.
 #include <Eigen/Core>

@@ -1,5 +1,5 @@
 #pragma once
-// The full-history GSSM factor graph of one run (DESIGN.md §1): one node for
+// The full-history GSSM factor graph of one run (docs/DESIGN.md §1): one node for
 // the constants x_b for the whole run, one node x_c(k) per measurement time,
 // priors on x_c(0) and x_b, a process factor per step and a measurement
 // factor per measurement.
@@ -24,7 +24,7 @@ std::vector<FactorPtr> priorFactors(const Model& model, const Gaussian& state_pr
 
 /// What the step k−1 → k adds to the graph: its process factor x_c(k−1) →
 /// x_c(k) under input u over dt (touching x_b), and the measurement y at
-/// x_c(k) when y is non-empty (DESIGN.md §1 eqs. (2)–(3)).
+/// x_c(k) when y is non-empty (docs/DESIGN.md §1, eqs. 2–3).
 std::vector<FactorPtr> stepFactors(const Model& model, std::int64_t k, double dt, const Eigen::VectorXd& u,
                                    const Eigen::VectorXd& y = Eigen::VectorXd());
 

@@ -1,5 +1,5 @@
 #pragma once
-// The GSSM model interface (DESIGN.md §1). A model splits its state into a
+// The GSSM model interface (docs/DESIGN.md §1, eq. 1). A model splits its state into a
 // time-series part x_c (dim n_c) and a constant part x_b (dim n_b):
 //
 //   x_c(k+1) = f(x_c(k), x_b, u_k, T) + q_c(k),   q_c ~ N(0, Q(T))

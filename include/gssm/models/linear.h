@@ -1,5 +1,5 @@
 #pragma once
-// A linear GSSM built from continuous-time matrices (DESIGN.md §1):
+// A linear GSSM built from continuous-time matrices (docs/DESIGN.md §1, eq. 1):
 //   d/dt x_c = A_c x_c + A_b x_b + B u,   y = C_c x_c + C_b x_b
 // discretized with F_c = I + A_c T, F_b = A_b T, B_k = B T (Euler, the
 // paper's choice) or exactly with the matrix exponential of the augmented

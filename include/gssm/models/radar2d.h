@@ -1,5 +1,5 @@
 #pragma once
-// The paper's 2-D radar example (DESIGN.md §2): horizontal distance x is a
+// The paper's 2-D radar example (docs/DESIGN.md §2 in the gssm repository): horizontal distance x is a
 // time series; horizontal velocity xdot and altitude h are constants.
 //   x(k+1) = x(k) + xdot·T + q,   range = sqrt(x² + h²) + r
 #include "gssm/model/model.h"

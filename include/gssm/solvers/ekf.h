@@ -1,5 +1,5 @@
 #pragma once
-// ExtendedKalmanFilter: the baseline (DESIGN.md §1, "Kalman / EKF
+// ExtendedKalmanFilter: the baseline (docs/DESIGN.md §1, eq. 7, "EKF
 // discretization"). One stacked state z = [x_c; x_b] evolves step by step
 // with x_b(k+1) = x_b(k); the constants are carried as a random walk with
 // zero (or a small, optional) process noise and marginalized every step.

@@ -1,5 +1,5 @@
 #pragma once
-// Incremental smoothers over a GSSM factor graph (DESIGN.md §3, layer 5):
+// Incremental smoothers over a GSSM factor graph (docs/DESIGN.md §6):
 //
 // * IncrementalSmoother — full history, iSAM2 class: each update re-eliminates
 //   only the top of the Bayes tree that new or relinearized factors touch,
