@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     x += 100 * 0.05;
     return gssm::Measurement{k * 0.05, Eigen::VectorXd::Constant(1, std::hypot(x, 1000.0) + 3 * n01(rng))};
   };
-  if (method == "batch") {
+  if (gssm::methodNamed(method) == gssm::Method::Batch) {
     std::vector<gssm::Measurement> ms;
     for (long k = 1; k <= steps; ++k) ms.push_back(next(k));
     const auto t0 = std::chrono::steady_clock::now();

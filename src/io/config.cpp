@@ -129,40 +129,45 @@ void writeModel(const Model& model, IniDocument& ini) {
 }
 
 namespace {
+// Each method's own INI section, from the method table.
+std::string sectionOf(Method m) { return methodInfo(m).ini_section; }
+
 ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& model) {
-  ini.requireOnlyKeys("ekf", {"constant_process_noise", "joseph_form"});
+  const std::string ekf = sectionOf(Method::Ekf);
+  ini.requireOnlyKeys(ekf, {"constant_process_noise", "joseph_form"});
   ExtendedKalmanFilterOptions o;
-  if (ini.has("ekf", "constant_process_noise"))
-    o.constant_process_noise = ini.getVector("ekf", "constant_process_noise", model.dims().nb);
-  o.joseph_form = ini.getBool("ekf", "joseph_form", true);
+  if (ini.has(ekf, "constant_process_noise"))
+    o.constant_process_noise = ini.getVector(ekf, "constant_process_noise", model.dims().nb);
+  o.joseph_form = ini.getBool(ekf, "joseph_form", true);
   std::string why;
-  if (!o.validate(model.dims().nb, &why)) throw InputError(ini.source() + ": [ekf] " + why);
+  if (!o.validate(model.dims().nb, &why)) throw InputError(ini.source() + ": [" + ekf + "] " + why);
   return o;
 }
 
 void readSmoother(const IniDocument& ini, EstimatorOptions& eo) {
-  ini.requireOnlyKeys("smoother", {"relinearize", "relinearize_threshold", "constants_check_sigmas",
+  const std::string smoother = sectionOf(Method::Incremental);  // the fixed lag reads it too
+  ini.requireOnlyKeys(smoother, {"relinearize", "relinearize_threshold", "constants_check_sigmas",
                                    "max_local_iterations", "wildfire_threshold", "ordering",
                                    "iterate_to_convergence", "convergence_tolerance", "max_iterations",
                                    "newton_polish_steps"});
   SmootherOptions& o = eo.smoother;
-  o.relinearize = ini.getBool("smoother", "relinearize", o.relinearize);
-  o.relinearize_threshold = ini.getDouble("smoother", "relinearize_threshold", o.relinearize_threshold);
-  o.constants_check_sigmas = ini.getDouble("smoother", "constants_check_sigmas", o.constants_check_sigmas);
+  o.relinearize = ini.getBool(smoother, "relinearize", o.relinearize);
+  o.relinearize_threshold = ini.getDouble(smoother, "relinearize_threshold", o.relinearize_threshold);
+  o.constants_check_sigmas = ini.getDouble(smoother, "constants_check_sigmas", o.constants_check_sigmas);
   o.max_local_iterations =
-      static_cast<int>(ini.getInt("smoother", "max_local_iterations", o.max_local_iterations));
-  o.wildfire_threshold = ini.getDouble("smoother", "wildfire_threshold", o.wildfire_threshold);
-  o.iterate_to_convergence = ini.getBool("smoother", "iterate_to_convergence", o.iterate_to_convergence);
-  o.convergence_tolerance = ini.getDouble("smoother", "convergence_tolerance", o.convergence_tolerance);
-  o.max_iterations = static_cast<int>(ini.getInt("smoother", "max_iterations", o.max_iterations));
-  o.newton_polish_steps = static_cast<int>(ini.getInt("smoother", "newton_polish_steps", o.newton_polish_steps));
-  const std::string ordering = ini.getString("smoother", "ordering", "colamd");
+      static_cast<int>(ini.getInt(smoother, "max_local_iterations", o.max_local_iterations));
+  o.wildfire_threshold = ini.getDouble(smoother, "wildfire_threshold", o.wildfire_threshold);
+  o.iterate_to_convergence = ini.getBool(smoother, "iterate_to_convergence", o.iterate_to_convergence);
+  o.convergence_tolerance = ini.getDouble(smoother, "convergence_tolerance", o.convergence_tolerance);
+  o.max_iterations = static_cast<int>(ini.getInt(smoother, "max_iterations", o.max_iterations));
+  o.newton_polish_steps = static_cast<int>(ini.getInt(smoother, "newton_polish_steps", o.newton_polish_steps));
+  const std::string ordering = ini.getString(smoother, "ordering", "colamd");
   if (ordering != "colamd" && ordering != "time")
-    throw InputError(ini.source() + ": [smoother] ordering = '" + ordering + "': expected colamd or time");
+    throw InputError(ini.source() + ": [" + smoother + "] ordering = '" + ordering + "': expected colamd or time");
   eo.incremental.ordering =
       ordering == "time" ? EliminationOrdering::TimeOrdered : EliminationOrdering::ConstrainedColamd;
   std::string why;
-  if (!o.validate(&why)) throw InputError(ini.source() + ": [smoother] " + why);
+  if (!o.validate(&why)) throw InputError(ini.source() + ": [" + smoother + "] " + why);
 }
 
 int readWindow(const IniDocument& ini, const std::string& section, int fallback) {
@@ -174,17 +179,18 @@ int readWindow(const IniDocument& ini, const std::string& section, int fallback)
 }
 
 void readBatch(const IniDocument& ini, BatchSolverOptions& o) {
-  ini.requireOnlyKeys("batch", {"algorithm", "max_iterations", "newton_polish_steps"});
-  const std::string algorithm = ini.getString("batch", "algorithm", "levenberg-marquardt");
+  const std::string batch = sectionOf(Method::Batch);
+  ini.requireOnlyKeys(batch, {"algorithm", "max_iterations", "newton_polish_steps"});
+  const std::string algorithm = ini.getString(batch, "algorithm", "levenberg-marquardt");
   if (algorithm != "levenberg-marquardt" && algorithm != "gauss-newton")
-    throw InputError(ini.source() + ": [batch] algorithm = '" + algorithm +
+    throw InputError(ini.source() + ": [" + batch + "] algorithm = '" + algorithm +
                      "': expected levenberg-marquardt or gauss-newton");
   o.method = algorithm == "gauss-newton" ? BatchSolverOptions::Method::GaussNewton
                                          : BatchSolverOptions::Method::LevenbergMarquardt;
-  o.max_iterations = static_cast<int>(ini.getInt("batch", "max_iterations", o.max_iterations));
-  o.newton_polish_steps = static_cast<int>(ini.getInt("batch", "newton_polish_steps", o.newton_polish_steps));
+  o.max_iterations = static_cast<int>(ini.getInt(batch, "max_iterations", o.max_iterations));
+  o.newton_polish_steps = static_cast<int>(ini.getInt(batch, "newton_polish_steps", o.newton_polish_steps));
   std::string why;
-  if (!o.validate(&why)) throw InputError(ini.source() + ": [batch] " + why);
+  if (!o.validate(&why)) throw InputError(ini.source() + ": [" + batch + "] " + why);
 }
 }  // namespace
 
@@ -197,8 +203,8 @@ EstimatorOptions estimatorOptions(const IniDocument& ini, const Model& model, Me
   EstimatorOptions o(method);
   o.ekf = ekfOptions(ini, model);
   readSmoother(ini, o);
-  o.fixed_lag.window = readWindow(ini, "fixed_lag", o.fixed_lag.window);
-  o.paper_window.window = readWindow(ini, "paper_window", o.paper_window.window);
+  o.fixed_lag.window = readWindow(ini, sectionOf(Method::FixedLag), o.fixed_lag.window);
+  o.paper_window.window = readWindow(ini, sectionOf(Method::PaperWindow), o.paper_window.window);
   readBatch(ini, o.batch);
   return o;
 }
@@ -262,7 +268,7 @@ IniDocument builtinScenario(const std::string& name, unsigned seed, int steps) {
     // Centripetal acceleration of a 50 m circle at 0.1 rad/s about (100, 100).
     ini.set("truth", "input_amplitude", -0.5);
     ini.set("truth", "input_omega", 0.1);
-    ini.set("ekf", "constant_process_noise", Eigen::MatrixXd(Eigen::RowVector3d::Zero()));
+    ini.set(sectionOf(Method::Ekf), "constant_process_noise", Eigen::MatrixXd(Eigen::RowVector3d::Zero()));
     if (name == "nav-paper-like") {
       ini.setComment("scenario",
                      "Nav2D with priors several sigmas from the truth, as in the radar paper scenario:\n"
@@ -293,7 +299,7 @@ IniDocument builtinScenario(const std::string& name, unsigned seed, int steps) {
     ini.set("truth", "process_noise", "false");
     ini.set("truth", "measurement_noise", "true");
     // The paper's EKF: Q = diag(0.005², 0.005², 0) on [x, xdot, h].
-    ini.set("ekf", "constant_process_noise",
+    ini.set(sectionOf(Method::Ekf), "constant_process_noise",
             Eigen::MatrixXd(Eigen::RowVector2d(0.005 * 0.005, 0.0)));
   } else if (name == "consistent") {
     ini.setComment("scenario",
@@ -301,7 +307,7 @@ IniDocument builtinScenario(const std::string& name, unsigned seed, int steps) {
                    "models, so a consistent estimator's NEES averages about 3.");
     ini.set("truth", "process_noise", "true");
     ini.set("truth", "measurement_noise", "true");
-    ini.set("ekf", "constant_process_noise", Eigen::MatrixXd(Eigen::RowVector2d(0.0, 0.0)));
+    ini.set(sectionOf(Method::Ekf), "constant_process_noise", Eigen::MatrixXd(Eigen::RowVector2d(0.0, 0.0)));
   } else {
     std::string known;
     for (const auto& n : scenarioNames()) known += (known.empty() ? "" : ", ") + n;
