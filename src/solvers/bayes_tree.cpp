@@ -207,7 +207,9 @@ struct BayesTreeEngine::UpdatePlan {
   // eliminateTop
   std::vector<Key> ordering;
   std::vector<Clique> fresh;                        // one per ordering entry
-  std::vector<std::vector<InputSource>> fresh_owned;  // factor inputs each fresh clique consumed
+  // The factor inputs each fresh clique consumed, as (clique, source) in
+  // clique order (one list per update, not one per clique).
+  std::vector<std::pair<std::size_t, InputSource>> fresh_owned;
   // commit
   std::vector<int> fresh_id;
 };
@@ -327,7 +329,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
                                                                       : std::optional<InputSource>(in.second));
   }
   p.fresh.assign(ordering.size(), Clique{});
-  p.fresh_owned.assign(ordering.size(), {});
+  p.fresh_owned.clear();
   const double damping = p.update.damping;
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
     const Key& v = ordering[vi];
@@ -359,7 +361,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
         M.block(r0, colOf.at(f.keys[i]), f.b.size(), f.A[i].cols()) = f.A[i];
       M.block(r0, ncols, f.b.size(), 1) = f.b;
       r0 += f.b.size();
-      if (pend_source[id]) p.fresh_owned[vi].push_back(*pend_source[id]);
+      if (pend_source[id]) p.fresh_owned.emplace_back(vi, *pend_source[id]);
     }
     if (damp_rows > 0) {
       // Marquardt rows pull δ_v toward its current value: √λ·D (δ_v − δ̂_v) = 0.
@@ -452,10 +454,12 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   }
   const std::vector<Key>& ordering = p.ordering;
   p.fresh_id.resize(ordering.size());
+  auto owned = p.fresh_owned.begin();
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
     const int c = allocClique();
     p.fresh_id[vi] = c;
-    for (const InputSource& src : p.fresh_owned[vi]) {
+    for (; owned != p.fresh_owned.end() && owned->first == vi; ++owned) {
+      const InputSource& src = owned->second;
       using Kind = InputSource::Kind;
       const int s = src.kind == Kind::Slot        ? src.index
                     : src.kind == Kind::NewFactor ? new_slot_of[static_cast<std::size_t>(src.index)]
