@@ -25,6 +25,7 @@ constexpr const char* kRunTag = "gssm offline run v1";
 // at a time), so a run is not resumed on another dataset.
 std::uint64_t foldMeasurement(std::uint64_t h, const Measurement& m) {
   h = internal::fnv1a64(reinterpret_cast<const char*>(&m.t), sizeof m.t, h);
+  if (m.channel != 0) h = internal::fnv1a64(reinterpret_cast<const char*>(&m.channel), sizeof m.channel, h);
   return internal::fnv1a64(reinterpret_cast<const char*>(m.y.data()),
                            static_cast<std::size_t>(m.y.size()) * sizeof(double), h);
 }
@@ -126,7 +127,7 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
     for (; next_input < inputs.size() && inputs[next_input].t < m.t; ++next_input)
       est->addInput(std::max(inputs[next_input].t, est->time()), inputs[next_input].u);
     const auto t0 = Clock::now();
-    est->addMeasurement(m.t, m.y);
+    est->addMeasurement(m);
     out.update_seconds.push_back(since(t0));
     data_hash = foldMeasurement(data_hash, m);
     if (options.compute_nis) out.nis.push_back(est->report().nis);
@@ -172,6 +173,7 @@ OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
     row.mean.resize(nc + nb);
     row.mean.head(nc) = x.at(key);
     if (nb) row.mean.tail(nb) = x.at(Key::constants());
+    row.mean = model.wrapStacked(std::move(row.mean));
     row.covariance = solver.jointMarginalCovariance(stackedKeys(model, key.step));
     out.rows.push_back(std::move(row));
   }

@@ -90,9 +90,9 @@ std::unique_ptr<Estimator> restoreCheckpointBytes(const Model& model, const std:
     throw CheckpointError(source + ": not a gssm checkpoint (no GSSMCKPT signature)");
   header.u64("signature");
   info.version = header.u32("format version");
-  if (info.version != kCheckpointVersion)
+  if (info.version < 1 || info.version > kCheckpointVersion)
     throw CheckpointError(source + ": checkpoint format version " + std::to_string(info.version) +
-                          ", this build reads version " + std::to_string(kCheckpointVersion));
+                          ", this build reads versions 1 to " + std::to_string(kCheckpointVersion));
   const std::uint64_t size = header.u64("payload size");
   const std::uint64_t checksum = header.u64("checksum");
   if (bytes.size() - kHeaderBytes != size) {
@@ -106,6 +106,7 @@ std::unique_ptr<Estimator> restoreCheckpointBytes(const Model& model, const std:
 
   const std::string payload = bytes.substr(kHeaderBytes);
   internal::ByteReader in(payload, source, kHeaderBytes);
+  in.setVersion(info.version);
   std::unique_ptr<Estimator> est;
   try {
     checkModelIdentity(in, model, info);

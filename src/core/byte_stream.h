@@ -72,6 +72,10 @@ class ByteReader {
   std::deque<double> times(const std::string& what);
 
   bool atEnd() const { return pos_ == size_; }
+  /// The format version of what is being read (records added in a later
+  /// version are read only from files of that version on).
+  std::uint32_t version() const { return version_; }
+  void setVersion(std::uint32_t v) { version_ = v; }
   std::size_t offset() const { return base_ + pos_; }
   /// Throws CheckpointError "source: byte N: what".
   [[noreturn]] void fail(const std::string& what) const;
@@ -88,6 +92,7 @@ class ByteReader {
   std::size_t size_, pos_ = 0;
   std::string source_;
   std::size_t base_;
+  std::uint32_t version_ = ~0u;  // unset: the current format
 };
 
 /// Visits one record's field list with a writer or a reader, so the two

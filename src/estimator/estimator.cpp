@@ -8,6 +8,7 @@
 
 #include "core/byte_stream.h"
 #include "factors/factor_io.h"
+#include "gssm/core/angles.h"
 #include "gssm/core/error.h"
 #include "gssm/core/time.h"
 #include "gssm/factors/problem.h"
@@ -146,15 +147,16 @@ Eigen::VectorXd Estimator::inputInForce() const {
 
 void Estimator::advance(double t) {
   const auto start = std::chrono::steady_clock::now();
-  doStep(k_ + 1, t - t_, inputInForce(), Eigen::VectorXd());
+  doStep(k_ + 1, t - t_, inputInForce(), nullptr);
   t_ = t;
   ++k_;
   report_.steps = k_;
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-double Estimator::innovationNis(double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
+double Estimator::innovationNis(double dt, const Eigen::VectorXd& u, const Measurement& m) {
   const ModelDims& d = model_.dims();
+  const MeasurementChannel& ch = model_.channel(m.channel);
   const StateEstimate e = current();
   const Eigen::VectorXd xc = e.mean.head(d.nc), xb = e.mean.tail(d.nb);
   Eigen::VectorXd x = xc;
@@ -166,30 +168,47 @@ double Estimator::innovationNis(double dt, const Eigen::VectorXd& u, const Eigen
     F.topLeftCorner(d.nc, d.nc) = J_f_xc;
     F.topRightCorner(d.nc, d.nb) = J_f_xb;
     P = F * P * F.transpose();
-    P.topLeftCorner(d.nc, d.nc) += model_.processNoise(dt);
+    P.topLeftCorner(d.nc, d.nc) += model_.processNoiseOf(dt, u);
   }
   Eigen::MatrixXd J_h_xc, J_h_xb;
-  const Eigen::VectorXd innovation = y - model_.h(x, xb, &J_h_xc, &J_h_xb);
-  Eigen::MatrixXd H(d.ny, d.nc + d.nb);
+  Eigen::VectorXd innovation = m.y - model_.h(m.channel, x, xb, &J_h_xc, &J_h_xb);
+  wrapAngles(innovation, ch.angles);
+  Eigen::MatrixXd H(ch.dim(), d.nc + d.nb);
   H << J_h_xc, J_h_xb;
-  const Eigen::MatrixXd S = H * P * H.transpose() + model_.measurementNoise();
+  const Eigen::MatrixXd S = H * P * H.transpose() + (m.R.size() ? m.R : ch.R);
   return innovation.dot(S.ldlt().solve(innovation));
 }
 
-void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) {
+void Estimator::addMeasurement(double t, const Eigen::VectorXd& y) { addMeasurement(Measurement{t, y}); }
+
+void Estimator::addMeasurement(double t, const std::string& channel, const Eigen::VectorXd& y) {
+  addMeasurement(Measurement{t, y, model_.channelIndex(channel), {}});
+}
+
+void Estimator::addMeasurement(const Measurement& m) {
   const auto start = std::chrono::steady_clock::now();
+  const double t = m.t;
   if (!std::isfinite(t) || t < t_ || (t == t_ && k_ == 0)) {
     std::ostringstream os;
     os << methodName() << ": measurement time " << t << " must be after the previous state (" << t_ << ")"
        << (k_ == 0 ? ", the start t0" : "");
     throw InvalidArgument(os.str());
   }
-  requireVector(y, model_.dims().ny, std::string(methodName()) + ": measurement y at t = " + std::to_string(t));
-  const double nis = options_.compute_nis ? innovationNis(t - t_, inputInForce(), y) : report_.nis;
+  if (m.channel < 0 || m.channel >= model_.numChannels())
+    throw InvalidArgument(std::string(methodName()) + ": measurement at t = " + std::to_string(t) + " names channel " +
+                          std::to_string(m.channel) + "; model '" + model_.name() + "' has " +
+                          std::to_string(model_.numChannels()));
+  const MeasurementChannel& ch = model_.channel(m.channel);
+  const std::string what = model_.numChannels() == 1 ? "measurement y" : "measurement on channel '" + ch.name + "'";
+  requireVector(m.y, ch.dim(), std::string(methodName()) + ": " + what + " at t = " + std::to_string(t));
+  if (m.R.size())
+    requireCovariance(m.R, ch.dim(), std::string(methodName()) + ": own noise covariance of the measurement at t = " +
+                                         std::to_string(t));
+  const double nis = options_.compute_nis ? innovationNis(t - t_, inputInForce(), m) : report_.nis;
   if (t == t_) {
-    doMeasurement(k_, y);  // at the newest state
+    doMeasurement(k_, m);  // at the newest state
   } else {
-    doStep(k_ + 1, t - t_, inputInForce(), y);  // strong guarantee: throws before changing anything
+    doStep(k_ + 1, t - t_, inputInForce(), &m);  // strong guarantee: throws before changing anything
     t_ = t;
     ++k_;
   }
@@ -237,19 +256,21 @@ class EkfEstimator final : public Estimator {
   }
 
  protected:
-  void doStep(std::int64_t, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
+  void doStep(std::int64_t, double dt, const Eigen::VectorXd& u, const Measurement* m) override {
     ExtendedKalmanFilter next = ekf_;  // commit only if both halves succeed
     next.predict(ekf_.time() + dt, u);
-    if (y.size()) next.update(y);
+    if (m) next.update(*m);
     ekf_ = std::move(next);
     report_.iterations = 1;
-    updated_ = y.size() > 0;
+    report_.rejected = ekf_.rejected();
+    updated_ = m != nullptr;
     markDetail();
   }
-  void doMeasurement(std::int64_t, const Eigen::VectorXd& y) override {
+  void doMeasurement(std::int64_t, const Measurement& m) override {
     ExtendedKalmanFilter next = ekf_;
-    next.update(y);
+    next.update(m);
     ekf_ = std::move(next);
+    report_.rejected = ekf_.rejected();
     updated_ = true;
     markDetail();
   }
@@ -260,7 +281,10 @@ class EkfEstimator final : public Estimator {
   }
   bool updated_ = false;  // the last step had a measurement
   void saveState(internal::ByteWriter& out) const override { ekf_.save(out); }
-  void loadState(internal::ByteReader& in) override { ekf_.load(in); }
+  void loadState(internal::ByteReader& in) override {
+    ekf_.load(in);
+    report_.rejected = ekf_.rejected();
+  }
   ExtendedKalmanFilter ekf_;
 };
 
@@ -310,7 +334,7 @@ class SmootherEstimator final : public Estimator {
     e.step = k;
     e.t = times_[times_.size() - 1 - static_cast<std::size_t>(step() - k)];
     const Eigen::VectorXd xb = nb ? smoother_.estimate(Key::constants()) : Eigen::VectorXd();
-    e.mean = stack(smoother_.estimate(Key::state(k)), xb);
+    e.mean = model_.wrapStacked(stack(smoother_.estimate(Key::state(k)), xb));
     e.covariance = smoother_.jointMarginalCovariance(stackedKeys(model_, k));
     return e;
   }
@@ -322,8 +346,8 @@ class SmootherEstimator final : public Estimator {
   }
 
  protected:
-  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
-    const auto factors = stepFactors(model_, k, dt, u, y);
+  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* m) override {
+    const auto factors = stepFactors(model_, k, dt, u, m);
     const Eigen::VectorXd xb = model_.dims().nb ? smoother_.estimate(Key::constants())
                                                 : Eigen::VectorXd(Eigen::VectorXd::Zero(0));
     Values initial;
@@ -334,8 +358,8 @@ class SmootherEstimator final : public Estimator {
     times_.push_back(times_.back() + dt);
     while (keep_times_ > 0 && times_.size() > keep_times_) times_.pop_front();
   }
-  void doMeasurement(std::int64_t k, const Eigen::VectorXd& y) override {
-    report_.smoother = smoother_.update({std::make_shared<MeasurementFactor>(model_, k, y)}, Values{});
+  void doMeasurement(std::int64_t k, const Measurement& m) override {
+    report_.smoother = smoother_.update({std::make_shared<MeasurementFactor>(model_, k, m)}, Values{});
     report_.iterations = report_.smoother.iterations;
     markDetail();
   }
@@ -394,7 +418,7 @@ class PaperWindowEstimator final : public Estimator {
     StateEstimate e;
     e.step = k;
     e.t = times_[static_cast<std::size_t>(k - oldest_)];
-    e.mean = stack(values_.at(Key::state(k)), nb ? values_.at(Key::constants()) : Eigen::VectorXd());
+    e.mean = model_.wrapStacked(stack(values_.at(Key::state(k)), nb ? values_.at(Key::constants()) : Eigen::VectorXd()));
     e.covariance = solver_.jointMarginalCovariance(stackedKeys(model_, k));
     return e;
   }
@@ -405,14 +429,14 @@ class PaperWindowEstimator final : public Estimator {
   }
 
  protected:
-  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y) override {
+  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* m) override {
     // Work on copies; commit at the end.
     auto steps = steps_;
     auto times = times_;
     Values values = values_;
     Gaussian prior_state = prior_state_, prior_constants = prior_constants_;
     std::int64_t oldest = oldest_;
-    steps.push_back(stepFactors(model_, k, dt, u, y));
+    steps.push_back(stepFactors(model_, k, dt, u, m));
     const Eigen::VectorXd xb = model_.dims().nb ? values.at(Key::constants()) : Eigen::VectorXd();
     values.insert(Key::state(k), predictState(model_, values.at(Key::state(k - 1)), xb, u, dt, k));
     times.push_back(times.back() + dt);
@@ -444,10 +468,10 @@ class PaperWindowEstimator final : public Estimator {
   }
 
  private:
-  void doMeasurement(std::int64_t k, const Eigen::VectorXd& y) override {
+  void doMeasurement(std::int64_t k, const Measurement& m) override {
     auto steps = steps_;
     Values values = values_;
-    steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, y));
+    steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, m));
     BatchSolver solver(gaussNewton());
     const BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state_, prior_constants_, oldest_), values);
     steps_ = std::move(steps);

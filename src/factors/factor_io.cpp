@@ -3,7 +3,12 @@
 namespace gssm::internal {
 
 namespace {
-enum class FactorTag : std::uint8_t { Prior = 1, Process = 2, Measurement = 3, LinearGaussian = 4 };
+// Measurement is the default channel (format v1); MeasurementOnChannel
+// names its channel (written only for channels other than 0, so
+// single-channel checkpoints keep their v1 bytes).
+enum class FactorTag : std::uint8_t {
+  Prior = 1, Process = 2, Measurement = 3, LinearGaussian = 4, MeasurementOnChannel = 5, PriorWithAngles = 6
+};
 
 void requireDim(ByteReader& in, const Model& model, const Key& k, Eigen::Index size, const std::string& what) {
   if (size != variableDim(model, k))
@@ -14,17 +19,19 @@ void requireDim(ByteReader& in, const Model& model, const Key& k, Eigen::Index s
 
 void writeFactor(ByteWriter& out, const Factor& f) {
   if (const auto* p = dynamic_cast<const PriorFactor*>(&f)) {
-    out.u8(static_cast<std::uint8_t>(FactorTag::Prior));
+    out.u8(static_cast<std::uint8_t>(p->angles().empty() ? FactorTag::Prior : FactorTag::PriorWithAngles));
     out.key(p->keys()[0]);
     out.gaussian({p->mean(), p->noise().covariance()});
+    if (!p->angles().empty()) out.ints(p->angles());
   } else if (const auto* q = dynamic_cast<const ProcessFactor*>(&f)) {
     out.u8(static_cast<std::uint8_t>(FactorTag::Process));
     out.i64(q->keys()[0].step);
     out.vec(q->input());
     out.f64(q->dt());
   } else if (const auto* m = dynamic_cast<const MeasurementFactor*>(&f)) {
-    out.u8(static_cast<std::uint8_t>(FactorTag::Measurement));
+    out.u8(static_cast<std::uint8_t>(m->channel() == 0 ? FactorTag::Measurement : FactorTag::MeasurementOnChannel));
     out.i64(m->keys()[0].step);
+    if (m->channel() != 0) out.i32(m->channel());
     out.vec(m->measurement());
     out.mat(m->noise().covariance());
   } else if (const auto* l = dynamic_cast<const LinearGaussianFactor*>(&f)) {
@@ -44,11 +51,16 @@ void writeFactor(ByteWriter& out, const Factor& f) {
 FactorPtr readFactor(ByteReader& in, const Model& model, const std::string& what) {
   const std::uint8_t tag = in.u8((what + " type").c_str());
   switch (static_cast<FactorTag>(tag)) {
-    case FactorTag::Prior: {
+    case FactorTag::Prior:
+    case FactorTag::PriorWithAngles: {
       const Key k = in.key(what + " key");
       const Gaussian g = in.gaussian(what + " prior");
       requireDim(in, model, k, g.mean.size(), what);
-      return std::make_shared<PriorFactor>(k, g);
+      std::vector<int> angles;
+      if (static_cast<FactorTag>(tag) == FactorTag::PriorWithAngles) angles = in.ints(what + " angle components");
+      for (int a : angles)
+        if (a < 0 || a >= g.mean.size()) in.fail(what + ": angle component " + std::to_string(a) + " out of range");
+      return std::make_shared<PriorFactor>(k, g, std::move(angles));
     }
     case FactorTag::Process: {
       const std::int64_t k = in.i64((what + " step").c_str());
@@ -57,15 +69,20 @@ FactorPtr readFactor(ByteReader& in, const Model& model, const std::string& what
       const double dt = in.f64(what + " dt");
       return std::make_shared<ProcessFactor>(model, k, u, dt);
     }
-    case FactorTag::Measurement: {
+    case FactorTag::Measurement:
+    case FactorTag::MeasurementOnChannel: {
       const std::int64_t k = in.i64((what + " step").c_str());
       if (k < 0 || k >= (std::int64_t(1) << 53)) in.fail(what + ": step " + std::to_string(k) + " out of range");
+      const int channel = static_cast<FactorTag>(tag) == FactorTag::Measurement ? 0 : in.i32((what + " channel").c_str());
+      if (channel < 0 || channel >= model.numChannels())
+        in.fail(what + ": channel " + std::to_string(channel) + " but model '" + model.name() + "' has " +
+                std::to_string(model.numChannels()));
       const Eigen::VectorXd y = in.vec(what + " measurement");
       const Eigen::MatrixXd R = in.mat(what + " noise covariance");
-      if (R.rows() != model.dims().ny || R.cols() != model.dims().ny)
-        in.fail(what + ": noise covariance is not " + std::to_string(model.dims().ny) + " x " +
-                std::to_string(model.dims().ny));
-      return std::make_shared<MeasurementFactor>(model, k, y, GaussianNoise(R, what + " noise"));
+      const int ny = model.channel(channel).dim();
+      if (y.size() != ny || R.rows() != ny || R.cols() != ny)
+        in.fail(what + ": measurement or noise covariance is not of the channel's size " + std::to_string(ny));
+      return std::make_shared<MeasurementFactor>(model, k, y, channel, GaussianNoise(R, what + " noise"));
     }
     case FactorTag::LinearGaussian: {
       std::vector<Key> keys = in.keys(what + " keys");

@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "gssm/core/angles.h"
 #include "gssm/core/error.h"
 
 namespace gssm {
@@ -17,10 +18,28 @@ const Eigen::VectorXd& constantsOrEmpty(const Model& m, const Values& x) {
 }
 }  // namespace
 
+double Factor::linearizeRobust(const Values& x, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const {
+  linearize(x, r, J);
+  const double s = r.squaredNorm();
+  if (!loss_.robust()) return 0.5 * s;
+  const double w = std::sqrt(loss_.weight(s));
+  r *= w;
+  if (J)
+    for (auto& block : *J) block *= w;
+  return 0.5 * loss_.rho(s);
+}
+
 double Factor::cost(const Values& x) const {
   Eigen::VectorXd r;
   linearize(x, r, nullptr);
-  return 0.5 * r.squaredNorm();
+  return 0.5 * loss_.rho(r.squaredNorm());
+}
+
+double Factor::weight(const Values& x) const {
+  if (!loss_.robust()) return 1.0;
+  Eigen::VectorXd r;
+  linearize(x, r, nullptr);
+  return loss_.weight(r.squaredNorm());
 }
 
 double FactorGraph::cost(const Values& x) const {
@@ -28,22 +47,24 @@ double FactorGraph::cost(const Values& x) const {
   Eigen::VectorXd r;  // one buffer for all factors
   for (const auto& f : factors_) {
     f->linearize(x, r, nullptr);
-    c += 0.5 * r.squaredNorm();
+    c += 0.5 * f->loss().rho(r.squaredNorm());
   }
   return c;
 }
 
 // ---- PriorFactor -------------------------------------------------------------
-PriorFactor::PriorFactor(Key key, const Gaussian& prior)
+PriorFactor::PriorFactor(Key key, const Gaussian& prior, std::vector<int> angles)
     : Factor({key}, static_cast<int>(prior.mean.size())),
       mean_(prior.mean),
-      noise_(prior.covariance, "prior on " + key.toString()) {
+      noise_(prior.covariance, "prior on " + key.toString()),
+      angles_(std::move(angles)) {
   requireVector(prior.mean, noise_.dim(), "prior mean of " + key.toString());
 }
 
 void PriorFactor::linearize(const Values& x, Eigen::VectorXd& r,
                             std::vector<Eigen::MatrixXd>* J) const {
   r = x.at(keys()[0]) - mean_;
+  wrapAngles(r, angles_);
   noise_.whitenInPlace(r);
   if (J) {
     J->resize(1);
@@ -61,7 +82,9 @@ ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::Ve
       model_(&model),
       u_(u),
       dt_(dt),
-      noise_(model.processNoiseModel(dt, "process noise of step " + std::to_string(k))) {
+      noise_(model.processNoiseDependsOnInput()
+                 ? GaussianNoise(model.processNoiseOf(dt, u), "process noise of step " + std::to_string(k))
+                 : model.processNoiseModel(dt, "process noise of step " + std::to_string(k))) {
   if (!(dt > 0) || !std::isfinite(dt))
     throw InvalidArgument("process factor x_c(" + std::to_string(k) + ") -> x_c(" +
                           std::to_string(k + 1) + "): time step must be > 0, got " +
@@ -76,6 +99,7 @@ void ProcessFactor::linearize(const Values& x, Eigen::VectorXd& r,
   const Eigen::VectorXd& xb = constantsOrEmpty(*model_, x);
   Eigen::MatrixXd J_f_xc, J_f_xb;
   r = xk1 - model_->f(xk, xb, u_, dt_, J ? &J_f_xc : nullptr, J ? &J_f_xb : nullptr);
+  wrapAngles(r, model_->angleStates());  // stacked indices below n_c are x_c's
   noise_.whitenInPlace(r);
   if (J) {
     const int nc = model_->dims().nc;
@@ -93,15 +117,32 @@ std::string ProcessFactor::describe() const {
 
 // ---- MeasurementFactor -------------------------------------------------------
 MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y)
-    : MeasurementFactor(model, k, y, model.measurementNoiseModel()) {}
+    : MeasurementFactor(model, k, y, 0, model.channelNoiseModel(0)) {}
 
-MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y,
+namespace {
+GaussianNoise measurementNoise(const Model& model, std::int64_t k, const Measurement& m) {
+  if (m.R.size() == 0) return model.channelNoiseModel(m.channel);
+  return GaussianNoise(m.R, "noise of the measurement on channel '" + model.channel(m.channel).name +
+                                "' at step " + std::to_string(k));
+}
+}  // namespace
+
+MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const Measurement& m)
+    : MeasurementFactor(model, k, m.y, m.channel, measurementNoise(model, k, m)) {}
+
+MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y, int channel,
                                      const GaussianNoise& noise)
-    : Factor(withConstants(model, {Key::state(k)}), model.dims().ny),
+    : Factor(withConstants(model, {Key::state(k)}), model.channel(channel).dim(), model.channel(channel).loss),
       model_(&model),
       y_(y),
+      channel_(channel),
       noise_(noise) {
-  requireVector(y, model.dims().ny, "measurement y at step " + std::to_string(k));
+  const MeasurementChannel& ch = model.channel(channel);
+  requireVector(y, ch.dim(), "measurement on channel '" + ch.name + "' at step " + std::to_string(k));
+  if (noise.dim() != ch.dim())
+    throw InvalidArgument("measurement on channel '" + ch.name + "' at step " + std::to_string(k) +
+                          ": its noise covariance is " + std::to_string(noise.dim()) + " x " +
+                          std::to_string(noise.dim()) + ", the channel has " + std::to_string(ch.dim()) + " components");
 }
 
 void MeasurementFactor::linearize(const Values& x, Eigen::VectorXd& r,
@@ -109,7 +150,8 @@ void MeasurementFactor::linearize(const Values& x, Eigen::VectorXd& r,
   const Eigen::VectorXd& xc = x.at(keys()[0]);
   const Eigen::VectorXd& xb = constantsOrEmpty(*model_, x);
   Eigen::MatrixXd J_h_xc, J_h_xb;
-  r = model_->h(xc, xb, J ? &J_h_xc : nullptr, J ? &J_h_xb : nullptr) - y_;
+  r = model_->h(channel_, xc, xb, J ? &J_h_xc : nullptr, J ? &J_h_xb : nullptr) - y_;
+  wrapAngles(r, model_->channel(channel_).angles);
   noise_.whitenInPlace(r);
   if (J) {
     J->resize(keys().size());
@@ -120,7 +162,8 @@ void MeasurementFactor::linearize(const Values& x, Eigen::VectorXd& r,
 }
 
 std::string MeasurementFactor::describe() const {
-  return "measurement at " + keys()[0].toString();
+  if (channel_ == 0 && model_->numChannels() == 1) return "measurement at " + keys()[0].toString();
+  return "measurement on channel '" + model_->channel(channel_).name + "' at " + keys()[0].toString();
 }
 
 // ---- LinearGaussianFactor ----------------------------------------------------

@@ -32,15 +32,20 @@ std::vector<ScheduledStep> stepSchedule(const std::vector<Measurement>& measurem
 
 std::vector<FactorPtr> priorFactors(const Model& model, const Gaussian& state_prior,
                                     const Gaussian& constants_prior, std::int64_t step) {
-  std::vector<FactorPtr> f{std::make_shared<PriorFactor>(Key::state(step), state_prior)};
-  if (model.dims().nb > 0) f.push_back(std::make_shared<PriorFactor>(Key::constants(), constants_prior));
+  // The model's angle components, split between x_c and x_b.
+  const int nc = model.dims().nc;
+  std::vector<int> state_angles, constant_angles;
+  for (int a : model.angleStates()) (a < nc ? state_angles : constant_angles).push_back(a < nc ? a : a - nc);
+  std::vector<FactorPtr> f{std::make_shared<PriorFactor>(Key::state(step), state_prior, state_angles)};
+  if (model.dims().nb > 0)
+    f.push_back(std::make_shared<PriorFactor>(Key::constants(), constants_prior, constant_angles));
   return f;
 }
 
 std::vector<FactorPtr> stepFactors(const Model& model, std::int64_t k, double dt, const Eigen::VectorXd& u,
-                                   const Eigen::VectorXd& y) {
+                                   const Measurement* measurement) {
   std::vector<FactorPtr> f{std::make_shared<ProcessFactor>(model, k - 1, u, dt)};
-  if (y.size()) f.push_back(std::make_shared<MeasurementFactor>(model, k, y));
+  if (measurement) f.push_back(std::make_shared<MeasurementFactor>(model, k, *measurement));
   return f;
 }
 
@@ -77,7 +82,7 @@ Problem buildProblem(const Model& model, const std::vector<Measurement>& measure
     p.initial.insert(Key::state(k + 1), model.f(p.initial.at(Key::state(k)), xb0, u, step.t - prev));
     p.times.push_back(step.t);
     for (std::size_t i : step.measurements)
-      p.graph.add(std::make_shared<MeasurementFactor>(model, k + 1, measurements[i].y));
+      p.graph.add(std::make_shared<MeasurementFactor>(model, k + 1, measurements[i]));
   }
   return p;
 }

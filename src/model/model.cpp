@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "gssm/core/angles.h"
 #include "gssm/core/error.h"
 #include "model/central_differences.h"
 
@@ -42,6 +43,12 @@ Model::Model(ModelDims dims, ModelNames names, ModelNoise noise)
   requireCovariance(noise_.Q, dims_.nc, "model: process noise Q");
   requireCovariance(noise_.R, dims_.ny, "model: measurement noise R");
   r_model_ = GaussianNoise(noise_.R, "model: measurement noise R");
+  MeasurementChannel y;
+  y.name = "y";
+  y.components = names_.measurement;
+  y.R = noise_.R;
+  channels_ = {y};
+  channel_noise_ = {r_model_};
   q_cache_ = std::make_shared<NoiseCache>();
   requireVector(noise_.prior_state.mean, dims_.nc, "model: prior mean of x_c(0)");
   requireCovariance(noise_.prior_state.covariance, dims_.nc, "model: prior covariance of x_c(0)");
@@ -52,6 +59,78 @@ Model::Model(ModelDims dims, ModelNames names, ModelNoise noise)
 }
 
 Eigen::MatrixXd Model::processNoise(double dt) const { return noise_.Q * (dt / noise_.T); }
+Eigen::MatrixXd Model::processNoiseOf(double dt, const Eigen::VectorXd&) const { return processNoise(dt); }
+
+Eigen::VectorXd Model::h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                         Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  if (channel != 0)
+    throw InvalidArgument("model '" + name() + "': channel " + std::to_string(channel) +
+                          " has no measurement function (the model does not override h(channel, ...))");
+  return h(xc, xb, J_h_xc, J_h_xb);
+}
+
+const MeasurementChannel& Model::channel(int c) const {
+  if (c < 0 || c >= numChannels())
+    throw InvalidArgument("model '" + name() + "': no channel " + std::to_string(c) + " (it has " +
+                          std::to_string(numChannels()) + ")");
+  return channels_[static_cast<std::size_t>(c)];
+}
+
+int Model::channelIndex(const std::string& channel_name) const {
+  std::string known;
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    if (channels_[i].name == channel_name) return static_cast<int>(i);
+    known += (i ? ", " : "") + channels_[i].name;
+  }
+  throw InvalidArgument("model '" + name() + "': unknown channel '" + channel_name + "' (channels: " + known + ")");
+}
+
+const GaussianNoise& Model::channelNoiseModel(int c) const {
+  channel(c);  // range check
+  return channel_noise_[static_cast<std::size_t>(c)];
+}
+
+void Model::setChannelLoss(int c, const RobustLoss& loss, double ekf_gate) {
+  std::string why;
+  if (!loss.validate(&why)) throw InvalidArgument("model '" + name() + "', channel '" + channel(c).name + "': " + why);
+  if (!(ekf_gate >= 0) || !std::isfinite(ekf_gate))
+    throw InvalidArgument("model '" + name() + "', channel '" + channel(c).name + "': EKF gate must be >= 0");
+  channels_[static_cast<std::size_t>(c)].loss = loss;
+  channels_[static_cast<std::size_t>(c)].ekf_gate = ekf_gate;
+}
+
+void Model::setChannels(std::vector<MeasurementChannel> channels) {
+  if (channels.empty() || channels.front().dim() != dims_.ny)
+    throw InvalidArgument("model: channel 0 must have n_y = " + std::to_string(dims_.ny) + " components");
+  std::set<std::string> names, components;
+  std::vector<GaussianNoise> noise;
+  for (const auto& ch : channels) {
+    if (ch.name.empty() || !names.insert(ch.name).second)
+      throw InvalidArgument("model: channel name '" + ch.name + "' is empty or used twice");
+    requireNames(ch.components, ch.dim(), "channel '" + ch.name + "' component", components);
+    requireCovariance(ch.R, ch.dim(), "model: noise R of channel '" + ch.name + "'");
+    for (int a : ch.angles)
+      if (a < 0 || a >= ch.dim()) throw InvalidArgument("model: channel '" + ch.name + "': angle component out of range");
+    std::string why;
+    if (!ch.loss.validate(&why)) throw InvalidArgument("model: channel '" + ch.name + "': " + why);
+    noise.emplace_back(ch.R, "model: noise R of channel '" + ch.name + "'");
+  }
+  channels_ = std::move(channels);
+  channel_noise_ = std::move(noise);
+}
+
+void Model::setAngleStates(std::vector<int> stacked_components) {
+  for (int a : stacked_components)
+    if (a < 0 || a >= dims_.nc + dims_.nb)
+      throw InvalidArgument("model: angle component " + std::to_string(a) + " outside the stacked state");
+  std::sort(stacked_components.begin(), stacked_components.end());
+  angle_states_ = std::move(stacked_components);
+}
+
+Eigen::VectorXd Model::wrapStacked(Eigen::VectorXd z) const {
+  wrapAngles(z, angle_states_);
+  return z;
+}
 
 struct Model::NoiseCache {
   std::mutex mutex;

@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "gssm/core/angles.h"
 #include "gssm/core/error.h"
 
 namespace gssm {
@@ -30,7 +31,9 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
   requireVector(run.states[0], d.nc, "simulate: true x_c(0)");
   requireVector(run.constants, d.nb, "simulate: true x_b");
   const double T = model.nominalStep();
-  const Eigen::VectorXd zc = Eigen::VectorXd::Zero(d.nc), zy = Eigen::VectorXd::Zero(d.ny);
+  const Eigen::VectorXd zc = Eigen::VectorXd::Zero(d.nc);
+  if (spec.channels.empty()) throw InvalidArgument("simulate: no measurement channels");
+  for (int c : spec.channels) model.channel(c);  // throws naming a channel the model does not have
   run.times.push_back(0.0);
   for (int k = 1; k <= spec.steps; ++k) {
     const double t_prev = (k - 1) * T;
@@ -38,12 +41,16 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
     requireVector(u, d.nu, "simulate: input at t = " + std::to_string(t_prev));
     if (spec.input) run.inputs.push_back({t_prev, u});
     Eigen::VectorXd x = model.f(run.states.back(), run.constants, u, T);
-    if (spec.process_noise) x += sampleGaussian(zc, model.processNoise(T), draw);
+    if (spec.process_noise) x += sampleGaussian(zc, model.processNoiseOf(T, u), draw);
+    wrapAngles(x, model.angleStates());  // stacked indices below n_c are x_c's
     const double t = k * T;
     if (k % spec.measure_every == 0) {
-      Eigen::VectorXd y = model.h(x, run.constants);
-      if (spec.measurement_noise) y += sampleGaussian(zy, model.measurementNoise(), draw);
-      run.measurements.push_back({t, std::move(y)});
+      const int c = spec.channels[run.measurements.size() % spec.channels.size()];
+      const MeasurementChannel& ch = model.channel(c);
+      Eigen::VectorXd y = model.h(c, x, run.constants);
+      if (spec.measurement_noise) y += sampleGaussian(Eigen::VectorXd::Zero(ch.dim()), ch.R, draw);
+      wrapAngles(y, ch.angles);
+      run.measurements.push_back({t, std::move(y), c, {}});
     }
     run.times.push_back(t);
     run.states.push_back(std::move(x));

@@ -46,6 +46,21 @@ LinearModel::LinearModel(LinearSystem sys, Discretization d)
   if (!sys_.A_c.allFinite() || !sys_.A_b.allFinite() || !sys_.B.allFinite() ||
       !sys_.C_c.allFinite() || !sys_.C_b.allFinite())
     throw InvalidArgument("LinearModel: a system matrix has a NaN or infinite entry");
+  if (!sys_.channels.empty()) {
+    std::vector<MeasurementChannel> channels{channel(0)};
+    for (const auto& c : sys_.channels) {
+      if (c.C_c.rows() != c.R.rows() || c.C_c.cols() != dims().nc || c.C_b.rows() != c.R.rows() ||
+          c.C_b.cols() != dims().nb || !c.C_c.allFinite() || !c.C_b.allFinite())
+        throw InvalidArgument("LinearModel: channel '" + c.name + "': C_c must be n × n_c and C_b n × n_b, finite, "
+                              "with n the size of its R");
+      MeasurementChannel ch;
+      ch.name = c.name;
+      ch.components = c.components.empty() ? numbered(c.name + "_", static_cast<int>(c.R.rows())) : c.components;
+      ch.R = c.R;
+      channels.push_back(std::move(ch));
+    }
+    setChannels(std::move(channels));
+  }
   // The nominal step's matrices are cached: f() at the nominal step is hot.
   Eigen::MatrixXd Fc, Fb, Bk;
   discreteMatrices(nominalStep(), Fc, Fb, Bk);
@@ -97,6 +112,23 @@ Eigen::VectorXd LinearModel::h(const Eigen::VectorXd& xc, const Eigen::VectorXd&
   if (J_h_xc) *J_h_xc = sys_.C_c;
   if (J_h_xb) *J_h_xb = sys_.C_b;
   return sys_.C_c * xc + sys_.C_b * xb;
+}
+
+void LinearModel::outputMatrices(int c, Eigen::MatrixXd& C_c, Eigen::MatrixXd& C_b) const {
+  channel(c);  // range check
+  const bool base = c == 0;
+  C_c = base ? sys_.C_c : sys_.channels[static_cast<std::size_t>(c - 1)].C_c;
+  C_b = base ? sys_.C_b : sys_.channels[static_cast<std::size_t>(c - 1)].C_b;
+}
+
+Eigen::VectorXd LinearModel::h(int c, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                               Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  if (c == 0) return h(xc, xb, J_h_xc, J_h_xb);
+  channel(c);  // range check
+  const LinearChannel& ch = sys_.channels[static_cast<std::size_t>(c - 1)];
+  if (J_h_xc) *J_h_xc = ch.C_c;
+  if (J_h_xb) *J_h_xb = ch.C_b;
+  return ch.C_c * xc + ch.C_b * xb;
 }
 
 }  // namespace gssm::models

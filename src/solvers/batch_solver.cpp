@@ -114,13 +114,13 @@ struct BatchSolver::Impl {
     std::vector<Eigen::Index> offs;
     for (const auto& f : graph) {
       std::vector<Eigen::MatrixXd>& J = jacobians[{f->keys().size(), f->dim()}];
-      f->linearize(x, r, &J);
+      const double c = f->linearizeRobust(x, r, &J);  // reweighted at every linearization
       if (!r.allFinite()) {
         if (trial) return std::numeric_limits<double>::infinity();
         throw NumericalError("BatchSolver: factor '" + f->describe() +
                              "' has a non-finite residual at the current estimate");
       }
-      cost += 0.5 * r.squaredNorm();
+      cost += c;
       const auto& keys = f->keys();
       offs.resize(keys.size());
       for (std::size_t a = 0; a < keys.size(); ++a) offs[a] = offset[x.indexOf(keys[a])];
@@ -283,7 +283,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
           Eigen::VectorXd r;
           std::vector<Eigen::MatrixXd> J;
           for (const auto& f : graph) {
-            f->linearize(at, r, &J);
+            f->linearizeRobust(at, r, &J);
             const Eigen::MatrixXd C = internal::residualCurvature(*f, at, r);
             sys.add(f->keys(), r, J, &C);
           }

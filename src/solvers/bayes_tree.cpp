@@ -112,7 +112,7 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
   LinearFactor lf;
   lf.keys = f.keys();
   Eigen::VectorXd r;
-  f.linearize(x, r, &lf.A);
+  f.linearizeRobust(x, r, &lf.A);  // robust factors reweighted at each linearization
   bool finite = r.allFinite();
   for (const auto& a : lf.A) finite = finite && a.allFinite();
   if (!finite)
@@ -636,7 +636,7 @@ double BayesTreeEngine::linearizationError(int slot) const {
     rlin += s.linear.A[i] * v.delta;
   }
   Eigen::VectorXd r;
-  s.nonlinear->linearize(x, r, nullptr);
+  s.nonlinear->linearizeRobust(x, r, nullptr);  // a moved weight is a linearization error too
   return (r - rlin).norm();
 }
 
@@ -682,7 +682,7 @@ void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
-      s.nonlinear->linearize(x, r, &J);
+      s.nonlinear->linearizeRobust(x, r, &J);
       const Eigen::MatrixXd C = residualCurvature(*s.nonlinear, x, r);
       sys.add(s.nonlinear->keys(), r, J, &C);
     } else {  // r = Σ A δ − b in δ coordinates: J = A, no curvature

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/byte_stream.h"
+#include "gssm/core/angles.h"
 #include "gssm/core/error.h"
 #include "gssm/core/gaussian.h"
 #include "gssm/core/key.h"
@@ -56,7 +57,7 @@ void ExtendedKalmanFilter::predict(double t, const Eigen::VectorXd& u) {
   F.topLeftCorner(d.nc, d.nc) = J_f_xc;
   F.topRightCorner(d.nc, d.nb) = J_f_xb;
   Eigen::MatrixXd Qz = Eigen::MatrixXd::Zero(n, n);
-  Qz.topLeftCorner(d.nc, d.nc) = model_->processNoise(dt);
+  Qz.topLeftCorner(d.nc, d.nc) = model_->processNoiseOf(dt, u);
   Qz.diagonal().tail(d.nb) = options_.constant_process_noise * (dt / model_->nominalStep());
   Eigen::MatrixXd P = F * P_ * F.transpose() + Qz;
   if (!xc.allFinite() || !P.allFinite())
@@ -64,27 +65,40 @@ void ExtendedKalmanFilter::predict(double t, const Eigen::VectorXd& u) {
                          std::to_string(t) + " is not finite; filter left at t = " +
                          std::to_string(t_));
   z_.head(d.nc) = xc;
+  wrapAngles(z_, model_->angleStates());
   P_ = 0.5 * (P + P.transpose());
   t_ = t;
 }
 
-void ExtendedKalmanFilter::update(const Eigen::VectorXd& y) {
+void ExtendedKalmanFilter::update(const Eigen::VectorXd& y) { update(Measurement{t_, y}); }
+
+bool ExtendedKalmanFilter::update(const Measurement& m) {
   const ModelDims& d = model_->dims();
-  requireVector(y, d.ny, "ExtendedKalmanFilter::update: measurement y");
+  const MeasurementChannel& ch = model_->channel(m.channel);
+  const Eigen::VectorXd& y = m.y;
+  requireVector(y, ch.dim(), "ExtendedKalmanFilter::update: measurement on channel '" + ch.name + "'");
+  if (m.R.size()) requireCovariance(m.R, ch.dim(), "ExtendedKalmanFilter::update: the measurement's own R");
   Eigen::MatrixXd J_h_xc, J_h_xb;
-  const Eigen::VectorXd yhat = model_->h(z_.head(d.nc), z_.tail(d.nb), &J_h_xc, &J_h_xb);
+  const Eigen::VectorXd yhat = model_->h(m.channel, z_.head(d.nc), z_.tail(d.nb), &J_h_xc, &J_h_xb);
   const int n = d.nc + d.nb;
-  Eigen::MatrixXd H(d.ny, n);
+  Eigen::MatrixXd H(ch.dim(), n);
   H << J_h_xc, J_h_xb;
-  const Eigen::MatrixXd& R = model_->measurementNoise();
+  const Eigen::MatrixXd& R = m.R.size() ? m.R : ch.R;
   const Eigen::MatrixXd S = H * P_ * H.transpose() + R;
   Eigen::LLT<Eigen::MatrixXd> llt(S);
   if (llt.info() != Eigen::Success || !S.allFinite())
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
                          ": innovation covariance S = HPHᵀ + R is not positive definite; "
                          "check R and the covariance P (filter unchanged)");
+  Eigen::VectorXd innov = y - yhat;
+  wrapAngles(innov, ch.angles);
+  const double nis = innov.dot(llt.solve(innov));
+  if (ch.ekf_gate > 0 && nis > ch.ekf_gate) {  // an outlier: leave the estimate as it is
+    nis_ = nis;
+    ++rejected_;
+    return false;
+  }
   const Eigen::MatrixXd K = llt.solve(H * P_).transpose();  // P Hᵀ S⁻¹ (P, S symmetric)
-  const Eigen::VectorXd innov = y - yhat;
   const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(n, n) - K * H;
   Eigen::MatrixXd P = options_.joseph_form
                           ? Eigen::MatrixXd(IKH * P_ * IKH.transpose() + K * R * K.transpose())
@@ -95,8 +109,10 @@ void ExtendedKalmanFilter::update(const Eigen::VectorXd& y) {
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
                          ": the updated covariance is not positive definite (filter unchanged)");
   z_ += K * innov;
+  wrapAngles(z_, model_->angleStates());
   P_ = std::move(P);
-  nis_ = innov.dot(llt.solve(innov));
+  nis_ = nis;
+  return true;
 }
 
 Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
@@ -110,7 +126,7 @@ Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& op
   std::int64_t k = 0;
   for (const ScheduledStep& step : stepSchedule(measurements, inputs, t0)) {
     ekf.predict(step.t, inputAt(model, inputs, ekf.time()));
-    for (std::size_t i : step.measurements) ekf.update(measurements[i].y);
+    for (std::size_t i : step.measurements) ekf.update(measurements[i]);
     x.insert(Key::state(++k), ekf.mean().head(d.nc));
   }
   if (d.nb > 0) x.insert(Key::constants(), ekf.mean().tail(d.nb));
@@ -122,6 +138,7 @@ void ExtendedKalmanFilter::save(internal::ByteWriter& out) const {
   out.vec(z_);
   out.mat(P_);
   out.f64(nis_);
+  out.i64(rejected_);  // since format version 2
 }
 
 void ExtendedKalmanFilter::load(internal::ByteReader& in) {
@@ -129,6 +146,8 @@ void ExtendedKalmanFilter::load(internal::ByteReader& in) {
   Eigen::VectorXd z = in.vec("EKF mean");
   Eigen::MatrixXd P = in.mat("EKF covariance");
   const double nis = in.f64("EKF NIS", true);
+  const std::int64_t rejected = in.version() >= 2 ? in.i64("EKF gated measurements") : 0;
+  if (rejected < 0) in.fail("EKF gated measurements: negative count");
   const Eigen::Index n = model_->dims().nc + model_->dims().nb;
   if (z.size() != n || P.rows() != n || P.cols() != n)
     in.fail("EKF state has size " + std::to_string(z.size()) + " (covariance " + std::to_string(P.rows()) +
@@ -137,6 +156,7 @@ void ExtendedKalmanFilter::load(internal::ByteReader& in) {
   z_ = std::move(z);
   P_ = std::move(P);
   nis_ = nis;
+  rejected_ = rejected;
 }
 
 }  // namespace gssm

@@ -28,7 +28,9 @@
 
 namespace gssm {
 
-constexpr std::uint32_t kCheckpointVersion = 1;
+/// Version 2 added the EKF's count of gated measurements; version 1 files
+/// still restore (the count starts at 0).
+constexpr std::uint32_t kCheckpointVersion = 2;
 
 /// What a checkpoint says about itself (filled by restore).
 struct CheckpointInfo {

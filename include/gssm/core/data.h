@@ -9,6 +9,8 @@ namespace gssm {
 struct Measurement {
   double t = 0.0;
   Eigen::VectorXd y;
+  int channel = 0;    ///< the model's measurement channel (0: the default)
+  Eigen::MatrixXd R;  ///< this measurement's own noise covariance; empty: the channel's
 };
 
 /// An input u held constant from time t until the next input (zero-order hold).

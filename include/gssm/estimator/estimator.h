@@ -48,6 +48,9 @@ struct EstimatorReport {
   std::int64_t steps = 0;     ///< measurements processed
   double seconds = 0;         ///< wall time of the last addMeasurement
   int iterations = 0;         ///< solver iterations of the last update (1 for the EKF)
+  /// Measurements rejected by their channel's EKF gate so far (EKF only;
+  /// the smoothers down-weight by robust losses instead).
+  std::int64_t rejected = 0;
   UpdateReport smoother;      ///< the smoother's report (incremental, fixed-lag; zeros otherwise)
   std::string detail;         ///< one line from the underlying estimator
   /// Normalized innovation squared of the last measurement, eᵀS⁻¹e with the
@@ -101,6 +104,12 @@ class Estimator {
   /// the newest state's time (after t0): attached to that state (multi-rate
   /// sensors, several measurements per step).
   void addMeasurement(double t, const Eigen::VectorXd& y);
+  /// A measurement on the model's channel called `channel` (several
+  /// sensors: any rate, any interleaving, several at one time stamp).
+  void addMeasurement(double t, const std::string& channel, const Eigen::VectorXd& y);
+  /// A measurement on m.channel, with its own noise covariance m.R when given
+  /// (a receiver that reports its accuracy).
+  void addMeasurement(const Measurement& m);
 
   /// Newest state and constants with their joint covariance.
   virtual StateEstimate current() = 0;
@@ -134,10 +143,9 @@ class Estimator {
   Estimator(const Model& model, const EstimatorOptions& options);
   /// Processes a validated step k−1 → k under input u, with the measurement
   /// y at x_c(k) when y is non-empty; must be strongly exception safe.
-  virtual void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u,
-                      const Eigen::VectorXd& y) = 0;
+  virtual void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* m) = 0;
   /// Adds a measurement at the newest state x_c(k), k ≥ 1; strongly safe.
-  virtual void doMeasurement(std::int64_t k, const Eigen::VectorXd& y) = 0;
+  virtual void doMeasurement(std::int64_t k, const Measurement& m) = 0;
   /// The one-line `detail` of the last update, called by report() only
   /// after markDetail() (default: the smoother report's line).
   virtual std::string formatDetail() const { return report_.smoother.toString(); }
@@ -153,7 +161,7 @@ class Estimator {
   virtual void loadState(internal::ByteReader& in);
   void advance(double t);  // process-only step to t
   /// NIS of y at a step dt after the current estimate (dt = 0: at it).
-  double innovationNis(double dt, const Eigen::VectorXd& u, const Eigen::VectorXd& y);
+  double innovationNis(double dt, const Eigen::VectorXd& u, const Measurement& m);
   Eigen::VectorXd inputInForce() const;
   double t_;            // time of the newest state
   std::int64_t k_ = 0;  // its step

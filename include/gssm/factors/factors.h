@@ -9,6 +9,7 @@
 
 #include "gssm/core/gaussian.h"
 #include "gssm/core/key.h"
+#include "gssm/core/data.h"
 #include "gssm/model/model.h"
 #include "gssm/core/values.h"
 
@@ -25,38 +26,50 @@ class Factor {
   /// key, J[i] of size dim() × dim(keys()[i]).
   virtual void linearize(const Values& x, Eigen::VectorXd& r,
                          std::vector<Eigen::MatrixXd>* J) const = 0;
-  /// ½‖r(x)‖².
+  /// What the solvers minimize: linearize() with r and J scaled by √ρ'(s),
+  /// s = ‖r‖², for a factor with a robust loss (iteratively reweighted least
+  /// squares, core/robust_loss.h); returns the cost ½ρ(s).
+  double linearizeRobust(const Values& x, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const;
+  /// ½ρ(‖r(x)‖²) (½‖r(x)‖² without a robust loss).
   double cost(const Values& x) const;
+  /// ρ'(‖r(x)‖²) at x: 1 without a loss; below 1 where a loss down-weights.
+  double weight(const Values& x) const;
+  const RobustLoss& loss() const { return loss_; }
   /// Human-readable description naming the variables ("range at x_c(12)").
   virtual std::string describe() const = 0;
 
  protected:
-  Factor(std::vector<Key> keys, int dim) : keys_(std::move(keys)), dim_(dim) {}
+  Factor(std::vector<Key> keys, int dim, RobustLoss loss = {})
+      : keys_(std::move(keys)), dim_(dim), loss_(loss) {}
 
  private:
   std::vector<Key> keys_;
   int dim_;
+  RobustLoss loss_;
 };
 
 using FactorPtr = std::shared_ptr<const Factor>;
 
-/// E[x] = mean with covariance Σ: r = L⁻¹ (x − mean).
+/// E[x] = mean with covariance Σ: r = L⁻¹ (x − mean), the listed angle
+/// components of x − mean wrapped to (−π, π].
 class PriorFactor final : public Factor {
  public:
-  PriorFactor(Key key, const Gaussian& prior);
+  PriorFactor(Key key, const Gaussian& prior, std::vector<int> angles = {});
   void linearize(const Values& x, Eigen::VectorXd& r,
                  std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   const Eigen::VectorXd& mean() const { return mean_; }
   const GaussianNoise& noise() const { return noise_; }
+  const std::vector<int>& angles() const { return angles_; }
 
  private:
   Eigen::VectorXd mean_;
   GaussianNoise noise_;
+  std::vector<int> angles_;
 };
 
-/// x_c(k+1) = f(x_c(k), x_b, u_k, dt) + q:  r = L_Q⁻¹ (x_c(k+1) − f(...)).
-/// The model must outlive the factor.
+/// x_c(k+1) = f(x_c(k), x_b, u_k, dt) + q:  r = L_Q⁻¹ (x_c(k+1) − f(...)),
+/// angle states wrapped. The model must outlive the factor.
 class ProcessFactor final : public Factor {
  public:
   ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt);
@@ -73,21 +86,28 @@ class ProcessFactor final : public Factor {
   GaussianNoise noise_;
 };
 
-/// y = h(x_c(k), x_b) + r:  r = L_R⁻¹ (h(...) − y).
+/// y = h_c(x_c(k), x_b) + r on channel c:  r = L_R⁻¹ (h_c(...) − y), the
+/// channel's angle components wrapped, with the channel's robust loss.
 class MeasurementFactor final : public Factor {
  public:
+  /// On the default channel with its noise.
   MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y);
-  MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y,
+  /// On m.channel, with m.R when given (else the channel's R).
+  MeasurementFactor(const Model& model, std::int64_t k, const Measurement& m);
+  /// On `channel` with an explicit noise model (checkpoints).
+  MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y, int channel,
                     const GaussianNoise& noise);
   void linearize(const Values& x, Eigen::VectorXd& r,
                  std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   const Eigen::VectorXd& measurement() const { return y_; }
+  int channel() const { return channel_; }
   const GaussianNoise& noise() const { return noise_; }
 
  private:
   const Model* model_;
   Eigen::VectorXd y_;
+  int channel_;
   GaussianNoise noise_;
 };
 
@@ -119,7 +139,7 @@ class FactorGraph {
   const FactorPtr& operator[](std::size_t i) const { return factors_[i]; }
   auto begin() const { return factors_.begin(); }
   auto end() const { return factors_.end(); }
-  /// ½ Σ ‖r_i(x)‖².
+  /// ½ Σ ρ_i(‖r_i(x)‖²) (the robust cost; ½ Σ ‖r_i‖² without losses).
   double cost(const Values& x) const;
 
  private:

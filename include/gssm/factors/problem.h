@@ -23,10 +23,10 @@ std::vector<FactorPtr> priorFactors(const Model& model, const Gaussian& state_pr
                                     const Gaussian& constants_prior, std::int64_t step = 0);
 
 /// What the step k−1 → k adds to the graph: its process factor x_c(k−1) →
-/// x_c(k) under input u over dt (touching x_b), and the measurement y at
-/// x_c(k) when y is non-empty (docs/DESIGN.md §1, eqs. 2–3).
+/// x_c(k) under input u over dt (touching x_b), and the measurement at
+/// x_c(k) when one is given (docs/DESIGN.md §1, eqs. 2–3).
 std::vector<FactorPtr> stepFactors(const Model& model, std::int64_t k, double dt, const Eigen::VectorXd& u,
-                                   const Eigen::VectorXd& y = Eigen::VectorXd());
+                                   const Measurement* measurement = nullptr);
 
 /// x_c(0) sits at t0; each measurement opens a new step. Inputs are held
 /// (zero-order hold) from their time on; before the first input u = 0.

@@ -13,8 +13,24 @@
 #include <vector>
 
 #include "gssm/core/gaussian.h"
+#include "gssm/core/robust_loss.h"
 
 namespace gssm {
+
+/// One sensor stream of a model (docs/DESIGN.md §9). A model has at least
+/// one; the default channel of a one-sensor model is "y", built from its
+/// measurement names and R.
+struct MeasurementChannel {
+  std::string name;                     ///< unique among the model's channels
+  std::vector<std::string> components;  ///< component names; the dimension is their number
+  Eigen::MatrixXd R;                    ///< noise covariance
+  RobustLoss loss;                      ///< on the whitened residual (default: none, Gaussian)
+  std::vector<int> angles;              ///< components that are angles: residuals wrapped to (−π, π]
+  /// EKF: a measurement whose NIS exceeds this is rejected (0: no gate),
+  /// e.g. the χ² 0.999 quantile of the channel's dimension.
+  double ekf_gate = 0;
+  int dim() const { return static_cast<int>(components.size()); }
+};
 
 struct ModelDims {
   int nc = 0;  ///< time-series state x_c
@@ -54,15 +70,39 @@ class Model {
                             Eigen::MatrixXd* J_f_xc = nullptr,
                             Eigen::MatrixXd* J_f_xb = nullptr) const = 0;
 
-  /// Measurement model y = h(x_c, x_b); fills J_h_xc (n_y×n_c) and J_h_xb
-  /// (n_y×n_b) when non-null.
+  /// Measurement model of the default channel, y = h(x_c, x_b); fills
+  /// J_h_xc (n_y×n_c) and J_h_xb (n_y×n_b) when non-null.
   virtual Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                             Eigen::MatrixXd* J_h_xc = nullptr,
                             Eigen::MatrixXd* J_h_xb = nullptr) const = 0;
+  /// Measurement model of channel `channel` (dimension channel(c).dim()).
+  /// Default: channel 0 is h() above; models with several channels override.
+  virtual Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                            Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const;
+
+  /// The measurement channels (at least one; channel 0 has n_y components).
+  int numChannels() const { return static_cast<int>(channels_.size()); }
+  const MeasurementChannel& channel(int c) const;
+  /// The channel called `name`; InvalidArgument naming the known ones otherwise.
+  int channelIndex(const std::string& name) const;
+  /// R of channel c as a whitening noise model (factored once).
+  const GaussianNoise& channelNoiseModel(int c) const;
+  /// Sets the robust loss and the EKF gate of channel c (before any
+  /// estimator uses the model).
+  void setChannelLoss(int c, const RobustLoss& loss, double ekf_gate);
+  /// Components of the stacked state [x_c; x_b] that are angles.
+  const std::vector<int>& angleStates() const { return angle_states_; }
+  /// The stacked state with its angle components wrapped to (−π, π].
+  Eigen::VectorXd wrapStacked(Eigen::VectorXd z) const;
 
   /// Process noise covariance of a step of length dt. Default: Q·dt/T (a
   /// white-noise-driven state), which is Q itself at the nominal step.
   virtual Eigen::MatrixXd processNoise(double dt) const;
+  /// Process noise of a step under input u (odometry: noise grows with the
+  /// distance and the turn). Default: processNoise(dt). A model that
+  /// overrides it returns true from processNoiseDependsOnInput().
+  virtual Eigen::MatrixXd processNoiseOf(double dt, const Eigen::VectorXd& u) const;
+  virtual bool processNoiseDependsOnInput() const { return false; }
 
   const ModelDims& dims() const { return dims_; }
   const ModelNames& names() const { return names_; }
@@ -87,8 +127,16 @@ class Model {
   /// Validates every dimension, name and covariance; throws InvalidArgument
   /// or NumericalError naming the offending field.
   Model(ModelDims dims, ModelNames names, ModelNoise noise);
+  /// Replaces the default channel by these (a model with several sensors);
+  /// channel 0 must have n_y components. Validates names and covariances.
+  void setChannels(std::vector<MeasurementChannel> channels);
+  /// Marks components of the stacked state [x_c; x_b] as angles.
+  void setAngleStates(std::vector<int> stacked_components);
 
  private:
+  std::vector<MeasurementChannel> channels_;
+  std::vector<GaussianNoise> channel_noise_;
+  std::vector<int> angle_states_;
   ModelDims dims_;
   ModelNames names_;
   ModelNoise noise_;

@@ -25,6 +25,9 @@ struct SimulationSpec {
   /// true constants x_b (a sensor reading includes its bias); empty: zeros.
   std::function<Eigen::VectorXd(double t, const Eigen::VectorXd& xb)> input;
   int measure_every = 1;              ///< a measurement every this many steps (multi-rate)
+  /// The channel of each measurement, in turn (several sensors taking turns,
+  /// e.g. one beacon per range); default: the default channel only.
+  std::vector<int> channels{0};
 };
 
 struct SimulatedRun {

@@ -8,10 +8,18 @@
 
 namespace gssm::models {
 
+/// A further sensor of a linear system: y = C_c x_c + C_b x_b + r, r ~ N(0, R).
+struct LinearChannel {
+  std::string name;
+  Eigen::MatrixXd C_c, C_b, R;
+  std::vector<std::string> components;  ///< optional: left empty, <name>_1.. are used
+};
+
 struct LinearSystem {
-  Eigen::MatrixXd A_c, A_b, B, C_c, C_b;
-  ModelNoise noise;  ///< T, Q (per nominal step), R, priors
+  Eigen::MatrixXd A_c, A_b, B, C_c, C_b;  ///< C_c, C_b: the default channel "y"
+  ModelNoise noise;  ///< T, Q (per nominal step), R (of the default channel), priors
   ModelNames names;  ///< optional: left empty, names x1.., b1.., u1.., y1.. are used
+  std::vector<LinearChannel> channels;  ///< further sensors (channels 1, 2, ...)
 };
 
 enum class Discretization { Euler, Exact };
@@ -33,6 +41,10 @@ class LinearModel final : public Model {
                     Eigen::MatrixXd* J_f_xb = nullptr) const override;
   Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                    Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  /// C = [C_c, C_b] of a channel (0: the default).
+  void outputMatrices(int channel, Eigen::MatrixXd& C_c, Eigen::MatrixXd& C_b) const;
 
  private:
   LinearSystem sys_;

@@ -27,6 +27,7 @@ class Radar2D final : public Model {
   Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     const Eigen::VectorXd& u, double dt, Eigen::MatrixXd* J_f_xc = nullptr,
                     Eigen::MatrixXd* J_f_xb = nullptr) const override;
+  using Model::h;  // h(channel, ...) for channel 0
   Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
 };

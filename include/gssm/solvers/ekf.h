@@ -34,9 +34,15 @@ class ExtendedKalmanFilter {
   /// Propagates to time t > time() with input u held over the interval.
   /// Throws InvalidArgument (filter unchanged) on bad time or input.
   void predict(double t, const Eigen::VectorXd& u);
-  /// Measurement update at the current time; throws (filter unchanged) on
-  /// a bad measurement or a non-positive-definite innovation covariance.
+  /// Measurement update at the current time on the default channel; throws
+  /// (filter unchanged) on a bad measurement or a non-positive-definite
+  /// innovation covariance.
   void update(const Eigen::VectorXd& y);
+  /// Update with a measurement on its channel (its own R when given).
+  /// Returns false, leaving the estimate unchanged, when the channel has an
+  /// EKF gate and the measurement's NIS exceeds it (an outlier); lastNis()
+  /// is its NIS either way.
+  bool update(const Measurement& m);
 
   double time() const { return t_; }
   /// Stacked mean [x_c; x_b] and covariance.
@@ -44,6 +50,8 @@ class ExtendedKalmanFilter {
   const Eigen::MatrixXd& covariance() const { return P_; }
   /// Normalized innovation squared of the last update (NIS).
   double lastNis() const { return nis_; }
+  /// Measurements rejected by their channel's gate so far.
+  std::int64_t rejected() const { return rejected_; }
   const Model& model() const { return *model_; }
 
   /// Checkpoint: time, mean, covariance, last NIS (the options are the
@@ -59,6 +67,7 @@ class ExtendedKalmanFilter {
   Eigen::VectorXd z_;
   Eigen::MatrixXd P_;
   double nis_ = 0.0;
+  std::int64_t rejected_ = 0;
 };
 
 /// An initial guess for a batch solve from one EKF pass: x_c(k) from the
