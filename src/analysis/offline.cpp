@@ -1,10 +1,13 @@
 #include "gssm/analysis/offline.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "core/byte_stream.h"
 #include "gssm/checkpoint/checkpoint.h"
+#include "gssm/core/angles.h"
 #include "gssm/core/error.h"
 #include "gssm/factors/problem.h"
 
@@ -19,7 +22,8 @@ double since(Clock::time_point t0) {
 
 namespace {
 // The run so far, stored as a checkpoint's user data.
-constexpr const char* kRunTag = "gssm offline run v1";
+// v2 adds whether a row is due, the down-weighted and gated counts.
+constexpr const char* kRunTag = "gssm offline run v2";
 
 // Fingerprint of the measurements a checkpoint has consumed (folded in one
 // at a time), so a run is not resumed on another dataset.
@@ -31,9 +35,12 @@ std::uint64_t foldMeasurement(std::uint64_t h, const Measurement& m) {
 }
 
 std::string encodeRun(const OfflineRun& run, std::size_t next_measurement, std::size_t next_input,
-                      std::uint64_t data_fingerprint) {
+                      std::uint64_t data_fingerprint, bool row_due) {
   internal::ByteWriter w;
   w.str(kRunTag);
+  w.boolean(row_due);
+  w.u64(run.downweighted);
+  w.i64(run.rejected);
   w.u64(data_fingerprint);
   w.str(methodName(run.method));
   w.u64(next_measurement);
@@ -54,11 +61,18 @@ std::string encodeRun(const OfflineRun& run, std::size_t next_measurement, std::
 }
 
 OfflineRun decodeRun(const std::string& bytes, const std::string& source, std::size_t& next_measurement,
-                     std::size_t& next_input, std::uint64_t& data_fingerprint) {
+                     std::size_t& next_input, std::uint64_t& data_fingerprint, bool& row_due) {
   internal::ByteReader r(bytes, source + " (run progress)");
-  if (r.str("run tag") != kRunTag) r.fail("not the checkpoint of an offline run (gssm-process)");
-  data_fingerprint = r.u64("data fingerprint");
+  const std::string tag = r.str("run tag");
+  if (tag != kRunTag && tag != "gssm offline run v1") r.fail("not the checkpoint of an offline run (gssm-process)");
   OfflineRun run;
+  row_due = false;
+  if (tag == kRunTag) {
+    row_due = r.boolean("row due");
+    run.downweighted = r.u64("down-weighted count");
+    run.rejected = r.i64("gated count");
+  }
+  data_fingerprint = r.u64("data fingerprint");
   const std::string method = r.str("method");
   if (!methodNamed(method)) r.fail("unknown method '" + method + "'");
   run.method = *methodNamed(method);
@@ -77,8 +91,7 @@ OfflineRun decodeRun(const std::string& bytes, const std::string& source, std::s
   run.nis.resize(r.count("NIS values", 8));
   for (double& v : run.nis) v = r.f64("NIS", true);
   if (!r.atEnd()) r.fail("unexpected bytes after the run progress");
-  if (run.rows.size() != next_measurement || run.update_seconds.size() != next_measurement)
-    r.fail("row count does not match the measurements consumed");
+  if (run.update_seconds.size() != next_measurement) r.fail("latency count does not match the measurements consumed");
   return run;
 }
 }  // namespace
@@ -87,7 +100,7 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::vector<Measurement>& measurements,
                         const std::vector<Input>& inputs,
                         const std::function<void(std::size_t, std::size_t)>& progress,
-                        const StreamingCheckpoints& checkpoints) {
+                        const StreamingCheckpoints& checkpoints, RowTimes rows) {
   if (!checkpoints.path.empty() && checkpoints.every == 0)
     throw InvalidArgument("runStreaming: a checkpoint path needs checkpoints.every >= 1");
   OfflineRun out;
@@ -96,13 +109,14 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
   const auto start = Clock::now();
   std::unique_ptr<Estimator> est;
   std::size_t first = 0, next_input = 0;
+  bool row_due = false;  // rows at inputs: the newest state, made by an input, has no row yet
   std::uint64_t data_hash = internal::kFnv1a64Basis;
   double seconds_before = 0;
   if (!checkpoints.resume_from.empty()) {
     CheckpointInfo info;
     est = restoreCheckpoint(model, checkpoints.resume_from, &info);
     std::uint64_t fingerprint = 0;
-    out = decodeRun(info.user_data, checkpoints.resume_from, first, next_input, fingerprint);
+    out = decodeRun(info.user_data, checkpoints.resume_from, first, next_input, fingerprint, row_due);
     const auto fail = [&](const std::string& why) {
       throw CheckpointError(checkpoints.resume_from + ": cannot resume this run: " + why);
     };
@@ -122,26 +136,58 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
   }
   out.rows.reserve(measurements.size());
   out.update_seconds.reserve(measurements.size());
+  // Events in time order: an input at t makes the state at t (when after
+  // the newest), a measurement at t attaches to it or makes it. With rows
+  // at inputs, the row of a state an input made is taken just before the
+  // first later event, so it holds every measurement at its time.
+  const bool at_inputs = rows == RowTimes::Inputs;
+  const auto record = [&] {
+    const StateEstimate e = est->current();
+    out.rows.push_back({e.t, e.mean, e.covariance});
+  };
+  auto feedInputsBefore = [&](double t) {
+    for (; next_input < inputs.size() && inputs[next_input].t < t; ++next_input) {
+      const double ti = std::max(inputs[next_input].t, est->time());
+      if (at_inputs && row_due && ti > est->time()) record();
+      const bool advances = ti > est->time();
+      est->addInput(ti, inputs[next_input].u);
+      if (at_inputs && advances) row_due = true;
+    }
+  };
   for (std::size_t i = first; i < measurements.size(); ++i) {
     const Measurement& m = measurements[i];
-    for (; next_input < inputs.size() && inputs[next_input].t < m.t; ++next_input)
-      est->addInput(std::max(inputs[next_input].t, est->time()), inputs[next_input].u);
+    feedInputsBefore(m.t);
+    if (at_inputs && row_due && m.t > est->time()) {
+      record();
+      row_due = false;
+    }
     const auto t0 = Clock::now();
     est->addMeasurement(m);
     out.update_seconds.push_back(since(t0));
     data_hash = foldMeasurement(data_hash, m);
     if (options.compute_nis) out.nis.push_back(est->report().nis);
-    const StateEstimate e = est->current();
-    out.rows.push_back({e.t, e.mean, e.covariance});
+    const MeasurementChannel& ch = model.channel(m.channel);
+    if (!at_inputs || ch.loss.robust()) {
+      const StateEstimate e = est->current();
+      if (!at_inputs) out.rows.push_back({e.t, e.mean, e.covariance});
+      if (ch.loss.robust() && options.method != Method::Ekf) {
+        const ModelDims& d = model.dims();
+        Eigen::VectorXd r = m.y - model.h(m.channel, e.mean.head(d.nc), e.mean.tail(d.nb));
+        wrapAngles(r, ch.angles);
+        const double s = r.dot((m.R.size() ? m.R : ch.R).ldlt().solve(r));
+        if (ch.loss.weight(s) < 1.0) ++out.downweighted;
+      }
+    }
+    out.rejected = est->report().rejected;
     out.iterations = std::max(out.iterations, est->report().iterations);
-    if (progress && (out.rows.size() % every == 0 || out.rows.size() == measurements.size()))
-      progress(out.rows.size(), measurements.size());
+    if (progress && ((i + 1) % every == 0 || i + 1 == measurements.size())) progress(i + 1, measurements.size());
     if (!checkpoints.path.empty() && (i + 1) % checkpoints.every == 0) {
       out.total_seconds = seconds_before + since(start);
-      saveCheckpoint(*est, checkpoints.path,
-                     encodeRun(out, i + 1, next_input, data_hash));
+      saveCheckpoint(*est, checkpoints.path, encodeRun(out, i + 1, next_input, data_hash, row_due));
     }
   }
+  feedInputsBefore(std::numeric_limits<double>::infinity());  // inputs after the last measurement
+  if (at_inputs && row_due) record();
   out.total_seconds = seconds_before + since(start);
   out.summary = est->report().detail;
   return out;
@@ -149,7 +195,7 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
 
 OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
                     const std::vector<Measurement>& measurements,
-                    const std::vector<Input>& inputs) {
+                    const std::vector<Input>& inputs, RowTimes rows) {
   OfflineRun out;
   out.method = Method::Batch;
   const auto start = Clock::now();
@@ -161,12 +207,19 @@ OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
   out.summary = sum.toString();
   out.update_seconds.push_back(sum.seconds);
   const int nc = model.dims().nc, nb = model.dims().nb;
+  for (const auto& f : p.graph)
+    if (f->loss().robust() && f->weight(x) < 1.0) ++out.downweighted;
   // One row per measurement time (states between measurements, made by
-  // inputs, have no row), as the streaming runs report.
-  std::size_t mi = 0;
+  // inputs, have no row), as the streaming runs report; or one per input time.
+  std::size_t mi = 0, ii = 0;
   for (std::size_t k = 1; k < p.times.size(); ++k) {
-    if (mi >= measurements.size() || measurements[mi].t != p.times[k]) continue;
-    while (mi < measurements.size() && measurements[mi].t == p.times[k]) ++mi;
+    if (rows == RowTimes::Inputs) {
+      while (ii < inputs.size() && inputs[ii].t < p.times[k]) ++ii;
+      if (ii >= inputs.size() || inputs[ii].t != p.times[k]) continue;
+    } else {
+      if (mi >= measurements.size() || measurements[mi].t != p.times[k]) continue;
+      while (mi < measurements.size() && measurements[mi].t == p.times[k]) ++mi;
+    }
     const Key key = Key::state(static_cast<std::int64_t>(k));
     EstimateRow row;
     row.t = p.times[k];
@@ -184,13 +237,13 @@ OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
 OfflineRun runOffline(const Model& model, const EstimatorOptions& options,
                       const std::vector<Measurement>& measurements, const std::vector<Input>& inputs,
                       const std::function<void(std::size_t, std::size_t)>& progress,
-                      const StreamingCheckpoints& checkpoints) {
+                      const StreamingCheckpoints& checkpoints, RowTimes rows) {
   if (methodInfo(options.method).streaming)
-    return runStreaming(model, options, measurements, inputs, progress, checkpoints);
+    return runStreaming(model, options, measurements, inputs, progress, checkpoints, rows);
   if (!checkpoints.path.empty() || !checkpoints.resume_from.empty())
     throw InvalidArgument(std::string("runOffline: checkpoints apply to streaming methods, not '") +
                           methodName(options.method) + "'");
-  return runBatch(model, options, measurements, inputs);
+  return runBatch(model, options, measurements, inputs, rows);
 }
 
 }  // namespace gssm

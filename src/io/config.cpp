@@ -4,6 +4,11 @@
 #include "gssm/models/linear.h"
 #include "gssm/models/nav2d.h"
 #include "gssm/models/radar2d.h"
+#include "gssm/models/range_beacon2d.h"
+#include "gssm/io/csv.h"
+
+#include <cmath>
+#include <filesystem>
 
 namespace gssm::io {
 
@@ -34,6 +39,95 @@ std::unique_ptr<Model> withSource(const IniDocument& ini, Fn make) {
   }
 }
 }  // namespace
+
+// A file named in the INI, relative to the INI's folder.
+std::string besideIni(const IniDocument& ini, const std::string& file) {
+  const std::filesystem::path p(file);
+  if (p.is_absolute()) return file;
+  return (std::filesystem::path(ini.source()).parent_path() / p).string();
+}
+
+RobustLoss readLoss(const IniDocument& ini, const std::string& section) {
+  RobustLoss loss;
+  const std::string kind = ini.getString(section, "loss", "none");
+  bool known = false;
+  for (auto k : {RobustLoss::Kind::None, RobustLoss::Kind::Huber, RobustLoss::Kind::Cauchy, RobustLoss::Kind::Tukey})
+    if (kind == RobustLoss::name(k)) loss.kind = k, known = true;
+  if (!known)
+    throw InputError(ini.source() + ": [" + section + "] loss = '" + kind + "': expected none, huber, cauchy or tukey");
+  loss.scale = ini.getDouble(section, "loss_scale", loss.kind == RobustLoss::Kind::Huber ? 1.345 : 2.5);
+  std::string why;
+  if (!loss.validate(&why)) throw InputError(ini.source() + ": [" + section + "] " + why);
+  return loss;
+}
+
+// [model] beacons of a range-beacon model: a CSV file (beacon,x,y) beside
+// the INI, or inline rows "id x y".
+void readBeacons(const IniDocument& ini, std::vector<int>& ids, std::vector<Eigen::Vector2d>& positions) {
+  const std::string beacons = ini.getString("model", "beacons");
+  if (beacons.find(".csv") == std::string::npos) {
+    const Eigen::MatrixXd B = ini.getMatrix("model", "beacons");
+    if (B.cols() != 3) throw InputError(ini.source() + ": [model] beacons: expected rows of 'id x y' or a CSV file");
+    for (Eigen::Index i = 0; i < B.rows(); ++i) {
+      ids.push_back(static_cast<int>(B(i, 0)));
+      positions.emplace_back(B(i, 1), B(i, 2));
+    }
+    return;
+  }
+  const CsvTable t = readCsv(besideIni(ini, beacons));
+  const int id = t.column("beacon"), x = t.column("x"), y = t.column("y");
+  if (id < 0 || x < 0 || y < 0) throw InputError(t.source + ":1: expected columns beacon,x,y");
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    const double v = t.rows[r][static_cast<std::size_t>(id)];
+    if (v != std::floor(v))
+      throw InputError(t.source + ":" + std::to_string(t.line_of_row[r]) + ": column 'beacon': id must be an integer");
+    ids.push_back(static_cast<int>(v));
+    positions.emplace_back(t.rows[r][static_cast<std::size_t>(x)], t.rows[r][static_cast<std::size_t>(y)]);
+  }
+}
+
+// [model] type = range_beacon_2d: beacons from a CSV file (beacon,x,y) or
+// inline rows "id x y"; [prior] start from the truth file's first row or
+// given.
+std::unique_ptr<Model> makeRangeBeacon2D(const IniDocument& ini) {
+  ini.requireOnlyKeys("model", {"type", "T", "beacons", "range_scale", "range_offsets", "odometry_scale", "range_sd",
+                                "distance_sd", "turn_sd", "heading_drift_sd", "position_sd_per_s", "heading_sd_per_s",
+                                "loss", "loss_scale", "ekf_gate"});
+  ini.requireOnlyKeys("prior", {"start", "position_sd", "heading", "heading_sd", "range_scale_sd", "range_offset_sd",
+                                "odometry_scale_sd"});
+  models::RangeBeacon2D::Params p;
+  p.T = ini.getDouble("model", "T", p.T);
+  readBeacons(ini, p.beacon_ids, p.beacons);
+  p.range_scale = ini.getBool("model", "range_scale", p.range_scale);
+  p.range_offsets = ini.getBool("model", "range_offsets", p.range_offsets);
+  p.odometry_scale = ini.getBool("model", "odometry_scale", p.odometry_scale);
+  p.range_sd = ini.getDouble("model", "range_sd", p.range_sd);
+  p.distance_sd = ini.getDouble("model", "distance_sd", p.distance_sd);
+  p.turn_sd = ini.getDouble("model", "turn_sd", p.turn_sd);
+  p.heading_drift_sd = ini.getDouble("model", "heading_drift_sd", p.heading_drift_sd);
+  p.position_sd_per_s = ini.getDouble("model", "position_sd_per_s", p.position_sd_per_s);
+  p.heading_sd_per_s = ini.getDouble("model", "heading_sd_per_s", p.heading_sd_per_s);
+  p.range_loss = readLoss(ini, "model");
+  p.ekf_gate = ini.getDouble("model", "ekf_gate", 0.0);
+  const std::string start = ini.getString("prior", "start", "0 0");
+  if (start == "truth") {  // the first row of the dataset's truth file
+    const std::string truth = ini.getString("dataset", "truth", "truth.csv");
+    const CsvTable t = readCsv(besideIni(ini, truth));
+    const int px = t.column("px"), py = t.column("py");
+    if (px < 0 || py < 0 || t.rows.empty())
+      throw InputError(t.source + ": [prior] start = truth needs columns px, py and a first row");
+    p.start.head<2>() << t.rows[0][static_cast<std::size_t>(px)], t.rows[0][static_cast<std::size_t>(py)];
+  } else {
+    p.start.head<2>() = ini.getVector("prior", "start", 2);
+  }
+  p.start[2] = ini.getDouble("prior", "heading", 0.0);
+  const double psd = ini.getDouble("prior", "position_sd", 1.0);
+  p.start_sd << psd, psd, ini.getDouble("prior", "heading_sd", M_PI);
+  p.range_scale_sd = ini.getDouble("prior", "range_scale_sd", p.range_scale_sd);
+  p.range_offset_sd = ini.getDouble("prior", "range_offset_sd", p.range_offset_sd);
+  p.odometry_scale_sd = ini.getDouble("prior", "odometry_scale_sd", p.odometry_scale_sd);
+  return withSource(ini, [&] { return std::unique_ptr<Model>(std::make_unique<models::RangeBeacon2D>(p)); });
+}
 
 std::unique_ptr<Model> makeModel(const IniDocument& ini) {
   const std::string type = ini.getString("model", "type");
@@ -85,13 +179,19 @@ std::unique_ptr<Model> makeModel(const IniDocument& ini) {
       return std::unique_ptr<Model>(std::move(m));
     });
   }
+  if (type == "range_beacon_2d") return makeRangeBeacon2D(ini);
   throw InputError(ini.source() + ": [model] type = '" + type +
-                   "': unknown model (known: radar2d, linear, nav2d)");
+                   "': unknown model (known: radar2d, linear, nav2d, range_beacon_2d)");
 }
 
 std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini) {
   std::vector<Eigen::Vector2d> out;
   if (!ini.has("model", "beacons")) return out;
+  if (ini.getString("model", "type") == "range_beacon_2d") {
+    std::vector<int> ids;
+    readBeacons(ini, ids, out);
+    return out;
+  }
   const Eigen::MatrixXd B = ini.getMatrix("model", "beacons");
   if (B.cols() != 2) throw InputError(ini.source() + ": [model] beacons: expected rows of 'x y', one per beacon");
   for (Eigen::Index i = 0; i < B.rows(); ++i) out.emplace_back(B(i, 0), B(i, 1));

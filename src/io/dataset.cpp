@@ -1,7 +1,9 @@
 #include "gssm/io/dataset.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "gssm/core/error.h"
 #include "gssm/io/csv.h"
@@ -41,8 +43,184 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
   return IniDocument::load(path);
 }
 
-void readDatasetData(const std::string& dir, const Model& model, Dataset& out, BadRows bad_rows) {
+namespace {
+std::vector<std::string> words(const std::string& s) {
+  std::vector<std::string> out;
+  std::string w;
+  for (char c : s + " ") {
+    if (c == ' ' || c == '\t' || c == ',') {
+      if (!w.empty()) out.push_back(w);
+      w.clear();
+    } else {
+      w += c;
+    }
+  }
+  return out;
+}
+
+int requireColumn(const CsvTable& t, const std::string& name, const std::string& why) {
+  const int c = t.column(name);
+  if (c < 0) {
+    std::string have;
+    for (const auto& h : t.header) have += (have.empty() ? "" : ",") + h;
+    throw InputError(t.source + ":1: no column '" + name + "' (" + why + "); the header is '" + have + "'");
+  }
+  return c;
+}
+
+void requireIncreasing(const CsvTable& t, std::size_t r, double prev, double now) {
+  if (!(now > prev))
+    throw InputError(t.source + ":" + std::to_string(t.line_of_row[r]) + ": column 't': time " + formatDouble(now) +
+                     (now == prev ? " repeats the previous row's (duplicated timestamp)"
+                                  : " is before the previous row's " + formatDouble(prev)));
+}
+
+// One CSV per sensor stream, as the config's [dataset] describes.
+void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
+  ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
+                                  "channel_column", "channel_prefix", "truth", "truth_columns", "start_time", "rows"});
+  const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
+  // Truth first: it may give t0.
+  out.truth.reset();
+  std::optional<CsvTable> truth;
+  if (ini.has("dataset", "truth")) {
+    truth = readCsv(file("truth"));
+    const int tc = requireColumn(*truth, "t", "the time");
+    Truth tr;
+    const auto names = model.stackedStateNames();
+    std::vector<int> cols;
+    for (const auto& n : words(ini.getString("dataset", "truth_columns"))) {
+      const auto it = std::find(names.begin(), names.end(), n);
+      if (it == names.end())
+        throw InputError(ini.source() + ": [dataset] truth_columns: '" + n + "' is not a state of model '" +
+                         model.name() + "'");
+      tr.components.push_back(static_cast<int>(it - names.begin()));
+      cols.push_back(requireColumn(*truth, n, "[dataset] truth_columns"));
+    }
+    for (std::size_t r = 0; r < truth->rows.size(); ++r) {
+      const double t = truth->rows[r][static_cast<std::size_t>(tc)];
+      if (r) requireIncreasing(*truth, r, tr.times.back(), t);
+      Eigen::VectorXd z(static_cast<Eigen::Index>(cols.size()));
+      for (std::size_t i = 0; i < cols.size(); ++i) z[static_cast<Eigen::Index>(i)] = truth->rows[r][static_cast<std::size_t>(cols[i])];
+      tr.times.push_back(t);
+      tr.states.push_back(std::move(z));
+    }
+    out.truth = std::move(tr);
+  }
+  const std::string start = ini.getString("dataset", "start_time", "0");
+  if (start == "truth") {
+    if (!out.truth || out.truth->times.empty())
+      throw InputError(ini.source() + ": [dataset] start_time = truth, but there is no truth file with rows");
+    out.t0 = out.truth->times.front();
+  } else {
+    out.t0 = ini.getDouble("dataset", "start_time", 0.0);
+  }
+  const std::string rows = ini.getString("dataset", "rows", "measurements");
+  if (rows != "measurements" && rows != "inputs")
+    throw InputError(ini.source() + ": [dataset] rows = '" + rows + "': expected measurements or inputs");
+  out.rows_at_inputs = rows == "inputs";
+
+  // Inputs: rates held from each row's time, or increments over the interval
+  // ending at each row (held from the previous row's time, t0 for the first).
+  out.inputs.clear();
+  if (ini.has("dataset", "inputs")) {
+    const CsvTable in = readCsv(file("inputs"));
+    const int tc = requireColumn(in, "t", "the time");
+    std::vector<int> cols;
+    for (const auto& n : words(ini.getString("dataset", "input_columns")))
+      cols.push_back(requireColumn(in, n, "[dataset] input_columns"));
+    if (static_cast<int>(cols.size()) != model.dims().nu)
+      throw InputError(ini.source() + ": [dataset] input_columns names " + std::to_string(cols.size()) +
+                       " columns; model '" + model.name() + "' has " + std::to_string(model.dims().nu) + " inputs");
+    const std::string kind = ini.getString("dataset", "input_kind", "rates");
+    if (kind != "rates" && kind != "increments")
+      throw InputError(ini.source() + ": [dataset] input_kind = '" + kind + "': expected rates or increments");
+    double prev = out.t0;
+    for (std::size_t r = 0; r < in.rows.size(); ++r) {
+      const double t = in.rows[r][static_cast<std::size_t>(tc)];
+      requireIncreasing(in, r, prev, t);
+      Eigen::VectorXd u(model.dims().nu);
+      for (std::size_t i = 0; i < cols.size(); ++i) u[static_cast<Eigen::Index>(i)] = in.rows[r][static_cast<std::size_t>(cols[i])];
+      if (kind == "increments") {
+        out.inputs.push_back({prev, u / (t - prev)});
+      } else {
+        out.inputs.push_back({t, u});
+      }
+      prev = t;
+    }
+    // Increments: a last zero input makes the state at the last row's time.
+    if (kind == "increments" && !out.inputs.empty()) out.inputs.push_back({prev, Eigen::VectorXd::Zero(model.dims().nu)});
+  }
+
+  // Measurements: one channel per row, named by a column (or the default).
+  out.measurements.clear();
+  out.row_errors.clear();
+  if (ini.has("dataset", "measurements")) {
+    std::vector<CsvRowError> errors;
+    const CsvTable m = readCsv(file("measurements"), bad_rows == BadRows::Throw ? nullptr : &errors);
+    const int tc = requireColumn(m, "t", "the time");
+    std::vector<int> cols;
+    for (const auto& n : words(ini.getString("dataset", "measurement_columns")))
+      cols.push_back(requireColumn(m, n, "[dataset] measurement_columns"));
+    const bool by_column = ini.has("dataset", "channel_column");
+    const int cc = by_column ? requireColumn(m, ini.getString("dataset", "channel_column"), "[dataset] channel_column") : -1;
+    const std::string prefix = ini.getString("dataset", "channel_prefix", "");
+    std::size_t next_error = 0;
+    for (std::size_t r = 0; r < m.rows.size(); ++r) {
+      const int line = m.line_of_row[r];
+      if (bad_rows == BadRows::Stop && next_error < errors.size() && errors[next_error].line < line) break;
+      while (next_error < errors.size() && errors[next_error].line < line) ++next_error;
+      const auto& row = m.rows[r];
+      const double t = row[static_cast<std::size_t>(tc)];
+      std::string problem;
+      int channel = 0;
+      if (by_column) {
+        const double v = row[static_cast<std::size_t>(cc)];
+        const std::string name = prefix + (v == std::floor(v) ? std::to_string(static_cast<long long>(v)) : formatDouble(v));
+        channel = -1;
+        for (int c = 0; c < model.numChannels(); ++c)
+          if (model.channel(c).name == name) channel = c;
+        if (channel < 0)
+          problem = "column '" + m.header[static_cast<std::size_t>(cc)] + "': '" + formatDouble(v) +
+                    "' names channel '" + name + "', which model '" + model.name() + "' does not have";
+      }
+      if (problem.empty() && static_cast<int>(cols.size()) != model.channel(channel).dim())
+        throw InputError(ini.source() + ": [dataset] measurement_columns names " + std::to_string(cols.size()) +
+                         " columns; channel '" + model.channel(channel).name + "' has " +
+                         std::to_string(model.channel(channel).dim()) + " components");
+      if (problem.empty() && !out.measurements.empty() && t < out.measurements.back().t)
+        problem = "column 't': time " + formatDouble(t) + " is before the previous row's " +
+                  formatDouble(out.measurements.back().t);
+      if (problem.empty() && !(t > out.t0))
+        problem = "column 't': time " + formatDouble(t) + " is not after the start " + formatDouble(out.t0);
+      if (!problem.empty()) {
+        const std::string msg = m.source + ":" + std::to_string(line) + ": " + problem;
+        if (bad_rows == BadRows::Throw) throw InputError(msg);
+        errors.insert(errors.begin() + static_cast<long>(next_error), {line, msg});
+        ++next_error;
+        if (bad_rows == BadRows::Stop) break;
+        continue;
+      }
+      Eigen::VectorXd y(static_cast<Eigen::Index>(cols.size()));
+      for (std::size_t i = 0; i < cols.size(); ++i) y[static_cast<Eigen::Index>(i)] = row[static_cast<std::size_t>(cols[i])];
+      out.measurements.push_back({t, y, channel, {}});
+    }
+    std::sort(errors.begin(), errors.end(), [](const CsvRowError& a, const CsvRowError& b) { return a.line < b.line; });
+    for (const auto& e : errors) {
+      out.row_errors.push_back(e.message);
+      if (bad_rows == BadRows::Stop) break;
+    }
+  }
+}
+}  // namespace
+
+void readDatasetData(const std::string& dir, const Model& model, Dataset& out, BadRows bad_rows,
+                     const IniDocument* config) {
   out.dir = dir;
+  if (config && config->hasSection("dataset")) {
+    readStreams(dir, *config, model, out, bad_rows);
+    return;
+  }
   out.row_errors.clear();
   std::vector<CsvRowError> errors;
   const CsvTable m = readCsv((fs::path(dir) / "measurements.csv").string(),

@@ -10,16 +10,18 @@
 namespace gssm {
 
 struct RunErrors {
+  std::vector<int> components;         ///< the stacked components compared (the truth's)
   std::vector<double> times;
-  std::vector<Eigen::VectorXd> error;  ///< estimate − truth (stacked [x_c; x_b]) per row
-  std::vector<double> nees;            ///< eᵀP⁻¹e per row, with the row's covariance P
+  std::vector<Eigen::VectorXd> error;  ///< estimate − truth on those components, angles wrapped, per row
+  std::vector<double> nees;            ///< eᵀP⁻¹e per row, with the row's covariance P of those components
   /// Root mean square over the rows, per stacked state (empty without rows).
   Eigen::VectorXd rmse() const;
 };
 
 /// The error of each row of `run` against the truth row at the same instant
-/// (core/time.h). Throws InvalidArgument naming the first row time that has
-/// no truth row.
-RunErrors runErrors(const OfflineRun& run, const Truth& truth);
+/// (core/time.h), on the components the truth gives; `angles` (stacked
+/// indices, Model::angleStates) are wrapped to (−π, π]. Throws
+/// InvalidArgument naming the first row time that has no truth row.
+RunErrors runErrors(const OfflineRun& run, const Truth& truth, const std::vector<int>& angles = {});
 
 }  // namespace gssm

@@ -30,7 +30,15 @@ struct OfflineRun {
   double total_seconds = 0;
   int iterations = 0;                  ///< solver iterations (batch), 0 for filters
   std::string summary;                 ///< the solver's own report line
+  /// Measurements on robust channels whose weight ρ'(s) was below 1 at the
+  /// estimate after their update (streaming) or at the solution (batch).
+  std::size_t downweighted = 0;
+  std::int64_t rejected = 0;           ///< measurements rejected by an EKF gate
 };
+
+/// Where a run reports its estimates: after each measurement (gssm's own
+/// datasets), or at each state an input makes (a log's odometry steps).
+enum class RowTimes { Measurements, Inputs };
 
 /// Checkpoints of a streaming run (checkpoint.h): each holds the estimator
 /// and the run so far (rows, latencies, NIS), so a resumed run ends with the
@@ -53,14 +61,14 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::vector<Measurement>& measurements,
                         const std::vector<Input>& inputs = {},
                         const std::function<void(std::size_t, std::size_t)>& progress = {},
-                        const StreamingCheckpoints& checkpoints = {});
+                        const StreamingCheckpoints& checkpoints = {}, RowTimes rows = RowTimes::Measurements);
 
 /// The batch MAP of the whole run (from an EKF pass with default options);
 /// rows hold the smoothed estimate at each measurement time with its
 /// marginal covariance.
 OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
                     const std::vector<Measurement>& measurements,
-                    const std::vector<Input>& inputs = {});
+                    const std::vector<Input>& inputs = {}, RowTimes rows = RowTimes::Measurements);
 
 /// options.method over the whole recording: runBatch for the batch,
 /// runStreaming for the others (progress and checkpoints apply to those).
@@ -68,6 +76,6 @@ OfflineRun runOffline(const Model& model, const EstimatorOptions& options,
                       const std::vector<Measurement>& measurements,
                       const std::vector<Input>& inputs = {},
                       const std::function<void(std::size_t, std::size_t)>& progress = {},
-                      const StreamingCheckpoints& checkpoints = {});
+                      const StreamingCheckpoints& checkpoints = {}, RowTimes rows = RowTimes::Measurements);
 
 }  // namespace gssm

@@ -19,10 +19,12 @@ struct Input {
   Eigen::VectorXd u;
 };
 
-/// Ground truth: the stacked state [x_c; x_b] at known times (increasing).
+/// Ground truth: the stacked state [x_c; x_b] at known times (increasing),
+/// or only some of its components (e.g. a log's true position).
 struct Truth {
   std::vector<double> times;
   std::vector<Eigen::VectorXd> states;
+  std::vector<int> components;  ///< the stacked components each row gives, in order; empty: all
 };
 
 }  // namespace gssm

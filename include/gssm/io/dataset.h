@@ -16,6 +16,10 @@ namespace gssm::io {
 
 struct Dataset {
   std::string dir;
+  double t0 = 0;  ///< time of x_c(0)
+  /// One estimate row per input time (a log's odometry steps) instead of
+  /// per measurement.
+  bool rows_at_inputs = false;
   IniDocument scenario;
   std::vector<Measurement> measurements;
   std::vector<Input> inputs;  ///< inputs.csv (t,<input names>), if the model has inputs
@@ -34,10 +38,21 @@ enum class BadRows {
 
 /// Reads scenario.ini (or `config_override` when non-empty).
 IniDocument readScenario(const std::string& dir, const std::string& config_override = "");
-/// Reads measurements.csv and truth.csv (if present) of a model's shape;
-/// checks column names and increasing timestamps, naming file and line.
+/// Reads a dataset of a model's shape, naming file, line and column in
+/// every error. Two layouts:
+/// * gssm's own (no [dataset] section in `config`): measurements.csv
+///   (t,<channel 0 names>), inputs.csv, truth.csv (t,<stacked names>);
+/// * one CSV per sensor stream, described by the config's [dataset]:
+///     inputs = FILE, input_columns = NAMES, input_kind = rates | increments
+///       (increments: each row's change over the interval since the
+///       previous row, turned into rates held over that interval)
+///     measurements = FILE, measurement_columns = NAMES, channel_column =
+///       NAME and channel_prefix = TEXT (channel = prefix + that column's
+///       value; without them the default channel)
+///     truth = FILE, truth_columns = NAMES (stacked components it gives)
+///     start_time = truth | NUMBER (t0), rows = measurements | inputs
 void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
-                     BadRows bad_rows = BadRows::Throw);
+                     BadRows bad_rows = BadRows::Throw, const IniDocument* config = nullptr);
 
 /// The dataset as a run with its truth (true x_c(k) per truth row, x_b from
 /// the first row), for analyses that need the true trajectory. Throws

@@ -1,0 +1,130 @@
+#include "gssm/models/range_beacon2d.h"
+
+#include <cmath>
+
+#include "gssm/core/error.h"
+
+namespace gssm::models {
+
+namespace {
+int countConstants(const RangeBeacon2D::Params& p) {
+  return (p.range_scale ? 1 : 0) + (p.range_offsets ? static_cast<int>(p.beacons.size()) : 0) +
+         (p.odometry_scale ? 1 : 0);
+}
+
+ModelNames beaconNames(const RangeBeacon2D::Params& p) {
+  ModelNames n{{"px", "py", "heading"}, {}, {"v", "omega"}, {}};
+  if (p.range_scale) n.constants.push_back("range_scale");
+  if (p.range_offsets)
+    for (int id : p.beacon_ids) n.constants.push_back("range_offset_" + std::to_string(id));
+  if (p.odometry_scale) n.constants.push_back("odometry_scale");
+  if (!p.beacon_ids.empty()) n.measurement = {"range_" + std::to_string(p.beacon_ids.front())};
+  return n;
+}
+
+ModelNoise beaconNoise(const RangeBeacon2D::Params& p) {
+  if (p.beacons.empty() || p.beacons.size() != p.beacon_ids.size())
+    throw InvalidArgument("RangeBeacon2D: need at least one beacon, with one id per position");
+  ModelNoise n;
+  n.T = p.T;
+  n.Q = Eigen::Vector3d(p.position_sd_per_s * p.position_sd_per_s * p.T, p.position_sd_per_s * p.position_sd_per_s * p.T,
+                        p.heading_sd_per_s * p.heading_sd_per_s * p.T)
+            .asDiagonal();
+  n.R = Eigen::MatrixXd::Constant(1, 1, p.range_sd * p.range_sd);
+  n.prior_state = {p.start, Eigen::MatrixXd(p.start_sd.cwiseAbs2().asDiagonal())};
+  const int nb = countConstants(p);
+  Eigen::VectorXd mean(nb), sd(nb);
+  int i = 0;
+  if (p.range_scale) mean[i] = 1, sd[i++] = p.range_scale_sd;
+  if (p.range_offsets)
+    for (std::size_t b = 0; b < p.beacons.size(); ++b) mean[i] = 0, sd[i++] = p.range_offset_sd;
+  if (p.odometry_scale) mean[i] = 1, sd[i++] = p.odometry_scale_sd;
+  n.prior_constants = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
+  return n;
+}
+}  // namespace
+
+RangeBeacon2D::RangeBeacon2D(const Params& p)
+    : Model({3, countConstants(p), 2, 1}, beaconNames(p), beaconNoise(p)), p_(p) {
+  for (double v : {p.range_sd, p.distance_sd, p.turn_sd, p.heading_drift_sd, p.position_sd_per_s, p.heading_sd_per_s})
+    if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("RangeBeacon2D: every noise σ must be > 0");
+  int i = 0;
+  if (p.range_scale) i_scale_ = i++;
+  if (p.range_offsets) {
+    i_offset_ = i;
+    i += static_cast<int>(p.beacons.size());
+  }
+  if (p.odometry_scale) i_odo_ = i++;
+  std::vector<MeasurementChannel> channels;
+  for (int id : p.beacon_ids) {
+    MeasurementChannel ch;
+    ch.name = "range_" + std::to_string(id);
+    ch.components = {ch.name};
+    ch.R = Eigen::MatrixXd::Constant(1, 1, p.range_sd * p.range_sd);
+    ch.loss = p.range_loss;
+    ch.ekf_gate = p.ekf_gate;
+    channels.push_back(std::move(ch));
+  }
+  setChannels(std::move(channels));
+  setAngleStates({2});
+}
+
+Eigen::VectorXd RangeBeacon2D::f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u,
+                                 double dt, Eigen::MatrixXd* J_f_xc, Eigen::MatrixXd* J_f_xb) const {
+  const double s = i_odo_ >= 0 ? xb[i_odo_] : 1.0;
+  const double d = u[0] * dt, c = std::cos(xc[2]), sn = std::sin(xc[2]);
+  Eigen::VectorXd out(3);
+  out << xc[0] + s * d * c, xc[1] + s * d * sn, xc[2] + u[1] * dt;
+  if (J_f_xc) {
+    *J_f_xc = Eigen::MatrixXd::Identity(3, 3);
+    (*J_f_xc)(0, 2) = -s * d * sn;
+    (*J_f_xc)(1, 2) = s * d * c;
+  }
+  if (J_f_xb) {
+    *J_f_xb = Eigen::MatrixXd::Zero(3, dims().nb);
+    if (i_odo_ >= 0) {
+      (*J_f_xb)(0, i_odo_) = d * c;
+      (*J_f_xb)(1, i_odo_) = d * sn;
+    }
+  }
+  return out;
+}
+
+Eigen::VectorXd RangeBeacon2D::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
+                                 Eigen::MatrixXd* J_h_xb) const {
+  return h(0, xc, xb, J_h_xc, J_h_xb);
+}
+
+Eigen::VectorXd RangeBeacon2D::h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                                 Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  this->channel(channel);  // range check
+  const Eigen::Vector2d delta = xc.head<2>() - p_.beacons[static_cast<std::size_t>(channel)];
+  const double rho = delta.norm();
+  const double s = i_scale_ >= 0 ? xb[i_scale_] : 1.0;
+  const int io = rangeOffsetIndex(static_cast<std::size_t>(channel));
+  const double o = io >= 0 ? xb[io] : 0.0;
+  if (J_h_xc) {
+    *J_h_xc = Eigen::MatrixXd::Zero(1, 3);
+    if (rho > 0) J_h_xc->leftCols(2) = s * delta.transpose() / rho;
+  }
+  if (J_h_xb) {
+    *J_h_xb = Eigen::MatrixXd::Zero(1, dims().nb);
+    if (i_scale_ >= 0) (*J_h_xb)(0, i_scale_) = rho;
+    if (io >= 0) (*J_h_xb)(0, io) = 1.0;
+  }
+  return Eigen::VectorXd::Constant(1, s * rho + o);
+}
+
+Eigen::MatrixXd RangeBeacon2D::processNoise(double dt) const { return processNoiseOf(dt, Eigen::Vector2d::Zero()); }
+
+Eigen::MatrixXd RangeBeacon2D::processNoiseOf(double dt, const Eigen::VectorXd& u) const {
+  // Variances additive in distance, turn and time, so a split step has the
+  // noise of the whole; isotropic in position (no dependence on the heading).
+  const double d = std::abs(u[0]) * dt, a = std::abs(u[1]) * dt;
+  const double pos = p_.distance_sd * p_.distance_sd * d + p_.position_sd_per_s * p_.position_sd_per_s * dt;
+  const double head = p_.turn_sd * p_.turn_sd * a + p_.heading_drift_sd * p_.heading_drift_sd * d +
+                      p_.heading_sd_per_s * p_.heading_sd_per_s * dt;
+  return Eigen::Vector3d(pos, pos, head).asDiagonal();
+}
+
+}  // namespace gssm::models
