@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
         cli.given("checkpoint-every") ? static_cast<std::size_t>(cli.getInt("checkpoint-every", 1, 1000000000)) : 0;
     gssm::io::Dataset ds;
     const bool skip = cli.given("skip-bad-rows");
-    gssm::io::readDatasetData(data, *model, ds, skip ? gssm::io::BadRows::Skip : gssm::io::BadRows::Stop);
+    gssm::io::readDatasetData(data, *model, ds, skip ? gssm::io::BadRows::Skip : gssm::io::BadRows::Stop, &config);
     gssm::io::DatasetStatus status;
     if (skip) status.skipped = ds.row_errors;
     else if (!ds.row_errors.empty()) status = {true, ds.row_errors.front(), {}};
@@ -101,6 +101,8 @@ int main(int argc, char** argv) {
     std::vector<gssm::RunMetrics> metrics;
     std::vector<gssm::OfflineRun> runs;
     gssm::EstimatorOptions options = gssm::io::estimatorOptions(config, *model);
+    options.t0 = ds.t0;
+    const gssm::RowTimes rows = ds.rows_at_inputs ? gssm::RowTimes::Inputs : gssm::RowTimes::Measurements;
     if (cli.given("window"))
       options.fixed_lag.window = options.paper_window.window = static_cast<int>(cli.getInt("window", 1, 1000000));
     for (const gssm::Method method : methods) {
@@ -113,7 +115,7 @@ int main(int argc, char** argv) {
                        checkpoint_every, resume};
       }
       gssm::OfflineRun run =
-          gssm::runOffline(*model, options, ds.measurements, ds.inputs, progress(m), checkpoints);
+          gssm::runOffline(*model, options, ds.measurements, ds.inputs, progress(m), checkpoints, rows);
       writeEstimates((fs::path(out) / ("estimates-" + m + ".csv")).string(), *model, run);
       metrics.push_back(gssm::computeMetrics(*model, run, ds.truth ? &*ds.truth : nullptr));
       const auto& last = run.rows.back();
@@ -132,8 +134,17 @@ int main(int argc, char** argv) {
     std::optional<gssm::plot::PlanView> plan;
     const auto names = model->stackedStateNames();
     const auto px = std::find(names.begin(), names.end(), "px"), py = std::find(names.begin(), names.end(), "py");
-    if (px != names.end() && py != names.end())
-      plan = gssm::plot::PlanView{px - names.begin(), py - names.begin(), gssm::io::landmarks(config), "beacons"};
+    if (px != names.end() && py != names.end()) {
+      plan = gssm::plot::PlanView{px - names.begin(), py - names.begin(), gssm::io::landmarks(config), "beacons", {}};
+      if (rows == gssm::RowTimes::Inputs) {  // dead reckoning: the filter with no measurements
+        gssm::EstimatorOptions dr = options;
+        dr.method = gssm::Method::Ekf;
+        const gssm::OfflineRun odo = gssm::runOffline(*model, dr, {}, ds.inputs, {}, {}, rows);
+        std::vector<Eigen::Vector2d> path;
+        for (const auto& r : odo.rows) path.emplace_back(r.mean[plan->x], r.mean[plan->y]);
+        plan->paths.emplace_back("dead reckoning", std::move(path));
+      }
+    }
     for (const auto& p : gssm::plot::writeRunFigures(*model, runs, ds.truth ? &*ds.truth : nullptr, out, label, plan))
       std::cout << "figure: " << p << "\n";
     std::cout << "gssm-process: wrote " << out << "/metrics.json and estimates-*.csv\n";

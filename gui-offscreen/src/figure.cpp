@@ -154,7 +154,7 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
   yhi += pad;
   if (fig.xlim) xmin = fig.xlim->first, xmax = fig.xlim->second;
   if (fig.ylim) ylo = fig.ylim->first, yhi = fig.ylim->second;
-  const Ticks xt = niceTicks(xmin, xmax, 9), yt = niceTicks(ylo, yhi, 8);
+  Ticks xt = niceTicks(xmin, xmax, 9), yt = niceTicks(ylo, yhi, 8);
   const bool x_tight = !fig.bars.empty() || fig.xlim.has_value();
   Axes ax{0, 0, 0, 0, x_tight ? xmin : xt.lo, x_tight ? xmax : xt.hi, fig.ylim ? ylo : yt.lo,
           fig.ylim ? yhi : yt.hi};
@@ -166,6 +166,17 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
   ax.top = 56;
   ax.right = width - 24;
   ax.bottom = height - 56;
+  if (fig.equal_aspect) {
+    const double ux = (ax.x1 - ax.x0) / (ax.right - ax.left), uy = (ax.y1 - ax.y0) / (ax.bottom - ax.top);
+    const double u = std::max(ux, uy);
+    const double cx = 0.5 * (ax.x0 + ax.x1), cy = 0.5 * (ax.y0 + ax.y1);
+    ax.x0 = cx - 0.5 * u * (ax.right - ax.left);
+    ax.x1 = cx + 0.5 * u * (ax.right - ax.left);
+    ax.y0 = cy - 0.5 * u * (ax.bottom - ax.top);
+    ax.y1 = cy + 0.5 * u * (ax.bottom - ax.top);
+    xt = niceTicks(ax.x0, ax.x1, 9);
+    yt = niceTicks(ax.y0, ax.y1, 8);
+  }
 
   // ---- grid and ticks -------------------------------------------------------
   const TColor grid(225, 225, 225), axis(60, 60, 60), text(30, 30, 30);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "gssm/core/angles.h"
 #include "gssm/core/time.h"
 #include "gssm/plot/figure.h"
 
@@ -11,6 +12,14 @@ namespace gssm::plot {
 
 namespace {
 std::string display(Method method) { return methodInfo(method).label; }
+
+// Column of a stacked component in the truth's rows, or −1 if it has none.
+Eigen::Index truthColumn(const Truth* truth, Eigen::Index stacked) {
+  if (!truth) return -1;
+  if (truth->components.empty()) return stacked;
+  const auto it = std::find(truth->components.begin(), truth->components.end(), static_cast<int>(stacked));
+  return it == truth->components.end() ? -1 : static_cast<Eigen::Index>(it - truth->components.begin());
+}
 }  // namespace
 
 std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
@@ -23,7 +32,8 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto idx = static_cast<Eigen::Index>(i);
     const bool constant = static_cast<int>(i) >= nc;
-    if (!constant && !truth) continue;
+    const Eigen::Index tcol = truthColumn(truth, idx);
+    if (!constant && tcol < 0) continue;  // an error needs the truth of this state
     Figure f;
     f.title = constant ? names[i] + ": estimate and 3-sigma band (" + scenario_label + ")"
                        : names[i] + " error: estimate - truth, with 3-sigma band (" + scenario_label + ")";
@@ -40,9 +50,13 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
         if (!constant) {
           const auto j = match->find(row.t);
           if (!j) continue;  // no truth at this time: no error to draw
-          ref = truth->states[*j][idx];
+          ref = truth->states[*j][tcol];
         }
-        const double v = row.mean[idx] - ref, sd = std::sqrt(row.covariance(idx, idx));
+        double v = row.mean[idx] - ref;
+        if (std::find(model.angleStates().begin(), model.angleStates().end(), static_cast<int>(idx)) !=
+            model.angleStates().end())
+          v = wrapAngle(v);
+        const double sd = std::sqrt(row.covariance(idx, idx));
         s.x.push_back(row.t);
         s.y.push_back(v);
         b.x.push_back(row.t);
@@ -52,9 +66,9 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
       f.bands.push_back(std::move(b));
       f.series.push_back(std::move(s));
     }
-    if (truth && constant) {
+    if (constant && tcol >= 0) {
       Series t{"truth", truth->times, {}, Color{0, 0, 0}, 1, true};
-      for (const auto& z : truth->states) t.y.push_back(z[idx]);
+      for (const auto& z : truth->states) t.y.push_back(z[tcol]);
       f.series.push_back(std::move(t));
     } else if (!constant) {
       f.series.push_back({"zero error", {runs.front().rows.front().t, runs.front().rows.back().t}, {0, 0},
@@ -68,6 +82,7 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
   if (plan) {
     const Eigen::Index ix = plan->x, iy = plan->y;
     Figure f;
+    f.equal_aspect = true;
     f.title = "trajectory, plan view (" + scenario_label + ")";
     f.xlabel = names.at(static_cast<std::size_t>(ix)) + " (m)";
     f.ylabel = names.at(static_cast<std::size_t>(iy)) + " (m)";
@@ -80,13 +95,22 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
       }
       f.series.push_back(std::move(s));
     }
-    if (truth) {
+    const Eigen::Index tx = truthColumn(truth, ix), ty = truthColumn(truth, iy);
+    if (tx >= 0 && ty >= 0) {
       Series t{"truth", {}, {}, Color{0, 0, 0}, 1, true};
       for (const auto& z : truth->states) {
-        t.x.push_back(z[ix]);
-        t.y.push_back(z[iy]);
+        t.x.push_back(z[tx]);
+        t.y.push_back(z[ty]);
       }
       f.series.push_back(std::move(t));
+    }
+    for (const auto& [label, path] : plan->paths) {
+      Series p{label, {}, {}, Color{150, 150, 150}, 1, false};
+      for (const auto& q : path) {
+        p.x.push_back(q.x());
+        p.y.push_back(q.y());
+      }
+      f.series.push_back(std::move(p));
     }
     {
       for (std::size_t b = 0; b < plan->landmarks.size(); ++b) {
@@ -105,6 +129,27 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
     const std::string path = (fs::path(dir) / "fig-trajectory.png").string();
     savePng(f, path);
     written.push_back(path);
+    // The planar position error over time, when the truth has the position.
+    if (tx >= 0 && ty >= 0) {
+      Figure e;
+      e.title = "position error |estimate - truth| (" + scenario_label + ")";
+      e.xlabel = "time t (s)";
+      e.ylabel = "position error (m)";
+      for (std::size_t r = 0; r < runs.size(); ++r) {
+        Series s{display(runs[r].method), {}, {}, paletteColor(r), 2, false};
+        TimeMatcher match(truth->times);
+        for (const auto& row : runs[r].rows) {
+          const auto j = match.find(row.t);
+          if (!j) continue;
+          s.x.push_back(row.t);
+          s.y.push_back(std::hypot(row.mean[ix] - truth->states[*j][tx], row.mean[iy] - truth->states[*j][ty]));
+        }
+        e.series.push_back(std::move(s));
+      }
+      const std::string epath = (fs::path(dir) / "fig-position-error.png").string();
+      savePng(e, epath);
+      written.push_back(epath);
+    }
   }
   std::vector<std::pair<std::string, std::vector<double>>> lat;
   for (const auto& r : runs)

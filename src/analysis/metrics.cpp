@@ -24,16 +24,43 @@ RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth
   RunMetrics m;
   m.method = run.method;
   m.names = model.stackedStateNames();
+  m.constant_names = model.names().constants;
+  m.downweighted = run.downweighted;
+  m.rejected = run.rejected;
+  const int nc = model.dims().nc, nb = model.dims().nb;
+  if (!run.rows.empty() && nb > 0) {
+    m.constants = run.rows.back().mean.tail(nb);
+    m.constants_sd = run.rows.back().covariance.diagonal().tail(nb).cwiseSqrt();
+  }
+  (void)nc;
   m.latency_median = percentile(run.update_seconds, 50);
   m.latency_p99 = percentile(run.update_seconds, 99);
   m.total_seconds = run.total_seconds;
   m.iterations = run.iterations;
   if (!truth || run.rows.empty()) return m;
   m.has_truth = true;
-  const RunErrors errors = runErrors(run, *truth);
+  const RunErrors errors = runErrors(run, *truth, model.angleStates());
+  const auto all = model.stackedStateNames();
+  m.names.clear();
+  for (int c : errors.components) m.names.push_back(all[static_cast<std::size_t>(c)]);
   m.rows = errors.error.size();
   m.rmse = errors.rmse();
   m.final_error = errors.error.back();
+  m.max_abs_error = Eigen::VectorXd::Zero(m.rmse.size());
+  for (const auto& e : errors.error) m.max_abs_error = m.max_abs_error.cwiseMax(e.cwiseAbs());
+  const auto px = std::find(m.names.begin(), m.names.end(), "px"), py = std::find(m.names.begin(), m.names.end(), "py");
+  if (px != m.names.end() && py != m.names.end()) {
+    const auto ix = px - m.names.begin(), iy = py - m.names.begin();
+    double sq = 0, mx = 0, last = 0;
+    for (const auto& e : errors.error) {
+      last = std::hypot(e[ix], e[iy]);
+      sq += last * last;
+      mx = std::max(mx, last);
+    }
+    m.position_rmse = std::sqrt(sq / static_cast<double>(errors.error.size()));
+    m.position_max = mx;
+    m.position_final = last;
+  }
   double nees = 0;
   for (double v : errors.nees) nees += v;
   m.mean_nees = nees / static_cast<double>(m.rows);

@@ -42,7 +42,17 @@ std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& 
       os << "      \"final_error\": " << perState(m.names, m.final_error) << ",\n";
       os << "      \"mean_nees\": " << num(m.mean_nees) << ",\n";
       os << "      \"nees_dof\": " << m.names.size() << ",\n";
+      os << "      \"max_abs_error\": " << perState(m.names, m.max_abs_error) << ",\n";
+      if (std::isfinite(m.position_rmse))
+        os << "      \"position_error_m\": {\"rmse\": " << num(m.position_rmse) << ", \"max\": " << num(m.position_max)
+           << ", \"final\": " << num(m.position_final) << "},\n";
     }
+    if (!m.constant_names.empty() && m.constants.size()) {
+      os << "      \"constants\": " << perState(m.constant_names, m.constants) << ",\n";
+      os << "      \"constants_sd\": " << perState(m.constant_names, m.constants_sd) << ",\n";
+    }
+    os << "      \"downweighted\": " << m.downweighted << ",\n";
+    os << "      \"rejected\": " << m.rejected << ",\n";
     os << "      \"latency_median_s\": " << num(m.latency_median) << ",\n";
     os << "      \"latency_p99_s\": " << num(m.latency_p99) << ",\n";
     os << "      \"total_s\": " << num(m.total_seconds) << ",\n";

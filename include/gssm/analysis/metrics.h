@@ -1,6 +1,7 @@
 #pragma once
 // Accuracy, consistency and timing of one estimator run against the truth.
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -11,11 +12,19 @@ namespace gssm {
 
 struct RunMetrics {
   Method method = Method::Ekf;
-  std::vector<std::string> names;  ///< stacked state names
+  std::vector<std::string> names;  ///< the compared components' names (the truth's; all stacked states by default)
   std::size_t rows = 0;            ///< estimates compared with the truth
-  Eigen::VectorXd rmse;            ///< per stacked state (empty without truth)
+  Eigen::VectorXd rmse;            ///< per compared component (empty without truth)
+  Eigen::VectorXd max_abs_error;   ///< per compared component
   Eigen::VectorXd final_error;     ///< estimate − truth at the last row
-  double mean_nees = 0;            ///< mean of eᵀP⁻¹e over rows (n = n_c + n_b)
+  double mean_nees = 0;            ///< mean of eᵀP⁻¹e over rows (dof: the compared components)
+  /// Planar position error ‖(px, py) − truth‖ when px and py are compared
+  /// (NaN otherwise): RMS, largest, last.
+  double position_rmse = NAN, position_max = NAN, position_final = NAN;
+  std::vector<std::string> constant_names;  ///< x_b's
+  Eigen::VectorXd constants, constants_sd;  ///< at the last row
+  std::size_t downweighted = 0;             ///< see OfflineRun
+  std::int64_t rejected = 0;
   double latency_median = 0, latency_p99 = 0;  ///< per update, seconds
   double total_seconds = 0;
   int iterations = 0;

@@ -47,6 +47,9 @@ struct Figure {
   /// (bands excluded), so a start-up transient does not squash the rest.
   double robust_quantile = 0.01;
   bool legend = true;
+  /// One unit is the same length on both axes (a plan view: a circle stays
+  /// a circle); the shorter range is widened about its centre.
+  bool equal_aspect = false;
 };
 
 /// Draws the figure into a PNG of the given size; throws std::runtime_error

@@ -21,6 +21,8 @@ struct PlanView {
   Eigen::Index x = 0, y = 1;
   std::vector<Eigen::Vector2d> landmarks;
   std::string landmark_label = "beacons";
+  /// Further paths drawn thin and grey (e.g. dead reckoning), with labels.
+  std::vector<std::pair<std::string, std::vector<Eigen::Vector2d>>> paths;
 };
 
 /// Writes fig-<constant>.png, fig-<state>-error.png (with truth),
