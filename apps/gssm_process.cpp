@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
     }
 
     const gssm::io::IniDocument config = gssm::io::readScenario(data, cli.get("config"));
-    const auto model = gssm::io::makeModel(config);
+    const auto model = gssm::io::makeModel(config, data);
     if (!resume.empty()) {
       gssm::CheckpointInfo info;
       gssm::restoreCheckpoint(*model, resume, &info);  // throws a clear error if unusable
@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
     const auto names = model->stackedStateNames();
     const auto px = std::find(names.begin(), names.end(), "px"), py = std::find(names.begin(), names.end(), "py");
     if (px != names.end() && py != names.end()) {
-      plan = gssm::plot::PlanView{px - names.begin(), py - names.begin(), gssm::io::landmarks(config), "beacons", {}};
+      plan = gssm::plot::PlanView{px - names.begin(), py - names.begin(), gssm::io::landmarks(config, data), "beacons", {}};
       if (rows == gssm::RowTimes::Inputs) {  // dead reckoning: the filter with no measurements
         gssm::EstimatorOptions dr = options;
         dr.method = gssm::Method::Ekf;

@@ -40,11 +40,14 @@ std::unique_ptr<Model> withSource(const IniDocument& ini, Fn make) {
 }
 }  // namespace
 
-// A file named in the INI, relative to the INI's folder.
-std::string besideIni(const IniDocument& ini, const std::string& file) {
+// A file named in the INI: in the dataset folder when one is given, else
+// beside the INI.
+std::string dataFile(const IniDocument& ini, const std::string& data_dir, const std::string& file) {
   const std::filesystem::path p(file);
   if (p.is_absolute()) return file;
-  return (std::filesystem::path(ini.source()).parent_path() / p).string();
+  const std::filesystem::path base = data_dir.empty() ? std::filesystem::path(ini.source()).parent_path()
+                                                      : std::filesystem::path(data_dir);
+  return (base / p).string();
 }
 
 RobustLoss readLoss(const IniDocument& ini, const std::string& section) {
@@ -63,7 +66,8 @@ RobustLoss readLoss(const IniDocument& ini, const std::string& section) {
 
 // [model] beacons of a range-beacon model: a CSV file (beacon,x,y) beside
 // the INI, or inline rows "id x y".
-void readBeacons(const IniDocument& ini, std::vector<int>& ids, std::vector<Eigen::Vector2d>& positions) {
+void readBeacons(const IniDocument& ini, const std::string& data_dir, std::vector<int>& ids,
+                 std::vector<Eigen::Vector2d>& positions) {
   const std::string beacons = ini.getString("model", "beacons");
   if (beacons.find(".csv") == std::string::npos) {
     const Eigen::MatrixXd B = ini.getMatrix("model", "beacons");
@@ -74,7 +78,7 @@ void readBeacons(const IniDocument& ini, std::vector<int>& ids, std::vector<Eige
     }
     return;
   }
-  const CsvTable t = readCsv(besideIni(ini, beacons));
+  const CsvTable t = readCsv(dataFile(ini, data_dir, beacons));
   const int id = t.column("beacon"), x = t.column("x"), y = t.column("y");
   if (id < 0 || x < 0 || y < 0) throw InputError(t.source + ":1: expected columns beacon,x,y");
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
@@ -89,7 +93,7 @@ void readBeacons(const IniDocument& ini, std::vector<int>& ids, std::vector<Eige
 // [model] type = range_beacon_2d: beacons from a CSV file (beacon,x,y) or
 // inline rows "id x y"; [prior] start from the truth file's first row or
 // given.
-std::unique_ptr<Model> makeRangeBeacon2D(const IniDocument& ini) {
+std::unique_ptr<Model> makeRangeBeacon2D(const IniDocument& ini, const std::string& data_dir) {
   ini.requireOnlyKeys("model", {"type", "T", "beacons", "range_scale", "range_offsets", "odometry_scale", "range_sd",
                                 "distance_sd", "turn_sd", "heading_drift_sd", "position_sd_per_s", "heading_sd_per_s",
                                 "loss", "loss_scale", "ekf_gate"});
@@ -97,7 +101,7 @@ std::unique_ptr<Model> makeRangeBeacon2D(const IniDocument& ini) {
                                 "odometry_scale_sd"});
   models::RangeBeacon2D::Params p;
   p.T = ini.getDouble("model", "T", p.T);
-  readBeacons(ini, p.beacon_ids, p.beacons);
+  readBeacons(ini, data_dir, p.beacon_ids, p.beacons);
   p.range_scale = ini.getBool("model", "range_scale", p.range_scale);
   p.range_offsets = ini.getBool("model", "range_offsets", p.range_offsets);
   p.odometry_scale = ini.getBool("model", "odometry_scale", p.odometry_scale);
@@ -112,7 +116,7 @@ std::unique_ptr<Model> makeRangeBeacon2D(const IniDocument& ini) {
   const std::string start = ini.getString("prior", "start", "0 0");
   if (start == "truth") {  // the first row of the dataset's truth file
     const std::string truth = ini.getString("dataset", "truth", "truth.csv");
-    const CsvTable t = readCsv(besideIni(ini, truth));
+    const CsvTable t = readCsv(dataFile(ini, data_dir, truth));
     const int px = t.column("px"), py = t.column("py");
     if (px < 0 || py < 0 || t.rows.empty())
       throw InputError(t.source + ": [prior] start = truth needs columns px, py and a first row");
@@ -129,7 +133,7 @@ std::unique_ptr<Model> makeRangeBeacon2D(const IniDocument& ini) {
   return withSource(ini, [&] { return std::unique_ptr<Model>(std::make_unique<models::RangeBeacon2D>(p)); });
 }
 
-std::unique_ptr<Model> makeModel(const IniDocument& ini) {
+std::unique_ptr<Model> makeModel(const IniDocument& ini, const std::string& data_dir) {
   const std::string type = ini.getString("model", "type");
   if (type == "radar2d") {
     ini.requireOnlyKeys("model", {"type", "T", "Q", "R"});
@@ -179,17 +183,17 @@ std::unique_ptr<Model> makeModel(const IniDocument& ini) {
       return std::unique_ptr<Model>(std::move(m));
     });
   }
-  if (type == "range_beacon_2d") return makeRangeBeacon2D(ini);
+  if (type == "range_beacon_2d") return makeRangeBeacon2D(ini, data_dir);
   throw InputError(ini.source() + ": [model] type = '" + type +
                    "': unknown model (known: radar2d, linear, nav2d, range_beacon_2d)");
 }
 
-std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini) {
+std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini, const std::string& data_dir) {
   std::vector<Eigen::Vector2d> out;
   if (!ini.has("model", "beacons")) return out;
   if (ini.getString("model", "type") == "range_beacon_2d") {
     std::vector<int> ids;
-    readBeacons(ini, ids, out);
+    readBeacons(ini, data_dir, ids, out);
     return out;
   }
   const Eigen::MatrixXd B = ini.getMatrix("model", "beacons");

@@ -23,10 +23,13 @@ namespace gssm::io {
 
 /// Builds the model described by [model] and [prior]. Throws InputError
 /// naming file, line and key for an unknown type or a bad value.
-std::unique_ptr<Model> makeModel(const IniDocument& ini);
+/// Files the INI names (a range-beacon model's beacons.csv, the truth file
+/// its start position comes from) are read from `data_dir` when given, else
+/// from the INI's folder.
+std::unique_ptr<Model> makeModel(const IniDocument& ini, const std::string& data_dir = "");
 /// Positions of the model's landmarks ([model] beacons, rows of "x y");
 /// empty if it has none.
-std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini);
+std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini, const std::string& data_dir = "");
 /// Writes a model's [model] and [prior] sections (radar2d and linear).
 void writeModel(const Model& model, IniDocument& ini);
 
