@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
     const int window = static_cast<int>(cli.getInt("window", 1, 100000));
     loaded.scenario.options.fixed_lag.window = loaded.scenario.options.paper_window.window = window;
     gssm::io::Dataset ds;
-    gssm::io::readDatasetData(data, *loaded.truth, ds);
+    gssm::io::readDatasetData(data, *loaded.truth, ds, gssm::io::BadRows::Throw, &scenario);
     gssm::MonteCarloOptions o;
     o.seeds = static_cast<int>(cli.getInt("runs", 2, 100000));
     o.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

@@ -112,7 +112,7 @@ MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCa
           eo.compute_nis = true;
           const OfflineRun out = runOffline(estimator_model, eo, run.measurements, run.inputs);
           r.nis = out.nis;
-          const RunErrors errors = runErrors(out, truth);
+          const RunErrors errors = runErrors(out, truth, estimator_model.angleStates());
           for (const auto& e : errors.error) r.sq.push_back(e.cwiseAbs2());
           r.nees = errors.nees;
           r.rmse = errors.rmse();

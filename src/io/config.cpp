@@ -204,6 +204,34 @@ std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini, const std::string
 
 void writeModel(const Model& model, IniDocument& ini) {
   ini.set("model", "type", model.name());
+  if (const auto* rb = dynamic_cast<const models::RangeBeacon2D*>(&model)) {
+    const auto& p = rb->params();
+    Eigen::MatrixXd B(static_cast<Eigen::Index>(p.beacons.size()), 3);
+    for (std::size_t i = 0; i < p.beacons.size(); ++i)
+      B.row(static_cast<Eigen::Index>(i)) << p.beacon_ids[i], p.beacons[i].x(), p.beacons[i].y();
+    ini.set("model", "T", p.T);
+    ini.set("model", "beacons", B);
+    ini.set("model", "range_scale", p.range_scale ? "true" : "false");
+    ini.set("model", "range_offsets", p.range_offsets ? "true" : "false");
+    ini.set("model", "odometry_scale", p.odometry_scale ? "true" : "false");
+    ini.set("model", "range_sd", p.range_sd);
+    ini.set("model", "distance_sd", p.distance_sd);
+    ini.set("model", "turn_sd", p.turn_sd);
+    ini.set("model", "heading_drift_sd", p.heading_drift_sd);
+    ini.set("model", "position_sd_per_s", p.position_sd_per_s);
+    ini.set("model", "heading_sd_per_s", p.heading_sd_per_s);
+    ini.set("model", "loss", RobustLoss::name(p.range_loss.kind));
+    ini.set("model", "loss_scale", p.range_loss.scale);
+    ini.set("model", "ekf_gate", p.ekf_gate);
+    ini.set("prior", "start", Eigen::MatrixXd(p.start.head<2>().transpose()));
+    ini.set("prior", "position_sd", p.start_sd[0]);
+    ini.set("prior", "heading", p.start[2]);
+    ini.set("prior", "heading_sd", p.start_sd[2]);
+    ini.set("prior", "range_scale_sd", p.range_scale_sd);
+    ini.set("prior", "range_offset_sd", p.range_offset_sd);
+    ini.set("prior", "odometry_scale_sd", p.odometry_scale_sd);
+    return;
+  }
   if (const auto* lin = dynamic_cast<const models::LinearModel*>(&model)) {
     const auto& s = lin->system();
     ini.set("model", "A_c", s.A_c);
@@ -324,6 +352,19 @@ SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {
   s.measurement_noise = ini.getBool("truth", "measurement_noise", true);
   s.measure_every = static_cast<int>(ini.getInt("scenario", "measure_every", 1));
   if (s.measure_every < 1) throw InputError(ini.source() + ": [scenario] measure_every must be >= 1");
+  // Several sensors taking turns: "cycle" = every channel of the model in turn.
+  const std::string channels = ini.getString("scenario", "channels", "default");
+  if (channels == "cycle") {
+    s.channels.clear();
+    for (int c = 0; c < model.numChannels(); ++c) s.channels.push_back(c);
+  } else if (channels != "default") {
+    throw InputError(ini.source() + ": [scenario] channels = '" + channels + "': expected default or cycle");
+  }
+  // A constant measured input (odometry speed and turn rate: a circle).
+  if (ini.has("truth", "input")) {
+    const Eigen::VectorXd u = ini.getVector("truth", "input", model.dims().nu);
+    s.input = [u](double, const Eigen::VectorXd&) { return u; };
+  }
   // Input profile: true acceleration a(t) = amplitude·(cos ωt, sin ωt) (a
   // turning vehicle); an accelerometer measures a + b_a, the first n_u
   // constants being its bias (Nav2D).
@@ -358,13 +399,46 @@ LoadedScenario loadScenario(const IniDocument& scenario, const IniDocument* esti
   return out;
 }
 
-std::vector<std::string> scenarioNames() { return {"paper", "consistent", "nav-paper-like", "nav-consistent"}; }
+std::vector<std::string> scenarioNames() {
+  return {"paper", "consistent", "nav-paper-like", "nav-consistent", "beacons-plaza-like", "beacons-consistent"};
+}
 
 IniDocument builtinScenario(const std::string& name, unsigned seed, int steps) {
   IniDocument ini;
   ini.set("scenario", "name", name);
   ini.set("scenario", "seed", std::to_string(seed));
   ini.set("scenario", "steps", std::to_string(steps));
+  if (name.rfind("beacons-", 0) == 0) {
+    // The Plaza logs' kind, simulated: a vehicle circling (3 m/s, 0.1 rad/s)
+    // inside four beacons, odometry at 10 Hz, a range every 2nd step, the
+    // beacons in turn, ranges 7% long.
+    models::RangeBeacon2D::Params p;
+    p.beacon_ids = {0, 1, 5, 6};
+    p.beacons = {{-33.6, 27.0}, {-68.9, 18.4}, {1.7, -5.8}, {-37.6, 69.2}};
+    p.start = Eigen::Vector3d(-34, 55, 0);
+    p.start_sd = Eigen::Vector3d(1, 1, 0.5);
+    p.range_sd = 0.5;
+    const models::RangeBeacon2D rb(p);
+    writeModel(rb, ini);
+    ini.set("scenario", "measure_every", "2");
+    ini.set("scenario", "channels", "cycle");
+    ini.set("truth", "input", Eigen::MatrixXd(Eigen::RowVector2d(3.0, 0.1)));
+    ini.set("truth", "measurement_noise", "true");
+    if (name == "beacons-plaza-like") {
+      ini.setComment("scenario",
+                     "RangeBeacon2D like the CMU Plaza logs: ranges 7% long (range scale 1.07, 0.7 prior sd\n"
+                     "from its mean 1), heading 0.3 rad off the prior mean; no process noise in the truth.");
+      ini.set("truth", "state0", Eigen::MatrixXd(Eigen::RowVector3d(-34, 55, 0.3)));
+      ini.set("truth", "constants", Eigen::MatrixXd::Constant(1, 1, 1.07));
+      ini.set("truth", "process_noise", "false");
+    } else if (name == "beacons-consistent") {
+      ini.setComment("scenario", "RangeBeacon2D with the truth drawn from the estimators' own prior and noise models.");
+      ini.set("truth", "process_noise", "true");
+    } else {
+      throw InvalidArgument("unknown scenario '" + name + "'");
+    }
+    return ini;
+  }
   if (name.rfind("nav-", 0) == 0) {
     const models::Nav2D nav;
     writeModel(nav, ini);

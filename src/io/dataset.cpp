@@ -78,7 +78,8 @@ void requireIncreasing(const CsvTable& t, std::size_t r, double prev, double now
 // One CSV per sensor stream, as the config's [dataset] describes.
 void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
   ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
-                                  "channel_column", "channel_prefix", "truth", "truth_columns", "start_time", "rows"});
+                                  "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
+                                  "start_time", "rows"});
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   // Truth first: it may give t0.
   out.truth.reset();
@@ -138,7 +139,7 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
     double prev = out.t0;
     for (std::size_t r = 0; r < in.rows.size(); ++r) {
       const double t = in.rows[r][static_cast<std::size_t>(tc)];
-      requireIncreasing(in, r, prev, t);
+      if (r > 0 || kind == "increments" || t < prev) requireIncreasing(in, r, prev, t);  // rates may start at t0
       Eigen::VectorXd u(model.dims().nu);
       for (std::size_t i = 0; i < cols.size(); ++i) u[static_cast<Eigen::Index>(i)] = in.rows[r][static_cast<std::size_t>(cols[i])];
       if (kind == "increments") {
@@ -165,6 +166,9 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
     const bool by_column = ini.has("dataset", "channel_column");
     const int cc = by_column ? requireColumn(m, ini.getString("dataset", "channel_column"), "[dataset] channel_column") : -1;
     const std::string prefix = ini.getString("dataset", "channel_prefix", "");
+    const std::string by = ini.getString("dataset", "channel_by", "name");
+    if (by != "name" && by != "index")
+      throw InputError(ini.source() + ": [dataset] channel_by = '" + by + "': expected name or index");
     std::size_t next_error = 0;
     for (std::size_t r = 0; r < m.rows.size(); ++r) {
       const int line = m.line_of_row[r];
@@ -176,10 +180,12 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
       int channel = 0;
       if (by_column) {
         const double v = row[static_cast<std::size_t>(cc)];
-        const std::string name = prefix + (v == std::floor(v) ? std::to_string(static_cast<long long>(v)) : formatDouble(v));
+        const std::string name =
+            by == "index" ? "number " + formatDouble(v)
+                          : prefix + (v == std::floor(v) ? std::to_string(static_cast<long long>(v)) : formatDouble(v));
         channel = -1;
         for (int c = 0; c < model.numChannels(); ++c)
-          if (model.channel(c).name == name) channel = c;
+          if (by == "index" ? v == c : model.channel(c).name == name) channel = c;
         if (channel < 0)
           problem = "column '" + m.header[static_cast<std::size_t>(cc)] + "': '" + formatDouble(v) +
                     "' names channel '" + name + "', which model '" + model.name() + "' does not have";
@@ -294,15 +300,50 @@ SimulatedRun recordedRun(const Model& model, const Dataset& ds) {
 }
 
 void writeDataset(const std::string& dir, const Model& model, const SimulatedRun& run,
-                  const IniDocument& scenario) {
+                  const IniDocument& scenario_in) {
   fs::create_directories(dir);
+  IniDocument scenario = scenario_in;
   std::vector<std::string> mh{"t"};
-  for (const auto& n : model.names().measurement) mh.push_back(n);
   std::vector<std::vector<double>> rows;
-  for (const auto& m : run.measurements) {
-    std::vector<double> r{m.t};
-    r.insert(r.end(), m.y.data(), m.y.data() + m.y.size());
-    rows.push_back(std::move(r));
+  if (model.numChannels() > 1) {
+    // Several channels: one row per measurement with its channel's index,
+    // described by a [dataset] section (channels of one dimension).
+    const int dim = model.channel(0).dim();
+    for (int c = 0; c < model.numChannels(); ++c)
+      if (model.channel(c).dim() != dim)
+        throw InvalidArgument("writeDataset: channels of different dimensions need one file each");
+    mh.push_back("channel");
+    std::string cols;
+    for (int i = 1; i <= dim; ++i) {
+      mh.push_back("y" + std::to_string(i));
+      cols += (i > 1 ? " y" : "y") + std::to_string(i);
+    }
+    for (const auto& m : run.measurements) {
+      std::vector<double> r{m.t, static_cast<double>(m.channel)};
+      r.insert(r.end(), m.y.data(), m.y.data() + m.y.size());
+      rows.push_back(std::move(r));
+    }
+    std::string inputs, truth;
+    for (const auto& n : model.names().input) inputs += (inputs.empty() ? "" : " ") + n;
+    for (const auto& n : model.stackedStateNames()) truth += (truth.empty() ? "" : " ") + n;
+    scenario.set("dataset", "measurements", "measurements.csv");
+    scenario.set("dataset", "measurement_columns", cols);
+    scenario.set("dataset", "channel_column", "channel");
+    scenario.set("dataset", "channel_by", "index");
+    if (!run.inputs.empty()) {
+      scenario.set("dataset", "inputs", "inputs.csv");
+      scenario.set("dataset", "input_columns", inputs);
+      scenario.set("dataset", "input_kind", "rates");
+    }
+    scenario.set("dataset", "truth", "truth.csv");
+    scenario.set("dataset", "truth_columns", truth);
+  } else {
+    for (const auto& n : model.names().measurement) mh.push_back(n);
+    for (const auto& m : run.measurements) {
+      std::vector<double> r{m.t};
+      r.insert(r.end(), m.y.data(), m.y.data() + m.y.size());
+      rows.push_back(std::move(r));
+    }
   }
   writeCsv((fs::path(dir) / "measurements.csv").string(), mh, rows);
 

@@ -2,6 +2,7 @@
 // Time-stamped inputs and measurements as they arrive from sensors, and the
 // true trajectory of a recorded or simulated run.
 #include <Eigen/Core>
+#include <utility>
 #include <vector>
 
 namespace gssm {
@@ -11,6 +12,10 @@ struct Measurement {
   Eigen::VectorXd y;
   int channel = 0;    ///< the model's measurement channel (0: the default)
   Eigen::MatrixXd R;  ///< this measurement's own noise covariance; empty: the channel's
+
+  Measurement() = default;
+  Measurement(double t_, Eigen::VectorXd y_, int channel_ = 0, Eigen::MatrixXd R_ = {})
+      : t(t_), y(std::move(y_)), channel(channel_), R(std::move(R_)) {}
 };
 
 /// An input u held constant from time t until the next input (zero-order hold).

@@ -48,7 +48,8 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
 ///       previous row, turned into rates held over that interval)
 ///     measurements = FILE, measurement_columns = NAMES, channel_column =
 ///       NAME and channel_prefix = TEXT (channel = prefix + that column's
-///       value; without them the default channel)
+///       value; channel_by = index: the column holds the channel's index;
+///       without channel_column the default channel)
 ///     truth = FILE, truth_columns = NAMES (stacked components it gives)
 ///     start_time = truth | NUMBER (t0), rows = measurements | inputs
 void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
@@ -59,7 +60,9 @@ void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
 /// InputError when the dataset has no truth.csv.
 SimulatedRun recordedRun(const Model& model, const Dataset& dataset);
 
-/// Writes measurements.csv, truth.csv and scenario.ini.
+/// Writes measurements.csv, truth.csv (inputs.csv) and scenario.ini; for a
+/// model with several channels, measurements.csv has a channel column and
+/// scenario.ini a [dataset] section describing the files.
 void writeDataset(const std::string& dir, const Model& model, const SimulatedRun& run,
                   const IniDocument& scenario);
 
