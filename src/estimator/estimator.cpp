@@ -199,8 +199,10 @@ void Estimator::addMeasurement(const Measurement& m) {
                           std::to_string(m.channel) + "; model '" + model_.name() + "' has " +
                           std::to_string(model_.numChannels()));
   const MeasurementChannel& ch = model_.channel(m.channel);
-  const std::string what = model_.numChannels() == 1 ? "measurement y" : "measurement on channel '" + ch.name + "'";
-  requireVector(m.y, ch.dim(), std::string(methodName()) + ": " + what + " at t = " + std::to_string(t));
+  if (!validVector(m.y, ch.dim())) {
+    const std::string what = model_.numChannels() == 1 ? "measurement y" : "measurement on channel '" + ch.name + "'";
+    requireVector(m.y, ch.dim(), std::string(methodName()) + ": " + what + " at t = " + std::to_string(t));
+  }
   if (m.R.size())
     requireCovariance(m.R, ch.dim(), std::string(methodName()) + ": own noise covariance of the measurement at t = " +
                                          std::to_string(t));

@@ -138,7 +138,8 @@ MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const E
       channel_(channel),
       noise_(noise) {
   const MeasurementChannel& ch = model.channel(channel);
-  requireVector(y, ch.dim(), "measurement on channel '" + ch.name + "' at step " + std::to_string(k));
+  if (!validVector(y, ch.dim()))
+    requireVector(y, ch.dim(), "measurement on channel '" + ch.name + "' at step " + std::to_string(k));
   if (noise.dim() != ch.dim())
     throw InvalidArgument("measurement on channel '" + ch.name + "' at step " + std::to_string(k) +
                           ": its noise covariance is " + std::to_string(noise.dim()) + " x " +

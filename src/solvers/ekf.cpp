@@ -76,7 +76,8 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   const ModelDims& d = model_->dims();
   const MeasurementChannel& ch = model_->channel(m.channel);
   const Eigen::VectorXd& y = m.y;
-  requireVector(y, ch.dim(), "ExtendedKalmanFilter::update: measurement on channel '" + ch.name + "'");
+  if (!validVector(y, ch.dim()))
+    requireVector(y, ch.dim(), "ExtendedKalmanFilter::update: measurement on channel '" + ch.name + "'");
   if (m.R.size()) requireCovariance(m.R, ch.dim(), "ExtendedKalmanFilter::update: the measurement's own R");
   Eigen::MatrixXd J_h_xc, J_h_xb;
   const Eigen::VectorXd yhat = model_->h(m.channel, z_.head(d.nc), z_.tail(d.nb), &J_h_xc, &J_h_xb);

@@ -12,6 +12,9 @@ void requireCovariance(const Eigen::MatrixXd& m, Eigen::Index n, const std::stri
 /// Throws InvalidArgument mentioning `what` if `v` has the wrong size or a
 /// non-finite entry.
 void requireVector(const Eigen::VectorXd& v, Eigen::Index n, const std::string& what);
+/// What requireVector accepts; hot paths test this first and build their
+/// message only when it fails.
+inline bool validVector(const Eigen::VectorXd& v, Eigen::Index n) { return v.size() == n && v.allFinite(); }
 
 /// A zero-mean Gaussian N(0, Σ), Σ = L Lᵀ. whiten(v) = L⁻¹ v, so that
 /// ‖whiten(v)‖² is the squared Mahalanobis norm vᵀ Σ⁻¹ v.
