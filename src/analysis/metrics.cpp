@@ -27,12 +27,11 @@ RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth
   m.constant_names = model.names().constants;
   m.downweighted = run.downweighted;
   m.rejected = run.rejected;
-  const int nc = model.dims().nc, nb = model.dims().nb;
+  const int nb = model.dims().nb;
   if (!run.rows.empty() && nb > 0) {
     m.constants = run.rows.back().mean.tail(nb);
     m.constants_sd = run.rows.back().covariance.diagonal().tail(nb).cwiseSqrt();
   }
-  (void)nc;
   m.latency_median = percentile(run.update_seconds, 50);
   m.latency_p99 = percentile(run.update_seconds, 99);
   m.total_seconds = run.total_seconds;
