@@ -1,6 +1,7 @@
 #include "linear/sparse_cholesky.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <numeric>
 
@@ -34,6 +35,8 @@ void SparseCholesky::reset(Eigen::Index n, std::size_t capacity) {
   freeAll();
   n_ = n;
   count_ = 0;
+  dense_ = n <= kDenseMax;
+  factored_ = false;
   triplet_ = cholmod_allocate_triplet(n, n, std::max<std::size_t>(capacity, 1), 1, CHOLMOD_REAL,
                                       &common_);
   if (!triplet_) throw NumericalError("CHOLMOD could not allocate the system matrix");
@@ -54,6 +57,27 @@ void SparseCholesky::add(Eigen::Index i, Eigen::Index j, double v) {
 double& SparseCholesky::value(std::size_t e) { return static_cast<double*>(triplet_->x)[e]; }
 
 Eigen::Index SparseCholesky::factorize() {
+  if (dense_) {
+    // H from its upper-triangle triplets (duplicates summed), then a plain
+    // column Cholesky that reports the first column that is not positive.
+    Eigen::MatrixXd& L = L_;
+    L.setZero(n_, n_);
+    const int* Ti = static_cast<const int*>(triplet_->i);
+    const int* Tj = static_cast<const int*>(triplet_->j);
+    const double* Tx = static_cast<const double*>(triplet_->x);
+    for (std::size_t e = 0; e < count_; ++e) L(Tj[e], Ti[e]) += Tx[e];  // lower triangle: L(j, i), i <= j
+    factored_ = false;
+    for (Eigen::Index j = 0; j < n_; ++j) {
+      const double d = L(j, j) - L.row(j).head(j).squaredNorm();
+      if (!(d > 0) || !std::isfinite(d)) return j;
+      const double ljj = std::sqrt(d);
+      L(j, j) = ljj;
+      for (Eigen::Index i = j + 1; i < n_; ++i)
+        L(i, j) = (L(i, j) - L.row(i).head(j).dot(L.row(j).head(j))) / ljj;
+    }
+    factored_ = true;
+    return -1;
+  }
   if (!matrix_ || slot_.size() != count_) {
     // First factorization of this pattern: let CHOLMOD assemble (sort, sum
     // duplicates), then record where each triplet entry landed.
@@ -88,6 +112,12 @@ Eigen::Index SparseCholesky::factorize() {
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& B) {
+  if (dense_) {
+    if (!factored_) throw NumericalError("solve: nothing factored");
+    Eigen::MatrixXd Y = L_.triangularView<Eigen::Lower>().solve(B);
+    L_.transpose().triangularView<Eigen::Upper>().solveInPlace(Y);
+    return Y;
+  }
   cholmod_dense* b = cholmod_allocate_dense(B.rows(), B.cols(), B.rows(), CHOLMOD_REAL, &common_);
   std::memcpy(b->x, B.data(), sizeof(double) * B.size());
   cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor_, b, &common_);
@@ -109,6 +139,21 @@ bool SparseCholesky::SelectedInverse::lookup(Eigen::Index i, Eigen::Index j, dou
 }
 
 SparseCholesky::SelectedInverse SparseCholesky::selectedInverse() const {
+  if (dense_) {  // the whole inverse: every entry is "on the pattern"
+    if (!factored_) throw NumericalError("selectedInverse: nothing factored");
+    const Eigen::MatrixXd Linv = L_.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(n_, n_));
+    const Eigen::MatrixXd Hinv = Linv.transpose() * Linv;
+    SelectedInverse S;
+    S.colptr.assign(static_cast<std::size_t>(n_) + 1, 0);
+    for (Eigen::Index j = 0; j < n_; ++j) {
+      S.colptr[static_cast<std::size_t>(j) + 1] = S.colptr[static_cast<std::size_t>(j)] + static_cast<int>(n_ - j);
+      for (Eigen::Index i = j; i < n_; ++i) {
+        S.rows.push_back(static_cast<int>(i));
+        S.values.push_back(Hinv(i, j));
+      }
+    }
+    return S;
+  }
   if (!factor_) throw NumericalError("selectedInverse: nothing factored");
   cholmod_common& c = const_cast<cholmod_common&>(common_);
   // A simplicial LDLᵀ copy (unit L, D) of the factor, with sorted rows.

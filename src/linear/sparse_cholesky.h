@@ -2,7 +2,10 @@
 // Internal: a symmetric positive-definite sparse system H x = b factored by
 // CHOLMOD (supernodal LLᵀ, so an indefinite or singular H is detected and
 // the failing column reported). H is given by its upper triangle as
-// triplets whose pattern is fixed after the first analyze().
+// triplets whose pattern is fixed after the first analyze(). Systems of at
+// most kDenseMax unknowns (a paper window, a start-up batch) are factored
+// densely instead: CHOLMOD's symbolic analysis and supernodal machinery cost
+// far more than a 34 × 34 Cholesky.
 #include <Eigen/Core>
 #include <cholmod.h>
 #include <vector>
@@ -11,6 +14,7 @@ namespace gssm::internal {
 
 class SparseCholesky {
  public:
+  static constexpr Eigen::Index kDenseMax = 64;
   SparseCholesky();
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
@@ -56,6 +60,9 @@ class SparseCholesky {
   std::vector<int> slot_;
   Eigen::Index n_ = 0;
   std::size_t count_ = 0;
+  bool dense_ = false;
+  Eigen::MatrixXd L_;  // dense path: the lower Cholesky factor
+  bool factored_ = false;
 };
 
 }  // namespace gssm::internal

@@ -1,0 +1,69 @@
+// The internal factorization: the dense path (≤ kDenseMax unknowns) and the
+// CHOLMOD path give the solution, the selected inverse and the failing
+// column of a dense Eigen reference.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+#include "linear/sparse_cholesky.h"
+
+using gssm::internal::SparseCholesky;
+
+namespace {
+// A banded SPD matrix with a dense border (the GSSM's shape), given to the
+// factorization as upper-triangle triplets with every entry split in two
+// (duplicates must be summed).
+Eigen::MatrixXd fill(SparseCholesky& c, Eigen::Index n, unsigned seed, Eigen::Index indefinite_at = -1) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i <= j; ++i)
+      if (j - i <= 2 || j >= n - 2) H(i, j) = H(j, i) = (i == j ? 8.0 : u(rng));
+  if (indefinite_at >= 0) H(indefinite_at, indefinite_at) = -1.0;
+  std::size_t nnz = 0;
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i <= j; ++i) nnz += H(i, j) != 0 ? 2 : 0;
+  c.reset(n, nnz);
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i <= j; ++i)
+      if (H(i, j) != 0) {
+        c.add(i, j, 0.25 * H(i, j));
+        c.add(i, j, 0.75 * H(i, j));
+      }
+  return H;
+}
+}  // namespace
+
+TEST(SparseCholesky, DenseAndSparsePathsEqualADenseReference) {
+  for (const Eigen::Index n : {Eigen::Index(12), SparseCholesky::kDenseMax, SparseCholesky::kDenseMax + 1,
+                               Eigen::Index(150)}) {
+    SparseCholesky c;
+    const Eigen::MatrixXd H = fill(c, n, 3 + static_cast<unsigned>(n));
+    ASSERT_EQ(c.factorize(), -1) << n;
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 3);
+    const Eigen::MatrixXd X = c.solve(B);
+    EXPECT_LT((H * X - B).norm() / B.norm(), 1e-12) << n;
+    const Eigen::MatrixXd Hinv = H.inverse();
+    const auto S = c.selectedInverse();
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = j; i < n; ++i) {
+        double v;
+        if (S.lookup(i, j, v)) EXPECT_NEAR(v, Hinv(i, j), 1e-12) << n << " (" << i << ", " << j << ")";
+        if (i == j || i - j <= 2 || i >= n - 2) EXPECT_TRUE(S.lookup(i, j, v)) << "pattern entry missing";
+      }
+    // Refilled values, same pattern: the factorization follows.
+    for (std::size_t e = 0; e < c.entries(); ++e) c.value(e) *= 2;
+    ASSERT_EQ(c.factorize(), -1);
+    EXPECT_LT((2 * H * c.solve(B) - B).norm() / B.norm(), 1e-12) << n;
+  }
+}
+
+TEST(SparseCholesky, BothPathsReportTheColumnThatIsNotPositiveDefinite) {
+  for (const Eigen::Index n : {Eigen::Index(30), Eigen::Index(120)}) {
+    SparseCholesky c;
+    fill(c, n, 9, n / 3);
+    EXPECT_EQ(c.factorize(), n / 3) << n;
+  }
+}
