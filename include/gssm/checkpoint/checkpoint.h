@@ -14,7 +14,7 @@
 //   gssm::saveCheckpoint(*est, "run.ckpt");
 //   auto again = gssm::restoreCheckpoint(radar, "run.ckpt");   // continue
 //
-// File format (version 1): "GSSMCKPT", u32 version, u64 payload size, u64
+// File format (version 2; docs/DESIGN.md §7): "GSSMCKPT", u32 version, u64 payload size, u64
 // FNV-1a checksum of the payload, then the payload; scalars little-endian
 // IEEE-754. A truncated, corrupted or foreign file, a newer version, or a
 // checkpoint written with another model is rejected with a CheckpointError
