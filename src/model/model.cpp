@@ -42,13 +42,12 @@ Model::Model(ModelDims dims, ModelNames names, ModelNoise noise)
                           std::to_string(noise_.T));
   requireCovariance(noise_.Q, dims_.nc, "model: process noise Q");
   requireCovariance(noise_.R, dims_.ny, "model: measurement noise R");
-  r_model_ = GaussianNoise(noise_.R, "model: measurement noise R");
   MeasurementChannel y;
   y.name = "y";
   y.components = names_.measurement;
   y.R = noise_.R;
   channels_ = {y};
-  channel_noise_ = {r_model_};
+  channel_noise_ = {GaussianNoise(noise_.R, "model: measurement noise R")};
   q_cache_ = std::make_shared<NoiseCache>();
   requireVector(noise_.prior_state.mean, dims_.nc, "model: prior mean of x_c(0)");
   requireCovariance(noise_.prior_state.covariance, dims_.nc, "model: prior covariance of x_c(0)");

@@ -108,9 +108,10 @@ class Model {
   const ModelNames& names() const { return names_; }
   const ModelNoise& noise() const { return noise_; }
   double nominalStep() const { return noise_.T; }
-  const Eigen::MatrixXd& measurementNoise() const { return noise_.R; }
+  /// R of the default channel (channel 0).
+  const Eigen::MatrixXd& measurementNoise() const { return channels_.front().R; }
   /// R as a whitening noise model, factored once per model.
-  const GaussianNoise& measurementNoiseModel() const { return r_model_; }
+  const GaussianNoise& measurementNoiseModel() const { return channel_noise_.front(); }
   /// Q(dt) as a noise model, factored once per distinct dt among the last
   /// few asked for (time stamps k·T differenced give a handful of dt values
   /// that differ in the last bits) and shared; processNoise must be a pure
@@ -140,7 +141,6 @@ class Model {
   ModelDims dims_;
   ModelNames names_;
   ModelNoise noise_;
-  GaussianNoise r_model_;
   struct NoiseCache;
   std::shared_ptr<NoiseCache> q_cache_;  // shared by copies (same parameters); thread-safe
 };
