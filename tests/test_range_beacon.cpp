@@ -134,7 +134,6 @@ TEST(RobustLoss, RobustIncrementalEqualsRobustBatchAfterEveryUpdate) {
   p.range_loss = {RobustLoss::Kind::Huber, 1.0};
   const models::RangeBeacon2D model(p);
   SimulatedRun run = circleRun(model, 83, 120);
-  std::mt19937 rng(84);
   for (std::size_t i = 3; i < run.measurements.size(); i += 7) run.measurements[i].y[0] += 8;  // down-weighted
   EstimatorOptions o(Method::Incremental);
   o.smoother.iterate_to_convergence = true;  // the exact robust MAP after every update

@@ -1,13 +1,11 @@
 #include "gssm/analysis/offline.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
 #include <limits>
 
 #include "core/byte_stream.h"
 #include "gssm/checkpoint/checkpoint.h"
-#include "gssm/core/angles.h"
 #include "gssm/core/error.h"
 #include "gssm/factors/problem.h"
 
@@ -21,6 +19,14 @@ double since(Clock::time_point t0) {
 }  // namespace
 
 namespace {
+// The variables of a stacked estimate: x_c at its step and, if any, x_b.
+Values stateValues(const Model& model, const StateEstimate& e) {
+  Values x;
+  x.insert(Key::state(e.step), e.mean.head(model.dims().nc));
+  if (model.dims().nb > 0) x.insert(Key::constants(), e.mean.tail(model.dims().nb));
+  return x;
+}
+
 // The run so far, stored as a checkpoint's user data.
 // v2 adds whether a row is due, the down-weighted and gated counts.
 constexpr const char* kRunTag = "gssm offline run v2";
@@ -166,17 +172,13 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
     out.update_seconds.push_back(since(t0));
     data_hash = foldMeasurement(data_hash, m);
     if (options.compute_nis) out.nis.push_back(est->report().nis);
-    const MeasurementChannel& ch = model.channel(m.channel);
-    if (!at_inputs || ch.loss.robust()) {
+    // The EKF gates instead of weighting; the others' weight is the
+    // measurement factor's own, at the estimate after its update.
+    const bool weigh = model.channel(m.channel).loss.robust() && options.method != Method::Ekf;
+    if (!at_inputs || weigh) {
       const StateEstimate e = est->current();
       if (!at_inputs) out.rows.push_back({e.t, e.mean, e.covariance});
-      if (ch.loss.robust() && options.method != Method::Ekf) {
-        const ModelDims& d = model.dims();
-        Eigen::VectorXd r = m.y - model.h(m.channel, e.mean.head(d.nc), e.mean.tail(d.nb));
-        wrapAngles(r, ch.angles);
-        const double s = r.dot((m.R.size() ? m.R : ch.R).ldlt().solve(r));
-        if (ch.loss.weight(s) < 1.0) ++out.downweighted;
-      }
+      if (weigh && MeasurementFactor(model, e.step, m).weight(stateValues(model, e)) < 1.0) ++out.downweighted;
     }
     out.rejected = est->report().rejected;
     out.iterations = std::max(out.iterations, est->report().iterations);

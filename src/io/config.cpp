@@ -69,7 +69,8 @@ RobustLoss readLoss(const IniDocument& ini, const std::string& section) {
 void readBeacons(const IniDocument& ini, const std::string& data_dir, std::vector<int>& ids,
                  std::vector<Eigen::Vector2d>& positions) {
   const std::string beacons = ini.getString("model", "beacons");
-  if (beacons.find(".csv") == std::string::npos) {
+  // Inline rows of numbers, or the name of a file (anything else).
+  if (beacons.find_first_not_of("0123456789.-+eE \t;,[]") == std::string::npos) {
     const Eigen::MatrixXd B = ini.getMatrix("model", "beacons");
     if (B.cols() != 3) throw InputError(ini.source() + ": [model] beacons: expected rows of 'id x y' or a CSV file");
     for (Eigen::Index i = 0; i < B.rows(); ++i) {
