@@ -11,6 +11,7 @@ GSSM_PACKAGES=(
   libmrpt-img-dev libmrpt-opengl-dev
   libegl-mesa0 libgl1-mesa-dri
   python3
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-distributed python3-matplotlib
   clang libclang-rt-14-dev
 )
 

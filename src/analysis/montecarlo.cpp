@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <sstream>
 #include <thread>
 
@@ -59,76 +58,100 @@ double chiSquareQuantile(double p, int k) {
   return k * std::pow(1 - h + z * std::sqrt(h), 3);
 }
 
-namespace {
-// Per seed and method: squared errors and NEES at every step.
-struct SeedResult {
-  bool ok = false;
-  std::string error;
-  std::vector<Eigen::VectorXd> sq;  // per step
-  std::vector<double> nees, nis;
-  Eigen::VectorXd rmse, final_error;
-};
-}  // namespace
-
-MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
-                               const std::function<NormalSampler(unsigned)>& sampler_for_seed) {
+void validateMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options) {
   std::string why;
   if (!options.validate(&why)) throw InvalidArgument(why);
   if (!scenario.truth) throw InvalidArgument("MonteCarlo: the scenario has no truth model");
-  const auto start = std::chrono::steady_clock::now();
-  const Model* model = scenario.truth;
-  const SimulationSpec& spec = scenario.spec;
-  const Model& estimator_model = scenario.estimator ? *scenario.estimator : *model;
+  const Model& model = *scenario.truth;
+  const Model& estimator_model = scenario.estimator ? *scenario.estimator : model;
   for (const Method m : options.methods) {
     EstimatorOptions eo = scenario.options;
     eo.method = m;
     if (!eo.validate(estimator_model, &why)) throw InvalidArgument("MonteCarlo: " + why);
   }
-  if (estimator_model.dims().nc != model->dims().nc || estimator_model.dims().nb != model->dims().nb ||
-      estimator_model.dims().ny != model->dims().ny || estimator_model.dims().nu != model->dims().nu)
+  if (estimator_model.dims().nc != model.dims().nc || estimator_model.dims().nb != model.dims().nb ||
+      estimator_model.dims().ny != model.dims().ny || estimator_model.dims().nu != model.dims().nu)
     throw InvalidArgument("MonteCarlo: the estimators' model must have the truth model's dimensions");
-  const std::size_t M = options.methods.size(), S = static_cast<std::size_t>(options.seeds);
-  const int n = model->dims().nc + model->dims().nb;
-  std::vector<std::vector<SeedResult>> results(M, std::vector<SeedResult>(S));
-  std::vector<double> times;
-  std::mutex times_mutex;
-  std::atomic<int> next{0}, done{0};
+}
 
+MonteCarloSeedResult runMonteCarloSeed(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
+                                       unsigned seed, const NormalSampler& draw) {
+  const Model& model = *scenario.truth;
+  const Model& estimator_model = scenario.estimator ? *scenario.estimator : model;
+  MonteCarloSeedResult out;
+  out.seed = seed;
+  const SimulatedRun run = simulate(model, scenario.spec, draw);
+  const Truth truth = run.truth();
+  for (const auto& m : run.measurements) out.times.push_back(m.t);
+  for (const Method method : options.methods) {
+    MonteCarloSeedResult::PerMethod r;
+    r.method = method;
+    try {
+      EstimatorOptions eo = scenario.options;
+      eo.method = method;
+      eo.compute_nis = true;
+      const OfflineRun est = runOffline(estimator_model, eo, run.measurements, run.inputs);
+      r.nis = est.nis;
+      const RunErrors errors = runErrors(est, truth, estimator_model.angleStates());
+      for (const auto& e : errors.error) r.sq.push_back(e.cwiseAbs2());
+      r.nees = errors.nees;
+      r.rmse = errors.rmse();
+      r.final_error = errors.error.back();
+      r.ok = true;
+    } catch (const std::exception& e) {
+      r = MonteCarloSeedResult::PerMethod{};
+      r.method = method;
+      r.error = e.what();
+    }
+    out.methods.push_back(std::move(r));
+  }
+  return out;
+}
+
+MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
+                               const std::function<NormalSampler(unsigned)>& sampler_for_seed) {
+  validateMonteCarlo(scenario, options);
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<MonteCarloSeedResult> results(static_cast<std::size_t>(options.seeds));
+  std::atomic<int> next{0}, done{0};
   auto worker = [&] {
     for (int s = next++; s < options.seeds; s = next++) {
       const unsigned seed = options.first_seed + static_cast<unsigned>(s);
-      const SimulatedRun run = simulate(*model, spec, sampler_for_seed(seed));
-      const Truth truth = run.truth();
-      {
-        std::lock_guard<std::mutex> lock(times_mutex);
-        if (times.empty())
-          for (const auto& m : run.measurements) times.push_back(m.t);
-      }
-      for (std::size_t mi = 0; mi < M; ++mi) {
-        SeedResult& r = results[mi][static_cast<std::size_t>(s)];
-        try {
-          EstimatorOptions eo = scenario.options;
-          eo.method = options.methods[mi];
-          eo.compute_nis = true;
-          const OfflineRun out = runOffline(estimator_model, eo, run.measurements, run.inputs);
-          r.nis = out.nis;
-          const RunErrors errors = runErrors(out, truth, estimator_model.angleStates());
-          for (const auto& e : errors.error) r.sq.push_back(e.cwiseAbs2());
-          r.nees = errors.nees;
-          r.rmse = errors.rmse();
-          r.final_error = errors.error.back();
-          r.ok = true;
-        } catch (const std::exception& e) {
-          r.error = e.what();
-        }
-      }
+      results[static_cast<std::size_t>(s)] = runMonteCarloSeed(scenario, options, seed, sampler_for_seed(seed));
       if (options.progress) options.progress(++done, options.seeds);
     }
   };
   std::vector<std::thread> pool;
   for (int t = 0; t < std::min(options.threads, options.seeds); ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
+  MonteCarloResult res = summarizeMonteCarlo(scenario, options, results);
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return res;
+}
 
+MonteCarloResult summarizeMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
+                                     const std::vector<MonteCarloSeedResult>& results) {
+  validateMonteCarlo(scenario, options);
+  const std::size_t M = options.methods.size(), S = static_cast<std::size_t>(options.seeds);
+  if (results.size() != S)
+    throw InvalidArgument("summarizeMonteCarlo: " + std::to_string(results.size()) + " seed results for " +
+                          std::to_string(S) + " seeds");
+  for (std::size_t s = 0; s < S; ++s) {
+    const unsigned want = options.first_seed + static_cast<unsigned>(s);
+    if (results[s].seed != want || results[s].methods.size() != M)
+      throw InvalidArgument("summarizeMonteCarlo: result " + std::to_string(s) + " is seed " +
+                            std::to_string(results[s].seed) + " with " + std::to_string(results[s].methods.size()) +
+                            " methods; expected seed " + std::to_string(want) + " with " + std::to_string(M) +
+                            " (results in seed order, every method of the options)");
+    for (std::size_t mi = 0; mi < M; ++mi)
+      if (results[s].methods[mi].method != options.methods[mi])
+        throw InvalidArgument("summarizeMonteCarlo: seed " + std::to_string(want) + ": method " +
+                              std::to_string(mi) + " is " + methodName(results[s].methods[mi].method) +
+                              ", the options say " + methodName(options.methods[mi]));
+  }
+  const Model* model = scenario.truth;
+  const SimulationSpec& spec = scenario.spec;
+  const int n = model->dims().nc + model->dims().nb;
   MonteCarloResult res;
   res.scenario = scenario.name;
   res.seeds = options.seeds;
@@ -145,23 +168,24 @@ MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCa
   for (std::size_t mi = 0; mi < M; ++mi) {
     MethodSummary m;
     m.method = options.methods[mi];
-    m.times = times;
+    m.times = results.front().times;
     m.mean_rmse = m.rms_final_error = m.beats_ekf = Eigen::VectorXd::Zero(n);
     const std::size_t rows = static_cast<std::size_t>(spec.steps / spec.measure_every);
     std::vector<Eigen::VectorXd> sq_t(rows, Eigen::VectorXd::Zero(n));
     std::vector<double> nees_t(rows, 0.0), nis_t(rows, 0.0);
     int ok = 0;
     for (std::size_t s = 0; s < S; ++s) {
-      const SeedResult& r = results[mi][s];
+      const auto& r = results[s].methods[mi];
       if (!r.ok) {
-        if (m.failures++ == 0) m.first_failure = "seed " + std::to_string(options.first_seed + s) + ": " + r.error;
+        if (m.failures++ == 0) m.first_failure = "seed " + std::to_string(results[s].seed) + ": " + r.error;
         continue;
       }
       ++ok;
       m.mean_rmse += r.rmse;
       m.rms_final_error += r.final_error.cwiseAbs2();
-      if (results[ekf][s].ok)
-        for (int i = 0; i < n; ++i) m.beats_ekf[i] += r.rmse[i] < results[ekf][s].rmse[i] ? 1.0 : 0.0;
+      const auto& base = results[s].methods[ekf];
+      if (base.ok)
+        for (int i = 0; i < n; ++i) m.beats_ekf[i] += r.rmse[i] < base.rmse[i] ? 1.0 : 0.0;
       for (std::size_t k = 0; k < r.sq.size() && k < sq_t.size(); ++k) {
         sq_t[k] += r.sq[k];
         nees_t[k] += r.nees[k];
@@ -195,7 +219,6 @@ MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCa
     }
     res.methods.push_back(std::move(m));
   }
-  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return res;
 }
 

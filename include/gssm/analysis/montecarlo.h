@@ -69,8 +69,43 @@ struct MonteCarloResult {
   std::string markdown() const;
 };
 
-/// Runs the scenario for seeds first_seed.. with every method.
-/// `sampler_for_seed` makes the N(0, 1) source of one seed.
+/// One seed of a campaign: its simulated run estimated by every method.
+/// The unit of work a distributed campaign ships (Python `gssm.campaign`
+/// runs seeds on Dask workers and summarizes them in seed order).
+struct MonteCarloSeedResult {
+  struct PerMethod {
+    Method method = Method::Ekf;
+    bool ok = false;
+    std::string error;                 ///< what the estimator threw (when !ok)
+    std::vector<Eigen::VectorXd> sq;   ///< per measurement: squared error of each stacked state
+    std::vector<double> nees, nis;     ///< per measurement (nis empty for batch)
+    Eigen::VectorXd rmse, final_error; ///< over the run; at the last measurement
+  };
+  unsigned seed = 0;
+  std::vector<double> times;           ///< measurement times
+  std::vector<PerMethod> methods;      ///< in MonteCarloOptions::methods order
+};
+
+/// Simulates seed `seed` (N(0, 1) draws from `draw`) and runs every method of
+/// `options` on it. Checks nothing: runMonteCarlo and campaigns validate first
+/// (validateMonteCarlo).
+MonteCarloSeedResult runMonteCarloSeed(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
+                                       unsigned seed, const NormalSampler& draw);
+
+/// Throws InvalidArgument unless the options, the scenario's models and every
+/// method's settings are usable together.
+void validateMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options);
+
+/// The table of a campaign from its seeds' results, which must be seeds
+/// first_seed, first_seed + 1, ... in that order (sums run in seed order, so
+/// the result is the same bit for bit however the seeds were computed).
+/// `seconds` is left 0 for the caller.
+MonteCarloResult summarizeMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
+                                     const std::vector<MonteCarloSeedResult>& seeds);
+
+/// Runs the scenario for seeds first_seed.. with every method, on
+/// options.threads threads. `sampler_for_seed` makes the N(0, 1) source of
+/// one seed.
 MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
                                const std::function<NormalSampler(unsigned)>& sampler_for_seed);
 
