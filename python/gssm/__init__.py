@@ -1,0 +1,115 @@
+"""gssm: real-time optimal estimation with the Graphical State Space Model.
+
+The C++ library at C++ speed: constants kept as one node for the whole run,
+an incremental (Bayes tree) smoother, an exact fixed-lag smoother, the EKF
+baseline and the batch MAP, on the same model object.
+
+    import gssm
+    model = gssm.models.Radar2D()
+    data = gssm.io.read_dataset("datasets/radar-paper")
+    est = gssm.make_estimator(model, method="fixed-lag", window=10)
+    for t, y in zip(data.t, data.y):
+        est.add_measurement(t, y)
+    e = est.current()                      # e.mean, e.covariance: NumPy
+    run = gssm.run(model, data, method="ekf")   # run.t, run.mean, run.sd
+
+Methods are named as gssm-process names them: see gssm.methods().
+"""
+from . import _gssm
+from ._gssm import (
+    Error,
+    InvalidArgument,
+    InputError,
+    NumericalError,
+    CheckpointError,
+    Estimator,
+    EstimatorOptions,
+    EkfOptions,
+    SmootherOptions,
+    BatchOptions,
+    EstimatorReport,
+    UpdateReport,
+    StateEstimate,
+    Run,
+    methods,
+    checkpoint_info,
+)
+from . import models, io, analysis  # noqa: E402  (after _gssm: they wrap it)
+from ._options import make_options  # noqa: E402
+
+__all__ = [
+    "Error", "InvalidArgument", "InputError", "NumericalError", "CheckpointError",
+    "Estimator", "EstimatorOptions", "EkfOptions", "SmootherOptions", "BatchOptions",
+    "EstimatorReport", "UpdateReport", "StateEstimate", "Run",
+    "methods", "make_options", "make_estimator", "run", "restore", "checkpoint_info",
+    "simulate", "models", "io", "analysis",
+]
+
+
+def make_estimator(model, method="fixed-lag", *, options=None, **settings):
+    """A streaming estimator for `model`.
+
+    method: "ekf", "incremental", "fixed-lag" or "paper-window" (the batch
+    solver needs the whole run: gssm.run(..., method="batch")).
+    options: an EstimatorOptions to start from (default: the C++ defaults).
+    settings: window=, ordering=, t0=, compute_nis=, and ekf=, smoother=,
+    batch= as dicts of those option groups' fields; see make_options.
+    Raises gssm.InvalidArgument naming the option at fault.
+    """
+    o = make_options(method, options=options, **settings)
+    o.validate(model)
+    return _gssm.make_estimator_from_options(model, o)
+
+
+def run(model, data, method="fixed-lag", *, options=None, rows_at_inputs=None, progress=None, **settings):
+    """Runs `method` over a whole dataset with the loop in C++; returns a gssm.Run.
+
+    data: a gssm.io.Dataset (read_dataset, simulate, io.from_arrays).
+    Settings come, as in gssm-process, from the dataset's scenario.ini
+    sections ([ekf], [smoother], [fixed_lag], [paper_window], [batch]) and
+    its start time when it has them, else from the C++ defaults; options=
+    replaces them and keyword settings (window=, ...) override either.
+    Every name gssm-process takes is a method here, "batch" included.
+    progress: a callable(done, total), called from the loop (holds the GIL).
+    The result equals gssm-process's estimates bit for bit.
+    """
+    if options is None:
+        options = _dataset_options(data, model, method)
+    o = make_options(method, options=options, **settings)
+    o.validate(model)
+    return _gssm.run_dataset(model, data, o, rows_at_inputs, progress)
+
+
+def _dataset_options(data, model, method):
+    if data.scenario.strip():
+        try:
+            return data.options(method, model)
+        except InputError:
+            pass  # a scenario.ini for another model: its settings do not apply
+    o = EstimatorOptions(method)
+    o.t0 = data.t0
+    return o
+
+
+def restore(model, source):
+    """The estimator a checkpoint holds, on `model`: source is bytes
+    (Estimator.to_bytes) or a file path (Estimator.save)."""
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        return _gssm.restore_bytes(model, bytes(source))
+    return _gssm.restore_file(model, str(source))
+
+
+def simulate(scenario="paper", seed=1, steps=400, **kwargs):
+    """A simulated run as a gssm.io.Dataset (with .model and the whole truth).
+
+    scenario: a built-in scenario name (gssm.io.scenarios(); the same bytes
+    gssm-simulate writes for the same seed and steps) or a gssm.models.Model
+    (x0=, xb=, measure_every= as keywords; x0 and xb drawn from the priors
+    unless given).
+    """
+    if isinstance(scenario, str):
+        if kwargs:
+            raise InvalidArgument("simulate: keyword arguments %s are for a model, not scenario '%s'"
+                                  % (sorted(kwargs), scenario))
+        return _gssm.io.simulate_scenario(scenario, seed, steps)
+    return _gssm.io.simulate_model(scenario, seed, steps, **kwargs)

@@ -1,0 +1,52 @@
+#pragma once
+// The gssm Python module (_gssm, wrapped by the pure-Python package gssm/):
+// one bind function per layer of the C++ library (docs/DESIGN.md §3), each
+// in its own file. Arrays cross as NumPy (pybind11/eigen.h copies them).
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <string>
+
+#include "gssm/analysis/offline.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/io/dataset.h"
+#include "gssm/model/model.h"
+
+namespace py = pybind11;
+
+namespace gssm::python {
+
+void bindErrors(py::module_& m);
+void bindModels(py::module_& models);
+void bindEstimator(py::module_& m);
+void bindIo(py::module_& io);
+void bindAnalysis(py::module_& analysis);
+void bindCampaign(py::module_& campaign);
+
+/// True when the model calls back into Python (a gssm.models.PythonModel):
+/// such a model needs the GIL held while it runs, so loops over it cannot
+/// release it.
+bool callsPython(const Model& model);
+
+/// The method named `name` (every name gssm-process takes); InvalidArgument
+/// naming the valid ones otherwise.
+Method methodFromName(const std::string& name);
+
+/// A dataset as Python sees it: the C++ dataset, the model its scenario.ini
+/// describes (when read from a folder or simulated), and the simulated run
+/// with the whole true trajectory (when simulated).
+struct PyDataset {
+  io::Dataset data;
+  std::shared_ptr<Model> model;
+  std::shared_ptr<SimulatedRun> simulated;
+};
+
+/// An offline run with the names of its columns (gssm.Run).
+struct PyRun {
+  OfflineRun run;
+  std::vector<std::string> names;
+};
+
+}  // namespace gssm::python

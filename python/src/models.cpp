@@ -1,0 +1,429 @@
+// gssm.models: the built-in models with the C++ defaults as keyword
+// defaults, the linear model from matrices, and models written in Python
+// (FunctionModel over Python callables; central differences where no
+// Jacobian is given). Built-in models pickle through their INI form
+// (io::writeModel / io::makeModel); the Python package pickles PythonModel
+// from its constructor arguments.
+#include <pybind11/functional.h>
+
+#include "bindings.h"
+#include "gssm/core/error.h"
+#include "gssm/io/config.h"
+#include "gssm/io/ini.h"
+#include "gssm/models/function_model.h"
+#include "gssm/models/linear.h"
+#include "gssm/models/nav2d.h"
+#include "gssm/models/radar2d.h"
+#include "gssm/models/range_beacon2d.h"
+
+namespace gssm::python {
+
+bool callsPython(const Model& model) { return dynamic_cast<const models::FunctionModel*>(&model) != nullptr; }
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+std::vector<Eigen::Vector2d> points(const Eigen::MatrixXd& m, const char* what) {
+  if (m.size() > 0 && m.cols() != 2)
+    throw InvalidArgument(std::string(what) + ": expected an array of shape (k, 2), got (" +
+                          std::to_string(m.rows()) + ", " + std::to_string(m.cols()) + ")");
+  std::vector<Eigen::Vector2d> out;
+  for (Eigen::Index i = 0; i < m.rows(); ++i) out.emplace_back(m(i, 0), m(i, 1));
+  return out;
+}
+
+MatrixXd pointsMatrix(const std::vector<Eigen::Vector2d>& p) {
+  MatrixXd m(static_cast<Eigen::Index>(p.size()), 2);
+  for (std::size_t i = 0; i < p.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = p[i].transpose();
+  return m;
+}
+
+RobustLoss lossNamed(const std::string& name, double scale) {
+  RobustLoss loss;
+  for (auto k : {RobustLoss::Kind::None, RobustLoss::Kind::Huber, RobustLoss::Kind::Cauchy, RobustLoss::Kind::Tukey})
+    if (name == RobustLoss::name(k)) {
+      loss.kind = k;
+      loss.scale = scale;
+      return loss;
+    }
+  throw InvalidArgument("loss '" + name + "': expected none, huber, cauchy or tukey");
+}
+
+/// A callable's result as a vector of `n` values (a float is a 1-vector),
+/// or an InvalidArgument naming the model and the function.
+VectorXd vectorResult(const py::object& r, Eigen::Index n, const std::string& model, const char* fn) {
+  VectorXd v;
+  if (py::isinstance<py::float_>(r) || py::isinstance<py::int_>(r)) {
+    v = VectorXd::Constant(1, r.cast<double>());
+  } else {
+    try {
+      v = r.cast<VectorXd>();
+    } catch (const py::cast_error&) {
+      throw InvalidArgument("model '" + model + "': " + fn + " returned " +
+                            py::str(py::type::of(r).attr("__name__")).cast<std::string>() +
+                            ", expected a 1-D array of " + std::to_string(n) + " floats");
+    }
+  }
+  if (v.size() != n)
+    throw InvalidArgument("model '" + model + "': " + fn + " returned " + std::to_string(v.size()) +
+                          " values, expected " + std::to_string(n));
+  return v;
+}
+
+MatrixXd matrixResult(const py::handle& r, Eigen::Index rows, Eigen::Index cols, const std::string& model,
+                      const std::string& what) {
+  if (r.is_none() && (rows == 0 || cols == 0)) return MatrixXd::Zero(rows, cols);
+  MatrixXd m;
+  try {
+    m = r.cast<MatrixXd>();
+  } catch (const py::cast_error&) {
+    throw InvalidArgument("model '" + model + "': " + what + " is not a 2-D array of floats");
+  }
+  if (rows * cols == 0 && m.size() == 0) return MatrixXd::Zero(rows, cols);
+  if (m.rows() != rows || m.cols() != cols)
+    throw InvalidArgument("model '" + model + "': " + what + " has shape (" + std::to_string(m.rows()) + ", " +
+                          std::to_string(m.cols()) + "), expected (" + std::to_string(rows) + ", " +
+                          std::to_string(cols) + ")");
+  return m;
+}
+
+void jacobianPair(const py::object& r, Eigen::Index rows, const ModelDims& d, const std::string& model,
+                  const char* fn, MatrixXd& J_xc, MatrixXd& J_xb) {
+  if (!py::isinstance<py::tuple>(r) && !py::isinstance<py::list>(r))
+    throw InvalidArgument("model '" + model + "': " + fn + " must return a pair (J_xc, J_xb)");
+  const py::sequence s = r;
+  if (s.size() != 2) throw InvalidArgument("model '" + model + "': " + fn + " must return a pair (J_xc, J_xb)");
+  J_xc = matrixResult(s[0], rows, d.nc, model, std::string(fn) + "[0] (J_xc)");
+  J_xb = matrixResult(s[1], rows, d.nb, model, std::string(fn) + "[1] (J_xb)");
+}
+
+Gaussian gaussian(const std::optional<VectorXd>& mean, const std::optional<MatrixXd>& cov, int n) {
+  Gaussian g;
+  g.mean = mean ? *mean : VectorXd::Zero(n);
+  g.covariance = cov ? *cov : MatrixXd::Identity(n, n);
+  return g;
+}
+
+std::shared_ptr<models::FunctionModel> makePythonModel(
+    int nc, int nb, int nu, int ny, py::function f, py::function h, const MatrixXd& Q, const MatrixXd& R, double T,
+    const std::optional<VectorXd>& prior_state_mean, const std::optional<MatrixXd>& prior_state_cov,
+    const std::optional<VectorXd>& prior_constants_mean, const std::optional<MatrixXd>& prior_constants_cov,
+    const py::object& jacobian_f, const py::object& jacobian_h, const std::string& name,
+    const std::vector<std::string>& state_names, const std::vector<std::string>& constant_names,
+    const std::vector<std::string>& input_names, const std::vector<std::string>& measurement_names,
+    bool verify_jacobians) {
+  if (nc < 1 || nb < 0 || nu < 0 || ny < 1)
+    throw InvalidArgument("PythonModel '" + name + "': need nc >= 1, nb >= 0, nu >= 0, ny >= 1");
+  ModelDims d{nc, nb, nu, ny};
+  auto numbered = [](const std::vector<std::string>& given, const char* prefix, int n, const char* what) {
+    if (!given.empty() && static_cast<int>(given.size()) != n)
+      throw InvalidArgument(std::string("PythonModel: ") + what + " has " + std::to_string(given.size()) +
+                            " names, expected " + std::to_string(n));
+    if (!given.empty()) return given;
+    std::vector<std::string> out;
+    for (int i = 1; i <= n; ++i) out.push_back(prefix + std::to_string(i));
+    return out;
+  };
+  ModelNames names{numbered(state_names, "x", nc, "state_names"), numbered(constant_names, "b", nb, "constant_names"),
+                   numbered(input_names, "u", nu, "input_names"),
+                   numbered(measurement_names, "y", ny, "measurement_names")};
+  ModelNoise noise;
+  noise.T = T;
+  noise.Q = Q;
+  noise.R = R;
+  noise.prior_state = gaussian(prior_state_mean, prior_state_cov, nc);
+  noise.prior_constants = gaussian(prior_constants_mean, prior_constants_cov, nb);
+  requireCovariance(Q, nc, "PythonModel '" + name + "': Q");
+  requireCovariance(R, ny, "PythonModel '" + name + "': R");
+  requireVector(noise.prior_state.mean, nc, "PythonModel '" + name + "': prior_state mean");
+  requireCovariance(noise.prior_state.covariance, nc, "PythonModel '" + name + "': prior_state covariance");
+  requireVector(noise.prior_constants.mean, nb, "PythonModel '" + name + "': prior_constants mean");
+  if (nb > 0)
+    requireCovariance(noise.prior_constants.covariance, nb, "PythonModel '" + name + "': prior_constants covariance");
+
+  models::ModelFunctions fns;
+  fns.name = name;
+  fns.f = [f, d, name](const VectorXd& xc, const VectorXd& xb, const VectorXd& u, double dt) {
+    return vectorResult(f(xc, xb, u, dt), d.nc, name, "f");
+  };
+  fns.h = [h, d, name](const VectorXd& xc, const VectorXd& xb) { return vectorResult(h(xc, xb), d.ny, name, "h"); };
+  if (!jacobian_f.is_none()) {
+    py::function jf = jacobian_f;
+    fns.jacobians_f = [jf, d, name](const VectorXd& xc, const VectorXd& xb, const VectorXd& u, double dt,
+                                    MatrixXd& J_xc, MatrixXd& J_xb) {
+      jacobianPair(jf(xc, xb, u, dt), d.nc, d, name, "jacobian_f", J_xc, J_xb);
+    };
+  }
+  if (!jacobian_h.is_none()) {
+    py::function jh = jacobian_h;
+    fns.jacobians_h = [jh, d, name](const VectorXd& xc, const VectorXd& xb, MatrixXd& J_xc, MatrixXd& J_xb) {
+      jacobianPair(jh(xc, xb), d.ny, d, name, "jacobian_h", J_xc, J_xb);
+    };
+  }
+  fns.verify_jacobians = verify_jacobians;
+  return std::make_shared<models::FunctionModel>(d, std::move(names), std::move(noise), std::move(fns));
+}
+
+std::string modelIni(const Model& m) {
+  io::IniDocument ini;
+  io::writeModel(m, ini);
+  return ini.toString();
+}
+
+}  // namespace
+
+void bindModels(py::module_& models) {
+  py::class_<MeasurementChannel>(models, "Channel", "A sensor of a model: its name, components, noise and loss.")
+      .def_readonly("name", &MeasurementChannel::name)
+      .def_readonly("components", &MeasurementChannel::components)
+      .def_readonly("R", &MeasurementChannel::R)
+      .def_property_readonly("loss", [](const MeasurementChannel& c) { return RobustLoss::name(c.loss.kind); })
+      .def_property_readonly("loss_scale", [](const MeasurementChannel& c) { return c.loss.scale; })
+      .def_readonly("angles", &MeasurementChannel::angles)
+      .def_readonly("ekf_gate", &MeasurementChannel::ekf_gate)
+      .def_property_readonly("dim", &MeasurementChannel::dim)
+      .def("__repr__", [](const MeasurementChannel& c) {
+        return "Channel(name='" + c.name + "', dim=" + std::to_string(c.dim()) + ", loss='" +
+               RobustLoss::name(c.loss.kind) + "')";
+      });
+
+  py::class_<Model, std::shared_ptr<Model>>(models, "Model",
+                                            "A GSSM: x_c(k+1) = f(x_c(k), x_b, u, dt) + q, y = h(x_c, x_b) + r "
+                                            "(docs/DESIGN.md §2). Abstract: use a built-in model or PythonModel.")
+      .def_property_readonly("name", &Model::name)
+      .def_property_readonly("nc", [](const Model& m) { return m.dims().nc; }, "size of the time-series state x_c")
+      .def_property_readonly("nb", [](const Model& m) { return m.dims().nb; }, "size of the constant state x_b")
+      .def_property_readonly("nu", [](const Model& m) { return m.dims().nu; }, "size of the input u")
+      .def_property_readonly("ny", [](const Model& m) { return m.dims().ny; }, "size of the default channel's y")
+      .def_property_readonly("state_names", [](const Model& m) { return m.names().state; })
+      .def_property_readonly("constant_names", [](const Model& m) { return m.names().constants; })
+      .def_property_readonly("input_names", [](const Model& m) { return m.names().input; })
+      .def_property_readonly("measurement_names", [](const Model& m) { return m.names().measurement; })
+      .def_property_readonly("stacked_state_names", &Model::stackedStateNames, "names of [x_c; x_b]")
+      .def_property_readonly("T", &Model::nominalStep, "nominal step (s)")
+      .def_property_readonly("Q", [](const Model& m) { return m.noise().Q; }, "process noise of one nominal step")
+      .def_property_readonly("R", &Model::measurementNoise, "noise covariance of the default channel")
+      .def_property_readonly("prior_state",
+                             [](const Model& m) { return py::make_tuple(m.priorState().mean, m.priorState().covariance); },
+                             "(mean, covariance) of x_c(0)")
+      .def_property_readonly(
+          "prior_constants",
+          [](const Model& m) { return py::make_tuple(m.priorConstants().mean, m.priorConstants().covariance); },
+          "(mean, covariance) of x_b")
+      .def_property_readonly("channels",
+                             [](const Model& m) {
+                               std::vector<MeasurementChannel> out;
+                               for (int c = 0; c < m.numChannels(); ++c) out.push_back(m.channel(c));
+                               return out;
+                             })
+      .def("channel_index", &Model::channelIndex, py::arg("name"), "index of the channel called `name`")
+      .def_property_readonly("angle_states", &Model::angleStates, "stacked components that are angles")
+      .def(
+          "f",
+          [](const Model& m, const VectorXd& xc, const VectorXd& xb, const VectorXd& u, double dt,
+             bool jacobians) -> py::object {
+            const auto d = m.dims();
+            requireVector(xc, d.nc, "f: xc");
+            requireVector(xb, d.nb, "f: xb");
+            const VectorXd uu = u.size() == 0 ? VectorXd::Zero(d.nu) : u;
+            requireVector(uu, d.nu, "f: u");
+            if (!jacobians) return py::cast(m.f(xc, xb, uu, dt));
+            MatrixXd J_xc, J_xb;
+            VectorXd v = m.f(xc, xb, uu, dt, &J_xc, &J_xb);
+            return py::make_tuple(v, J_xc, J_xb);
+          },
+          py::arg("xc"), py::arg("xb"), py::arg("u") = VectorXd(), py::arg("dt") = std::nan(""),
+          py::arg("jacobians") = false,
+          "x_c(k+1) without noise; with jacobians=True the tuple (value, J_f_xc, J_f_xb). dt defaults to T.")
+      .def(
+          "h",
+          [](const Model& m, const VectorXd& xc, const VectorXd& xb, const py::object& channel,
+             bool jacobians) -> py::object {
+            const auto d = m.dims();
+            requireVector(xc, d.nc, "h: xc");
+            requireVector(xb, d.nb, "h: xb");
+            const int c = py::isinstance<py::str>(channel) ? m.channelIndex(channel.cast<std::string>())
+                                                             : channel.cast<int>();
+            if (c < 0 || c >= m.numChannels())
+              throw InvalidArgument("h: channel " + std::to_string(c) + " out of range (the model has " +
+                                    std::to_string(m.numChannels()) + ")");
+            if (!jacobians) return py::cast(m.h(c, xc, xb));
+            MatrixXd J_xc, J_xb;
+            VectorXd v = m.h(c, xc, xb, &J_xc, &J_xb);
+            return py::make_tuple(v, J_xc, J_xb);
+          },
+          py::arg("xc"), py::arg("xb"), py::arg("channel") = 0, py::arg("jacobians") = false,
+          "y without noise on `channel` (index or name); with jacobians=True (value, J_h_xc, J_h_xb).")
+      .def("process_noise", &Model::processNoise, py::arg("dt"), "Q for a step of dt")
+      .def(
+          "check_jacobians",
+          [](const Model& m, const VectorXd& xc, const VectorXd& xb, const VectorXd& u, double dt, double eps) {
+            const JacobianCheck c = checkJacobians(m, xc, xb, u.size() ? u : VectorXd::Zero(m.dims().nu),
+                                                   std::isnan(dt) ? m.nominalStep() : dt, eps);
+            py::dict d;
+            d["max_abs_error"] = c.max_abs_error;
+            d["max_rel_error"] = c.max_rel_error;
+            d["worst"] = c.worst;
+            return d;
+          },
+          py::arg("xc"), py::arg("xb"), py::arg("u") = VectorXd(), py::arg("dt") = std::nan(""),
+          py::arg("eps") = 1e-6, "analytic Jacobians against central differences at one point")
+      .def("to_ini", &modelIni, "the model's INI form ([model], [noise], [prior]), as gssm-process reads it")
+      .def("__reduce__",
+           [](const Model& m) {
+             return py::make_tuple(py::module_::import("gssm._gssm.models").attr("from_ini"),
+                                   py::make_tuple(modelIni(m)));
+           })
+      .def("__repr__", [](const Model& m) {
+        const auto d = m.dims();
+        return "<gssm.models." + m.name() + " nc=" + std::to_string(d.nc) + " nb=" + std::to_string(d.nb) +
+               " nu=" + std::to_string(d.nu) + " ny=" + std::to_string(d.ny) + " channels=" +
+               std::to_string(m.numChannels()) + ">";
+      });
+
+  models.def(
+      "from_ini",
+      [](const std::string& text, const std::string& data_dir) -> std::shared_ptr<Model> {
+        return std::shared_ptr<Model>(io::makeModel(io::IniDocument::parse(text, "<ini text>"), data_dir));
+      },
+      py::arg("text"), py::arg("data_dir") = "",
+      "The model an INI text describes (as in a dataset's scenario.ini); file names in it are read from data_dir.");
+
+  const models::Radar2D::Params rp;
+  py::class_<models::Radar2D, Model, std::shared_ptr<models::Radar2D>>(
+      models, "Radar2D", "The paper's radar example: x_c = x, x_b = [xdot, h], y = range (docs/DESIGN.md §2).")
+      .def(py::init([](double T, double q, double r, double prior_x, double prior_xdot, double prior_h,
+                       double prior_var_x, double prior_var_xdot, double prior_var_h) {
+             models::Radar2D::Params p;
+             p.T = T, p.q = q, p.r = r, p.prior_x = prior_x, p.prior_xdot = prior_xdot, p.prior_h = prior_h;
+             p.prior_var_x = prior_var_x, p.prior_var_xdot = prior_var_xdot, p.prior_var_h = prior_var_h;
+             return std::make_shared<models::Radar2D>(p);
+           }),
+           py::arg("T") = rp.T, py::arg("q") = rp.q, py::arg("r") = rp.r, py::arg("prior_x") = rp.prior_x,
+           py::arg("prior_xdot") = rp.prior_xdot, py::arg("prior_h") = rp.prior_h,
+           py::arg("prior_var_x") = rp.prior_var_x, py::arg("prior_var_xdot") = rp.prior_var_xdot,
+           py::arg("prior_var_h") = rp.prior_var_h);
+
+  const models::Nav2D::Params np;
+  py::class_<models::Nav2D, Model, std::shared_ptr<models::Nav2D>>(
+      models, "Nav2D", "Constant-velocity vehicle ranging to beacons, with a range bias and clock drift as constants.")
+      .def(py::init([](double T, double accel_noise, double range_sigma, const MatrixXd& beacons,
+                       const Eigen::Vector4d& prior_state, const Eigen::Vector4d& prior_state_sd,
+                       const Eigen::Vector3d& prior_constants, const Eigen::Vector3d& prior_constants_sd) {
+             models::Nav2D::Params p;
+             p.T = T, p.accel_noise = accel_noise, p.range_sigma = range_sigma;
+             p.beacons = points(beacons, "Nav2D beacons");
+             p.prior_state = prior_state, p.prior_state_sd = prior_state_sd;
+             p.prior_constants = prior_constants, p.prior_constants_sd = prior_constants_sd;
+             return std::make_shared<models::Nav2D>(p);
+           }),
+           py::arg("T") = np.T, py::arg("accel_noise") = np.accel_noise, py::arg("range_sigma") = np.range_sigma,
+           py::arg("beacons") = pointsMatrix(np.beacons), py::arg("prior_state") = np.prior_state,
+           py::arg("prior_state_sd") = np.prior_state_sd, py::arg("prior_constants") = np.prior_constants,
+           py::arg("prior_constants_sd") = np.prior_constants_sd)
+      .def_property_readonly("beacons", [](const models::Nav2D& m) { return pointsMatrix(m.beacons()); });
+
+  const models::RangeBeacon2D::Params bp;
+  py::class_<models::RangeBeacon2D, Model, std::shared_ptr<models::RangeBeacon2D>>(
+      models, "RangeBeacon2D",
+      "A vehicle with odometry ranging to known beacons (the CMU Plaza logs); range scale, per-beacon offsets "
+      "and odometry scale as optional constants; one channel per beacon.")
+      .def(py::init([](const std::vector<int>& beacon_ids, const MatrixXd& beacons, double T, bool range_scale,
+                       bool range_offsets, bool odometry_scale, double range_sd, double distance_sd, double turn_sd,
+                       double heading_drift_sd, double position_sd_per_s, double heading_sd_per_s,
+                       const Eigen::Vector3d& start, const Eigen::Vector3d& start_sd, double range_scale_sd,
+                       double range_offset_sd, double odometry_scale_sd, const std::string& range_loss,
+                       double range_loss_scale, double ekf_gate) {
+             models::RangeBeacon2D::Params p;
+             p.beacon_ids = beacon_ids;
+             p.beacons = points(beacons, "RangeBeacon2D beacons");
+             p.T = T, p.range_scale = range_scale, p.range_offsets = range_offsets, p.odometry_scale = odometry_scale;
+             p.range_sd = range_sd, p.distance_sd = distance_sd, p.turn_sd = turn_sd;
+             p.heading_drift_sd = heading_drift_sd, p.position_sd_per_s = position_sd_per_s;
+             p.heading_sd_per_s = heading_sd_per_s, p.start = start, p.start_sd = start_sd;
+             p.range_scale_sd = range_scale_sd, p.range_offset_sd = range_offset_sd;
+             p.odometry_scale_sd = odometry_scale_sd;
+             p.range_loss = lossNamed(range_loss, range_loss_scale);
+             p.ekf_gate = ekf_gate;
+             return std::make_shared<models::RangeBeacon2D>(p);
+           }),
+           py::arg("beacon_ids"), py::arg("beacons"), py::arg("T") = bp.T, py::arg("range_scale") = bp.range_scale,
+           py::arg("range_offsets") = bp.range_offsets, py::arg("odometry_scale") = bp.odometry_scale,
+           py::arg("range_sd") = bp.range_sd, py::arg("distance_sd") = bp.distance_sd,
+           py::arg("turn_sd") = bp.turn_sd, py::arg("heading_drift_sd") = bp.heading_drift_sd,
+           py::arg("position_sd_per_s") = bp.position_sd_per_s, py::arg("heading_sd_per_s") = bp.heading_sd_per_s,
+           py::arg("start") = bp.start, py::arg("start_sd") = bp.start_sd,
+           py::arg("range_scale_sd") = bp.range_scale_sd, py::arg("range_offset_sd") = bp.range_offset_sd,
+           py::arg("odometry_scale_sd") = bp.odometry_scale_sd, py::arg("range_loss") = "none",
+           py::arg("range_loss_scale") = 1.345, py::arg("ekf_gate") = bp.ekf_gate)
+      .def_property_readonly("beacons", [](const models::RangeBeacon2D& m) { return pointsMatrix(m.params().beacons); })
+      .def_property_readonly("beacon_ids", [](const models::RangeBeacon2D& m) { return m.params().beacon_ids; });
+
+  py::class_<models::LinearModel, Model, std::shared_ptr<models::LinearModel>>(
+      models, "Linear",
+      "A linear GSSM from matrices: x_c' = A_c x_c + A_b x_b + B u (continuous time, discretized by "
+      "`discretization`), y = C_c x_c + C_b x_b; channels: further sensors as dicts with name, C_c, C_b, R.")
+      .def(py::init([](const MatrixXd& A_c, const MatrixXd& C_c, const MatrixXd& Q, const MatrixXd& R,
+                       const std::optional<MatrixXd>& A_b, const std::optional<MatrixXd>& B,
+                       const std::optional<MatrixXd>& C_b, const std::optional<VectorXd>& prior_state_mean,
+                       const std::optional<MatrixXd>& prior_state_cov,
+                       const std::optional<VectorXd>& prior_constants_mean,
+                       const std::optional<MatrixXd>& prior_constants_cov, double T, const std::string& discretization,
+                       const std::vector<py::dict>& channels, const std::vector<std::string>& state_names,
+                       const std::vector<std::string>& constant_names, const std::vector<std::string>& input_names,
+                       const std::vector<std::string>& measurement_names) {
+             const Eigen::Index nc = A_c.rows();
+             const Eigen::Index nb = A_b ? A_b->cols() : (C_b ? C_b->cols() : 0);
+             models::LinearSystem s;
+             s.A_c = A_c;
+             s.C_c = C_c;
+             s.A_b = A_b ? *A_b : MatrixXd::Zero(nc, nb);
+             s.B = B ? *B : MatrixXd::Zero(nc, 0);
+             s.C_b = C_b ? *C_b : MatrixXd::Zero(C_c.rows(), nb);
+             s.noise.T = T;
+             s.noise.Q = Q;
+             s.noise.R = R;
+             s.noise.prior_state = gaussian(prior_state_mean, prior_state_cov, static_cast<int>(nc));
+             s.noise.prior_constants = gaussian(prior_constants_mean, prior_constants_cov, static_cast<int>(nb));
+             s.names = {state_names, constant_names, input_names, measurement_names};
+             for (const py::dict& c : channels) {
+               models::LinearChannel ch;
+               ch.name = c["name"].cast<std::string>();
+               ch.C_c = c["C_c"].cast<MatrixXd>();
+               ch.C_b = c.contains("C_b") ? c["C_b"].cast<MatrixXd>() : MatrixXd::Zero(ch.C_c.rows(), nb);
+               ch.R = c["R"].cast<MatrixXd>();
+               if (c.contains("components")) ch.components = c["components"].cast<std::vector<std::string>>();
+               s.channels.push_back(std::move(ch));
+             }
+             if (discretization != "euler" && discretization != "exact")
+               throw InvalidArgument("Linear: discretization '" + discretization + "': expected euler or exact");
+             return std::make_shared<models::LinearModel>(
+                 std::move(s), discretization == "exact" ? models::Discretization::Exact : models::Discretization::Euler);
+           }),
+           py::arg("A_c"), py::arg("C_c"), py::arg("Q"), py::arg("R"), py::arg("A_b") = py::none(),
+           py::arg("B") = py::none(), py::arg("C_b") = py::none(), py::arg("prior_state_mean") = py::none(),
+           py::arg("prior_state_cov") = py::none(), py::arg("prior_constants_mean") = py::none(),
+           py::arg("prior_constants_cov") = py::none(), py::arg("T") = 1.0, py::arg("discretization") = "euler",
+           py::arg("channels") = std::vector<py::dict>{}, py::arg("state_names") = std::vector<std::string>{},
+           py::arg("constant_names") = std::vector<std::string>{}, py::arg("input_names") = std::vector<std::string>{},
+           py::arg("measurement_names") = std::vector<std::string>{})
+      .def_property_readonly("discretization", [](const models::LinearModel& m) {
+        return m.discretization() == models::Discretization::Exact ? "exact" : "euler";
+      });
+
+  py::class_<models::FunctionModel, Model, std::shared_ptr<models::FunctionModel>>(
+      models, "_FunctionModel", "Base of gssm.models.PythonModel (use that).")
+      .def(py::init(&makePythonModel), py::arg("nc"), py::arg("nb"), py::arg("nu"), py::arg("ny"), py::arg("f"),
+           py::arg("h"), py::arg("Q"), py::arg("R"), py::arg("T"), py::arg("prior_state_mean") = py::none(),
+           py::arg("prior_state_cov") = py::none(), py::arg("prior_constants_mean") = py::none(),
+           py::arg("prior_constants_cov") = py::none(), py::arg("jacobian_f") = py::none(),
+           py::arg("jacobian_h") = py::none(), py::arg("name") = "user",
+           py::arg("state_names") = std::vector<std::string>{}, py::arg("constant_names") = std::vector<std::string>{},
+           py::arg("input_names") = std::vector<std::string>{},
+           py::arg("measurement_names") = std::vector<std::string>{}, py::arg("verify_jacobians") = false)
+      .def_property_readonly("jacobian_source", &models::FunctionModel::jacobianSource);
+}
+
+}  // namespace gssm::python
