@@ -4,6 +4,7 @@
 #include "gssm/io/config.h"
 #include "gssm/io/csv.h"
 #include "gssm/io/ini.h"
+#include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
 
 using namespace gssm;
@@ -146,4 +147,47 @@ TEST(Config, MethodNamesAreParsedAtTheEdge) {
   EXPECT_EQ(parseMethod("batch", "option --method"), Method::Batch);
   expectInputError([] { parseMethod("kalman", "option --method"); },
                    {"option --method", "'kalman'", "ekf, batch, incremental, fixed-lag, paper-window"});
+}
+
+// The linear model's INI form holds every LinearModel: one without
+// constants, and further channels as [channel.<name>] sections.
+TEST(Config, LinearModelIniRoundTripsChannelsAndNoConstants) {
+  models::LinearSystem sys;
+  sys.A_c = (Eigen::MatrixXd(2, 2) << 0, 1, 0, 0).finished();
+  sys.A_b.setZero(2, 0);
+  sys.C_c = (Eigen::MatrixXd(1, 2) << 1, 0).finished();
+  sys.C_b.setZero(1, 0);
+  sys.noise.T = 0.1;
+  sys.noise.Q = Eigen::Matrix2d::Identity() * 1e-3;
+  sys.noise.R = Eigen::MatrixXd::Constant(1, 1, 0.25);
+  sys.noise.prior_state = {Eigen::Vector2d(0, 1), Eigen::Matrix2d::Identity()};
+  sys.noise.prior_constants = {Eigen::VectorXd(0), Eigen::MatrixXd(0, 0)};
+  models::LinearChannel gps;
+  gps.name = "gps";
+  gps.C_c = (Eigen::MatrixXd(2, 2) << 1, 0, 0, 1).finished();
+  gps.C_b.setZero(2, 0);
+  gps.R = Eigen::Matrix2d::Identity() * 4;
+  sys.channels.push_back(gps);
+  const models::LinearModel model(sys);
+  IniDocument ini;
+  writeModel(model, ini);
+  const auto back = makeModel(IniDocument::parse(ini.toString(), "<written>"));
+  ASSERT_EQ(back->dims().nb, 0);
+  ASSERT_EQ(back->numChannels(), 2);
+  EXPECT_EQ(back->channel(1).name, "gps");
+  EXPECT_EQ(back->channel(1).R, gps.R);
+  const Eigen::Vector2d x(3, -2);
+  EXPECT_EQ(back->h(1, x, Eigen::VectorXd(0)), model.h(1, x, Eigen::VectorXd(0)));
+  IniDocument again;
+  writeModel(*back, again);
+  EXPECT_EQ(again.toString(), ini.toString());
+  // a channel named without its section is named in the error
+  IniDocument broken = IniDocument::parse(ini.toString(), "<broken>");
+  broken.set("model", "channels", "gps wheel");
+  EXPECT_THROW(
+      try { makeModel(broken); } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("[channel.wheel]"), std::string::npos) << e.what();
+        throw;
+      },
+      InputError);
 }

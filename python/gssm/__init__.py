@@ -113,3 +113,8 @@ def simulate(scenario="paper", seed=1, steps=400, **kwargs):
                                   % (sorted(kwargs), scenario))
         return _gssm.io.simulate_scenario(scenario, seed, steps)
     return _gssm.io.simulate_model(scenario, seed, steps, **kwargs)
+
+
+def _restore_pickled(model, data):
+    """Unpickles an Estimator (pickled as its model and a checkpoint)."""
+    return _gssm.restore_bytes(model, data)

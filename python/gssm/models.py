@@ -57,3 +57,8 @@ class PythonModel(_gssm.models._FunctionModel):
 def _rebuild_python_model(args):
     args = dict(args)
     return PythonModel(args.pop("f"), args.pop("h"), **args)
+
+
+def _from_ini_pickled(text):
+    """Unpickles a built-in model (pickled through its INI form)."""
+    return from_ini(text)

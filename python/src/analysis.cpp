@@ -44,9 +44,9 @@ void bindAnalysis(py::module_& a) {
         MatrixXd err(static_cast<Eigen::Index>(e.error.size()), static_cast<Eigen::Index>(e.components.size()));
         for (std::size_t i = 0; i < e.error.size(); ++i) err.row(static_cast<Eigen::Index>(i)) = e.error[i].transpose();
         py::dict d;
-        d["t"] = e.times;
+        d["t"] = toArray(e.times);
         d["error"] = err;
-        d["nees"] = e.nees;
+        d["nees"] = toArray(e.nees);
         d["rmse"] = e.error.empty() ? VectorXd() : e.rmse();
         d["components"] = e.components;
         return d;
@@ -112,7 +112,7 @@ void bindAnalysis(py::module_& a) {
           b = posteriorCramerRao(*model, run, stride);
         }
         py::dict d;
-        d["t"] = b.times;
+        d["t"] = toArray(b.times);
         d["filtering"] = cube(b.filtering);
         d["smoothing"] = cube(b.smoothing);
         return d;

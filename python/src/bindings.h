@@ -25,6 +25,11 @@ void bindIo(py::module_& io);
 void bindAnalysis(py::module_& analysis);
 void bindCampaign(py::module_& campaign);
 
+/// A std::vector<double> as a 1-D NumPy array (a copy).
+inline py::array_t<double> toArray(const std::vector<double>& v) {
+  return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+}
+
 /// True when the model calls back into Python (a gssm.models.PythonModel):
 /// such a model needs the GIL held while it runs, so loops over it cannot
 /// release it.

@@ -85,7 +85,7 @@ MatrixXd rowsOf(const std::vector<VectorXd>& v) {
 void bindCampaign(py::module_& c) {
   py::class_<MonteCarloSeedResult>(c, "SeedResult", "One seed's run estimated by every method (picklable).")
       .def_readonly("seed", &MonteCarloSeedResult::seed)
-      .def_readonly("times", &MonteCarloSeedResult::times)
+      .def_property_readonly("times", [](const MonteCarloSeedResult& r) { return toArray(r.times); })
       .def_property_readonly("methods",
                              [](const MonteCarloSeedResult& r) {
                                std::vector<std::string> out;
@@ -129,7 +129,7 @@ void bindCampaign(py::module_& c) {
       .def_readonly("mean_nees", &MethodSummary::mean_nees)
       .def_readonly("nees_step_in_interval", &MethodSummary::nees_step_in_interval)
       .def_readonly("beats_ekf", &MethodSummary::beats_ekf)
-      .def_readonly("times", &MethodSummary::times)
+      .def_property_readonly("times", [](const MethodSummary& m) { return toArray(m.times); })
       .def_property_readonly("rmse_over_time", [](const MethodSummary& m) { return rowsOf(m.rmse_over_time); },
                              "(steps, n)")
       .def_readonly("consistency", &MethodSummary::consistency)

@@ -307,7 +307,7 @@ void bindEstimator(py::module_& m) {
           py::arg("path"), py::arg("user_data") = py::bytes(""), "a checkpoint file (atomic write)")
       .def("__reduce__",
            [](const PyEstimator& e) {
-             return py::make_tuple(py::module_::import("gssm._gssm").attr("restore_bytes"),
+             return py::make_tuple(py::module_::import("gssm").attr("_restore_pickled"),
                                    py::make_tuple(std::const_pointer_cast<Model>(e.model),
                                                   py::bytes(checkpointBytes(*e.est))));
            })
@@ -382,8 +382,8 @@ void bindEstimator(py::module_& m) {
                                      v(static_cast<py::ssize_t>(k), i, j) = r.run.rows[k].covariance(i, j);
                                return a;
                              }, "(N, n, n)")
-      .def_property_readonly("nis", [](const PyRun& r) { return r.run.nis; }, "NIS per measurement (compute_nis)")
-      .def_property_readonly("update_seconds", [](const PyRun& r) { return r.run.update_seconds; })
+      .def_property_readonly("nis", [](const PyRun& r) { return toArray(r.run.nis); }, "NIS per measurement (compute_nis)")
+      .def_property_readonly("update_seconds", [](const PyRun& r) { return toArray(r.run.update_seconds); })
       .def_property_readonly("total_seconds", [](const PyRun& r) { return r.run.total_seconds; },
                              "the estimator's own time (the loop in C++)")
       .def_property_readonly("iterations", [](const PyRun& r) { return r.run.iterations; })

@@ -106,7 +106,7 @@ void bindIo(py::module_& io) {
       .def_property_readonly("truth_t",
                              [](const PyDataset& d) -> py::object {
                                if (!d.data.truth) return py::none();
-                               return py::cast(d.data.truth->times);
+                               return toArray(d.data.truth->times);
                              }, "(K,) truth times, or None")
       .def_property_readonly("truth_x",
                              [](const PyDataset& d) -> py::object {
@@ -246,7 +246,7 @@ void bindIo(py::module_& io) {
   io.def(
       "simulate_model",
       [](std::shared_ptr<Model> model, unsigned seed, int steps, const std::optional<VectorXd>& x0,
-         const std::optional<VectorXd>& xb, int measure_every) {
+         const std::optional<VectorXd>& xb, int measure_every, const std::vector<py::object>& channels) {
         if (steps < 1) throw InvalidArgument("simulate: steps must be >= 1");
         PyDataset d;
         d.model = model;
@@ -255,6 +255,12 @@ void bindIo(py::module_& io) {
         spec.x0 = x0;
         spec.xb = xb;
         spec.measure_every = measure_every;
+        if (!channels.empty()) {
+          spec.channels.clear();
+          for (const auto& c : channels)
+            spec.channels.push_back(py::isinstance<py::str>(c) ? model->channelIndex(c.cast<std::string>())
+                                                               : c.cast<int>());
+        }
         d.simulated = std::make_shared<SimulatedRun>(simulate(*model, spec, mrptSampler(seed)));
         try {
           io::writeModel(*model, d.data.scenario);  // writable when the model has an INI form
@@ -264,8 +270,9 @@ void bindIo(py::module_& io) {
         return d;
       },
       py::arg("model"), py::arg("seed") = 1, py::arg("steps") = 400, py::arg("x0") = py::none(),
-      py::arg("xb") = py::none(), py::arg("measure_every") = 1,
-      "A run of `model` simulated with seed (x0, xb drawn from the priors unless given).");
+      py::arg("xb") = py::none(), py::arg("measure_every") = 1, py::arg("channels") = std::vector<py::object>{},
+      "A run of `model` simulated with seed (x0, xb drawn from the priors unless given); channels: the "
+      "channels (names or indices) measured in turn (default: the first).");
 }
 
 }  // namespace gssm::python

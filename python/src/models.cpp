@@ -203,7 +203,8 @@ void bindModels(py::module_& models) {
       .def_property_readonly("measurement_names", [](const Model& m) { return m.names().measurement; })
       .def_property_readonly("stacked_state_names", &Model::stackedStateNames, "names of [x_c; x_b]")
       .def_property_readonly("T", &Model::nominalStep, "nominal step (s)")
-      .def_property_readonly("Q", [](const Model& m) { return m.noise().Q; }, "process noise of one nominal step")
+      .def_property_readonly("Q", [](const Model& m) { return m.processNoise(m.nominalStep()); },
+                             "process noise covariance of one nominal step T")
       .def_property_readonly("R", &Model::measurementNoise, "noise covariance of the default channel")
       .def_property_readonly("prior_state",
                              [](const Model& m) { return py::make_tuple(m.priorState().mean, m.priorState().covariance); },
@@ -273,7 +274,7 @@ void bindModels(py::module_& models) {
       .def("to_ini", &modelIni, "the model's INI form ([model], [noise], [prior]), as gssm-process reads it")
       .def("__reduce__",
            [](const Model& m) {
-             return py::make_tuple(py::module_::import("gssm._gssm.models").attr("from_ini"),
+             return py::make_tuple(py::module_::import("gssm.models").attr("_from_ini_pickled"),
                                    py::make_tuple(modelIni(m)));
            })
       .def("__repr__", [](const Model& m) {

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 namespace gssm::io {
 
@@ -144,14 +145,29 @@ std::unique_ptr<Model> makeModel(const IniDocument& ini, const std::string& data
   }
   if (type == "linear") {
     ini.requireOnlyKeys("model", {"type", "T", "Q", "R", "A_c", "A_b", "B", "C_c", "C_b",
-                                  "discretization"});
+                                  "discretization", "channels"});
     models::LinearSystem s;
     s.A_c = ini.getMatrix("model", "A_c");
     const auto nc = s.A_c.rows();
-    s.A_b = ini.getMatrix("model", "A_b");
     s.C_c = ini.getMatrix("model", "C_c");
-    s.C_b = ini.getMatrix("model", "C_b");
+    // No A_b and C_b: a model without constants (n_b = 0).
+    s.A_b = ini.has("model", "A_b") ? ini.getMatrix("model", "A_b") : Eigen::MatrixXd::Zero(nc, 0);
+    s.C_b = ini.has("model", "C_b") ? ini.getMatrix("model", "C_b") : Eigen::MatrixXd::Zero(s.C_c.rows(), 0);
     s.B = ini.has("model", "B") ? ini.getMatrix("model", "B") : Eigen::MatrixXd::Zero(nc, 0);
+    // Further sensors: channels = gps wheel, each in its own [channel.<name>].
+    std::istringstream names(ini.getString("model", "channels", ""));
+    for (std::string name; names >> name;) {
+      const std::string section = "channel." + name;
+      if (!ini.hasSection(section))
+        throw InputError(ini.source() + ": [model] channels names '" + name + "' but there is no [" + section + "]");
+      ini.requireOnlyKeys(section, {"C_c", "C_b", "R"});
+      models::LinearChannel c;
+      c.name = name;
+      c.C_c = ini.getMatrix(section, "C_c");
+      c.C_b = ini.has(section, "C_b") ? ini.getMatrix(section, "C_b") : Eigen::MatrixXd::Zero(c.C_c.rows(), 0);
+      c.R = ini.getMatrix(section, "R");
+      s.channels.push_back(std::move(c));
+    }
     s.noise = readNoise(ini, static_cast<int>(nc), static_cast<int>(s.A_b.cols()),
                         static_cast<int>(s.C_c.rows()));
     const std::string disc = ini.getString("model", "discretization", "euler");
@@ -236,10 +252,18 @@ void writeModel(const Model& model, IniDocument& ini) {
   if (const auto* lin = dynamic_cast<const models::LinearModel*>(&model)) {
     const auto& s = lin->system();
     ini.set("model", "A_c", s.A_c);
-    ini.set("model", "A_b", s.A_b);
+    if (s.A_b.cols() > 0) ini.set("model", "A_b", s.A_b);
     if (s.B.size()) ini.set("model", "B", s.B);
     ini.set("model", "C_c", s.C_c);
-    ini.set("model", "C_b", s.C_b);
+    if (s.C_b.cols() > 0) ini.set("model", "C_b", s.C_b);
+    std::string channels;
+    for (const auto& c : s.channels) {
+      channels += (channels.empty() ? "" : " ") + c.name;
+      ini.set("channel." + c.name, "C_c", c.C_c);
+      if (c.C_b.cols() > 0) ini.set("channel." + c.name, "C_b", c.C_b);
+      ini.set("channel." + c.name, "R", c.R);
+    }
+    if (!channels.empty()) ini.set("model", "channels", channels);
     ini.set("model", "discretization",
             lin->discretization() == models::Discretization::Exact ? "exact" : "euler");
   } else if (const auto* nav = dynamic_cast<const models::Nav2D*>(&model)) {

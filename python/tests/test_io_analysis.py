@@ -1,0 +1,70 @@
+"""Datasets round-trip through NumPy and back to the bytes gssm-simulate
+writes; the analysis arrays equal what gssm-process reports."""
+import filecmp
+import json
+import os
+
+import numpy as np
+import pytest
+
+import gssm
+from conftest import run_app
+
+
+def test_simulate_writes_the_bundled_dataset_bit_for_bit(repo, tmp_path):
+    gssm.io.write_dataset(str(tmp_path), gssm.simulate("paper", seed=1, steps=400))
+    for f in ("measurements.csv", "truth.csv", "scenario.ini"):
+        assert filecmp.cmp(tmp_path / f, os.path.join(repo, "datasets", "radar-paper", f), shallow=False), f
+
+
+def test_read_back_and_from_arrays(repo, tmp_path):
+    data = gssm.io.read_dataset(os.path.join(repo, "datasets", "radar-paper"))
+    gssm.io.write_dataset(str(tmp_path), data)
+    again = gssm.io.read_dataset(str(tmp_path))
+    assert np.array_equal(again.t, data.t) and np.array_equal(again.y, data.y)
+    assert np.array_equal(again.truth_x, data.truth_x)
+    arrays = gssm.io.from_arrays(data.t, data.y[:, 0], truth_t=data.truth_t, truth_x=data.truth_x)
+    a = gssm.run(gssm.models.Radar2D(), arrays, method="fixed-lag")
+    b = gssm.run(gssm.models.Radar2D(), data, method="fixed-lag")
+    assert np.array_equal(a.mean, b.mean)
+
+
+def test_plaza_layout(repo):
+    data = gssm.io.read_dataset(os.path.join(repo, "datasets", "plaza2"))
+    model = data.model
+    assert data.rows_at_inputs and len(model.channels) > 1
+    assert data.u.shape == (len(data.input_t), model.nu)
+    assert set(np.unique(data.channel)) <= set(range(len(model.channels)))
+    assert data.truth_components == [0, 1]
+    assert "range_scale" in model.constant_names or model.nb >= 1
+
+
+def test_metrics_equal_gssm_process(repo, gssm_process, tmp_path):
+    d = os.path.join(repo, "datasets", "radar-paper")
+    run_app(gssm_process, "--data", d, "--method", "all", "--out", tmp_path)
+    cpp = json.load(open(tmp_path / "metrics.json"))["methods"]
+    data = gssm.io.read_dataset(d)
+    for method in gssm.methods():
+        run = gssm.run(data.model, data, method=method)
+        m = gssm.analysis.metrics(data.model, run, data)
+        e = gssm.analysis.errors(run, data)
+        np.testing.assert_array_equal(e["rmse"], m["rmse"])
+        assert e["error"].shape == (400, 3) and e["nees"].shape == (400,)
+        assert np.isclose(np.mean(e["nees"]), m["mean_nees"], rtol=1e-12)
+        rmse_cpp = np.array([cpp[method]["rmse"][n] for n in m["names"]])
+        np.testing.assert_allclose(m["rmse"], rmse_cpp, rtol=1e-9)
+        assert np.isclose(m["mean_nees"], cpp[method]["mean_nees"], rtol=1e-9)
+
+
+def test_bounds_and_identifiability():
+    data = gssm.simulate("consistent", seed=2, steps=200)
+    model = data.model
+    b = gssm.analysis.cramer_rao(model, data)
+    assert b["filtering"].shape == (200, 3, 3) and b["smoothing"].shape == (200, 3, 3)
+    # smoothing uses more data: never a larger bound
+    assert np.all(b["smoothing"][:, 0, 0] <= b["filtering"][:, 0, 0] * (1 + 1e-9))
+    run = gssm.run(model, data, method="batch")
+    ident = gssm.analysis.identifiability(model, run.covariance[-1][1:, 1:])
+    assert ident["rank"] == 2 and ident["determined"]
+    lo, hi = gssm.analysis.nees_interval(3, runs=1)
+    assert np.isclose(lo, gssm.analysis.chi2_quantile(0.025, 3)) and lo < 3 < hi
