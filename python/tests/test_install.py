@@ -1,0 +1,26 @@
+"""After `cmake --install`, the README's lines run against the installed
+package (not the build tree's), and it finds the installed gssm-process."""
+import glob
+import os
+import subprocess
+import sys
+
+from conftest import BUILD
+from test_contract import readme_snippet
+
+
+def test_installed_package_runs_the_readme_lines(repo, tmp_path):
+    prefix = tmp_path / "prefix"
+    subprocess.run(["cmake", "--install", BUILD, "--prefix", str(prefix)], check=True, capture_output=True)
+    packages = glob.glob(str(prefix / "lib" / "python3*" / "dist-packages"))
+    assert len(packages) == 1, packages
+    code = ("import gssm, os\n" + readme_snippet(repo) +
+            "\nprint(gssm.__file__)\nfrom gssm import _paths\nprint(_paths.GSSM_PROCESS)\n")
+    env = dict(os.environ, PYTHONPATH=packages[0])
+    proc = subprocess.run([sys.executable, "-c", code], cwd=repo, env=env, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    module, process = proc.stdout.split()[-2:]
+    assert module.startswith(str(prefix)), module
+    assert process == str(prefix / "bin" / "gssm-process") and os.path.exists(process)
+    for stub in ("__init__.pyi", "models.pyi", "io.pyi", "analysis.pyi", "campaign.pyi", "py.typed"):
+        assert os.path.exists(os.path.join(packages[0], "gssm", stub)), stub
