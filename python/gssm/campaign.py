@@ -82,7 +82,7 @@ def _run_seed(scenario, seed):
 
 
 def monte_carlo(scenarios="paper", seeds=100, *, first_seed=1, steps=400, methods=None, window=None,
-                estimator_config=None, client=None, workers=None, retries=3, progress=True):
+                estimator_config=None, client=None, workers=None, retries=3, progress=True, on_result=None):
     """A Monte Carlo campaign: every seed of every scenario with every method.
 
     scenarios: a built-in scenario name (gssm.io.scenarios()), a Scenario, or
@@ -95,6 +95,8 @@ def monte_carlo(scenarios="paper", seeds=100, *, first_seed=1, steps=400, method
     address ("tcp://host:8786"), a distributed.Client, or False (this
     process, no Dask: gssm-montecarlo's thread pool, on `workers` threads).
     retries: times Dask retries a seed whose worker died.
+    progress: a progress bar on stderr; on_result: a callable(scenario name,
+    SeedResult) called in the client as each seed arrives (Dask runs only).
     """
     single = not isinstance(scenarios, (list, tuple))
     wanted = [scenarios] if single else list(scenarios)
@@ -111,13 +113,13 @@ def monte_carlo(scenarios="paper", seeds=100, *, first_seed=1, steps=400, method
         for s in built:
             results[s.name] = s.run_local(seeds, first_seed, workers or os.cpu_count() or 1)
     else:
-        results = _dask_monte_carlo(built, seeds, first_seed, client, workers, retries, progress)
+        results = _dask_monte_carlo(built, seeds, first_seed, client, workers, retries, progress, on_result)
     for r in results.values():
         r.seconds = time.perf_counter() - start
     return results[built[0].name] if single else results
 
 
-def _dask_monte_carlo(built, seeds, first_seed, client, workers, retries, progress):
+def _dask_monte_carlo(built, seeds, first_seed, client, workers, retries, progress, on_result):
     from distributed import as_completed
     token = uuid.uuid4().hex[:8]
     with _client(client, workers) as c:
@@ -137,6 +139,8 @@ def _dask_monte_carlo(built, seeds, first_seed, client, workers, retries, progre
             got[name][result.seed] = result
             future.release()
             bar.step()
+            if on_result:
+                on_result(name, result)
     out = {}
     for s in built:
         ordered = [got[s.name][seed] for seed in range(first_seed, first_seed + seeds)]

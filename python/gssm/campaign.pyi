@@ -1,4 +1,4 @@
-from typing import Dict, List, Optional, Sequence, Union
+from typing import Callable, Dict, List, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -67,8 +67,9 @@ def local_cluster(workers: Optional[int] = None, threads_per_worker: int = 1) ->
 def monte_carlo(scenarios: Union[str, Scenario, Sequence[Union[str, Scenario]]] = "paper", seeds: int = 100, *,
                 first_seed: int = 1, steps: int = 400, methods: Optional[Sequence[str]] = None,
                 window: Optional[int] = None, estimator_config: Optional[str] = None, client: object = None,
-                workers: Optional[int] = None, retries: int = 3,
-                progress: bool = True) -> Union[MonteCarloResult, Dict[str, MonteCarloResult]]: ...
+                workers: Optional[int] = None, retries: int = 3, progress: bool = True,
+                on_result: Optional[Callable[[str, SeedResult], None]] = None
+                ) -> Union[MonteCarloResult, Dict[str, MonteCarloResult]]: ...
 def save_monte_carlo(result: MonteCarloResult, out: str, command: Optional[str] = None) -> List[str]: ...
 def process_folder(folder: str, out: str, *, method: str = "all", window: Optional[int] = None,
                    args: Sequence[str] = (), client: object = None, workers: Optional[int] = None,

@@ -44,33 +44,34 @@ def test_cluster_equals_single_process_and_the_cpp_app(client, tmp_path):
 
 def test_killed_worker_still_completes_every_seed_once(client):
     pids = client.run(os.getpid)
+    seeds = 40
+    arrived = []
+    two_done = threading.Event()
     killed = {}
 
-    def kill_one_worker():
-        # after the first seeds finished, while the campaign is running
-        deadline = time.time() + 60
-        while time.time() < deadline:
-            done = client.run_on_scheduler(
-                lambda dask_scheduler: sum(1 for ts in dask_scheduler.tasks.values()
-                                           if ts.key.startswith("gssm-mc") and ts.state == "memory"))
-            if done >= 2:
-                break
-            time.sleep(0.05)
-        addr, pid = sorted(pids.items())[0]
-        killed["at_memory"] = done
-        os.kill(pid, signal.SIGKILL)
-        killed["pid"] = pid
+    def on_result(name, result):
+        arrived.append(result.seed)
+        if len(arrived) >= 2:
+            two_done.set()
 
-    seeds = 40
+    def kill_one_worker():  # after the first seeds arrived, while the campaign runs
+        if not two_done.wait(60):
+            return
+        addr, pid = sorted(pids.items())[0]
+        os.kill(pid, signal.SIGKILL)
+        killed["arrived"] = len(arrived)
+
     killer = threading.Thread(target=kill_one_worker)
     killer.start()
-    res = gc.monte_carlo("paper", seeds=seeds, steps=400, window=10, client=client, progress=False)
+    res = gc.monte_carlo("paper", seeds=seeds, steps=400, window=10, client=client, progress=False,
+                         on_result=on_result)
     killer.join()
-    assert "pid" in killed, "the worker was not killed"
-    assert killed["at_memory"] < seeds, "the campaign had finished before the kill"
+    assert "arrived" in killed, "the worker was not killed"
+    assert killed["arrived"] < seeds, "the campaign had finished before the kill"
+    assert sorted(arrived) == list(range(1, seeds + 1))  # every seed once
     ref = gc.monte_carlo("paper", seeds=seeds, steps=400, window=10, client=False, workers=1)
-    same(res, ref)  # every seed present exactly once (summarize checks the seed order)
-    assert res.seeds == seeds
+    same(res, ref)
+    assert client.run(os.getpid) != pids  # the nanny replaced the killed worker
 
 
 def test_process_folder_on_dask_writes_what_gssm_process_writes(repo, client, gssm_process, tmp_path):

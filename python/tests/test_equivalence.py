@@ -98,3 +98,21 @@ def test_channels_and_inputs_in_a_python_loop(repo):
     run = gssm.run(model, data, method="fixed-lag")  # rows at the odometry times
     assert est.time == run.t[-1]
     np.testing.assert_allclose(est.current().mean, run.mean[-1], rtol=0, atol=1e-9)
+
+
+def test_measurement_with_its_own_R_and_progress(repo):
+    """add_measurement(R=...) equals a model whose channel has that R; the
+    progress callback of gssm.run sees every measurement."""
+    data = gssm.io.read_dataset(os.path.join(repo, "datasets", "radar-paper"))
+    noisy = gssm.models.Radar2D(r=36.0)
+    for method in gssm.methods(streaming_only=True):
+        a = gssm.make_estimator(gssm.models.Radar2D(), method)
+        b = gssm.make_estimator(noisy, method)
+        for t, y in zip(data.t[:120], data.y[:120]):
+            a.add_measurement(t, y, R=[[36.0]])
+            b.add_measurement(t, y)
+        np.testing.assert_allclose(a.current().mean, b.current().mean, rtol=1e-12, err_msg=method)
+        np.testing.assert_allclose(a.current().covariance, b.current().covariance, rtol=1e-9, err_msg=method)
+    seen = []
+    gssm.run(data.model, data, method="ekf", progress=lambda done, total: seen.append((done, total)))
+    assert seen and seen[-1] == (400, 400)
