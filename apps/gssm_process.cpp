@@ -28,14 +28,15 @@ void writeEstimates(const std::string& path, const gssm::Model& model, const gss
   const auto names = model.stackedStateNames();
   for (const auto& n : names) header.push_back(n);
   for (const auto& n : names) header.push_back("sd_" + n);
-  std::vector<std::vector<double>> rows;
+  gssm::io::CsvWriter out(path, header);
+  std::vector<double> row;
   for (const auto& r : run.rows) {
-    std::vector<double> row{r.t};
+    row.assign(1, r.t);
     for (Eigen::Index i = 0; i < r.mean.size(); ++i) row.push_back(r.mean[i]);
     for (Eigen::Index i = 0; i < r.mean.size(); ++i) row.push_back(std::sqrt(r.covariance(i, i)));
-    rows.push_back(std::move(row));
+    out.row(row);
   }
-  gssm::io::writeCsv(path, header, rows);
+  out.flush();
 }
 
 }  // namespace

@@ -1,9 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+
 #include "gssm/core/error.h"
 #include "gssm/io/config.h"
 #include "gssm/io/csv.h"
 #include "gssm/io/ini.h"
+#include "gssm/io/number_text.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
 
@@ -190,4 +196,61 @@ TEST(Config, LinearModelIniRoundTripsChannelsAndNoConstants) {
         throw;
       },
       InputError);
+}
+
+// The fast number formatting (std::to_chars) writes exactly what the printf
+// loop it replaced wrote (the shortest "%.Pg", P >= 6, that reads back), so
+// files stay byte-identical; and every double reads back to its bits.
+TEST(NumberText, SameTextAsThePrintfLoopAndExactRoundTrip) {
+  auto printfLoop = [](double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    for (int prec = 6; prec < 17; ++prec) {
+      char shorter[40];
+      std::snprintf(shorter, sizeof shorter, "%.*g", prec, v);
+      if (std::strtod(shorter, nullptr) == v) return std::string(shorter);
+    }
+    return std::string(buf);
+  };
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> mantissa(-1, 1);
+  std::uniform_int_distribution<int> exponent(-30, 30);
+  std::vector<double> values{0.1, 1e-5, 1e-4, 1e5, 123456, 1234567, 1e21, 5e-324, 2.2250738585072014e-308,
+                             1.7976931348623157e308, -0.001, 1e15, 1e16, 1e17, 9.0, 0.05, 2.5e-05};
+  for (int i = 0; i < 30000; ++i) values.push_back(mantissa(rng) * std::pow(10.0, exponent(rng)));
+  for (int i = 0; i < 30000; ++i) {
+    const std::uint64_t bits = rng();
+    double d;
+    std::memcpy(&d, &bits, sizeof d);
+    if (std::isfinite(d)) values.push_back(d);
+  }
+  int mismatches = 0;
+  for (double v : values) {
+    const std::string text = formatDouble(v);
+    double back = 0;
+    EXPECT_TRUE(parseDouble(text.data(), text.data() + text.size(), back)) << text;
+    if (text != printfLoop(v) || back != v) {
+      if (++mismatches < 5) ADD_FAILURE() << v << ": '" << text << "' vs printf '" << printfLoop(v) << "'";
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  double x = 0;
+  EXPECT_TRUE(parseDouble("+2.5", "+2.5" + 4, x) && x == 2.5);
+  for (const char* bad : {"", "+", "1.5x", " 1", "0x10", "1e999"}) {
+    const std::string s(bad);
+    EXPECT_FALSE(parseDouble(s.data(), s.data() + s.size(), x)) << "'" << s << "'";
+  }
+}
+
+TEST(Csv, WriteThenReadGivesTheSameDoubles) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01;
+  std::vector<std::vector<double>> rows(2000, std::vector<double>(4));
+  for (auto& r : rows)
+    for (double& v : r) v = n01(rng) * std::pow(10.0, static_cast<int>(rng() % 20) - 10);
+  const std::string path = ::testing::TempDir() + "/gssm_csv_roundtrip.csv";
+  writeCsv(path, {"a", "b", "c", "d"}, rows);
+  const CsvTable t = readCsv(path);
+  ASSERT_EQ(t.rows.size(), rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_EQ(t.rows[i], rows[i]) << "row " << i;
 }

@@ -18,11 +18,14 @@ constexpr int kCharW = 6, kCharH = 13;  // the "6x13" bitmap font
 
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
   const double pos = q * static_cast<double>(v.size() - 1);
   const auto i = static_cast<std::size_t>(pos);
   const auto j = std::min(i + 1, v.size() - 1);
-  return v[i] + (pos - static_cast<double>(i)) * (v[j] - v[i]);
+  // Selection, not a sort: O(n) for the 10⁵ latencies of a long run.
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(i), v.end());
+  const double vi = v[i];
+  const double vj = j == i ? vi : *std::min_element(v.begin() + static_cast<std::ptrdiff_t>(i) + 1, v.end());
+  return vi + (pos - static_cast<double>(i)) * (vj - vi);
 }
 
 // Maps data to pixels inside the plot rectangle.
@@ -110,6 +113,85 @@ void drawBand(mrpt::img::CImage& img, const Axes& ax, const Band& b) {
   }
 }
 
+// What a PNG can show of a long series: x increasing, at most first, min,
+// max and last of each of `buckets` equal slices of x (the line drawn
+// through them covers the same pixels as through all points). Other
+// series: a point is kept when it leaves the cell of the last kept one on a
+// `buckets` × `buckets` grid over its range.
+Series decimated(const Series& s, int buckets) {
+  const std::size_t n = std::min(s.x.size(), s.y.size());
+  if (n <= static_cast<std::size_t>(4 * buckets)) return s;
+  Series out = s;
+  out.x.clear();
+  out.y.clear();
+  const bool increasing = std::is_sorted(s.x.begin(), s.x.begin() + static_cast<std::ptrdiff_t>(n));
+  auto range = [&](const std::vector<double>& v) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (std::size_t i = 0; i < n; ++i)
+      if (std::isfinite(v[i])) lo = std::min(lo, v[i]), hi = std::max(hi, v[i]);
+    return std::make_pair(lo, hi > lo ? hi : lo + 1);
+  };
+  const auto [x0, x1] = range(s.x);
+  auto cell = [&](double v, double lo, double hi) {
+    return std::isfinite(v) ? static_cast<long>((v - lo) / (hi - lo) * buckets) : -1;
+  };
+  if (increasing) {
+    std::size_t i = 0;
+    while (i < n) {
+      const long b = cell(s.x[i], x0, x1);
+      std::size_t j = i, lo = i, hi = i;
+      for (; j < n && cell(s.x[j], x0, x1) == b; ++j) {
+        if (!std::isfinite(s.y[j])) continue;
+        if (!std::isfinite(s.y[lo]) || s.y[j] < s.y[lo]) lo = j;
+        if (!std::isfinite(s.y[hi]) || s.y[j] > s.y[hi]) hi = j;
+      }
+      std::size_t keep[4] = {i, std::min(lo, hi), std::max(lo, hi), j - 1};
+      std::size_t last = n;
+      for (std::size_t k : keep)
+        if (k != last) {
+          out.x.push_back(s.x[k]);
+          out.y.push_back(s.y[k]);
+          last = k;
+        }
+      i = j;
+    }
+    return out;
+  }
+  const auto [y0, y1] = range(s.y);
+  long cx = -2, cy = -2;
+  for (std::size_t i = 0; i < n; ++i) {
+    const long bx = cell(s.x[i], x0, x1), by = cell(s.y[i], y0, y1);
+    if (bx != cx || by != cy || i + 1 == n) {
+      out.x.push_back(s.x[i]);
+      out.y.push_back(s.y[i]);
+      cx = bx, cy = by;
+    }
+  }
+  return out;
+}
+
+// A band: per slice of x, the lowest lo and the highest hi.
+Band decimated(const Band& b, int buckets) {
+  const std::size_t n = std::min({b.x.size(), b.lo.size(), b.hi.size()});
+  if (n <= static_cast<std::size_t>(4 * buckets) || !std::is_sorted(b.x.begin(), b.x.begin() + static_cast<std::ptrdiff_t>(n)))
+    return b;
+  Band out = b;
+  out.x.clear(), out.lo.clear(), out.hi.clear();
+  const double x0 = b.x.front(), x1 = b.x[n - 1] > x0 ? b.x[n - 1] : x0 + 1;
+  for (std::size_t i = 0; i < n;) {
+    const long c = static_cast<long>((b.x[i] - x0) / (x1 - x0) * buckets);
+    double lo = b.lo[i], hi = b.hi[i];
+    std::size_t j = i;
+    for (; j < n && static_cast<long>((b.x[j] - x0) / (x1 - x0) * buckets) == c; ++j)
+      lo = std::min(lo, b.lo[j]), hi = std::max(hi, b.hi[j]);
+    out.x.push_back(b.x[i]);
+    out.lo.push_back(lo);
+    out.hi.push_back(hi);
+    i = j;
+  }
+  return out;
+}
+
 void centeredText(mrpt::img::CImage& img, int cx, int y, const std::string& s, TColor c,
                   int char_w = kCharW) {
   img.textOut(cx - static_cast<int>(s.size()) * char_w / 2, y, s, c);
@@ -123,7 +205,13 @@ Color paletteColor(std::size_t i) {
   return p[i % 10];
 }
 
-void savePng(const Figure& fig, const std::string& path, int width, int height) {
+void savePng(const Figure& figure, const std::string& path, int width, int height) {
+  // Long runs (10⁵ points and more) are decimated first to what `width`
+  // pixels can show: drawing cost and the axis quantiles then do not grow
+  // with the run.
+  Figure fig = figure;
+  for (auto& s : fig.series) s = decimated(s, 2 * width);
+  for (auto& b : fig.bands) b = decimated(b, 2 * width);
   mrpt::img::CImage img(width, height, mrpt::img::CH_RGB);
   img.filledRectangle(0, 0, width - 1, height - 1, TColor(255, 255, 255));
   img.selectTextFont("6x13");

@@ -1,28 +1,44 @@
 #include "gssm/io/csv.h"
 
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "gssm/core/error.h"
-#include "gssm/io/ini.h"
+#include "gssm/io/number_text.h"
 
 namespace gssm::io {
 
 namespace {
-std::vector<std::string> splitLine(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::stringstream ss(line);
-  while (std::getline(ss, cell, ',')) {
-    const auto b = cell.find_first_not_of(" \t\r");
-    const auto e = cell.find_last_not_of(" \t\r");
-    out.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
-  }
-  if (!line.empty() && line.back() == ',') out.push_back("");
-  return out;
+struct Cell {
+  const char* begin;
+  const char* end;
+  std::string str() const { return std::string(begin, end); }
+  bool empty() const { return begin == end; }
+};
+
+// Splits [b, e) at commas into cells trimmed of spaces, tabs and '\r'.
+void splitLine(const char* b, const char* e, std::vector<Cell>& cells) {
+  cells.clear();
+  auto trimmed = [](const char* cb, const char* ce) {
+    while (cb < ce && (*cb == ' ' || *cb == '\t' || *cb == '\r')) ++cb;
+    while (ce > cb && (ce[-1] == ' ' || ce[-1] == '\t' || ce[-1] == '\r')) --ce;
+    return Cell{cb, ce};
+  };
+  const char* start = b;
+  for (const char* p = b; p < e; ++p)
+    if (*p == ',') {
+      cells.push_back(trimmed(start, p));
+      start = p + 1;
+    }
+  cells.push_back(trimmed(start, e));
+}
+
+bool blank(const char* b, const char* e) {
+  for (; b < e; ++b)
+    if (*b != ' ' && *b != '\t' && *b != '\r') return false;
+  return true;
 }
 }  // namespace
 
@@ -35,31 +51,33 @@ int CsvTable::column(const std::string& name) const {
 CsvTable parseCsv(const std::string& text, const std::string& source, std::vector<CsvRowError>* row_errors) {
   CsvTable t;
   t.source = source;
-  std::stringstream ss(text);
-  std::string line;
   int lineno = 0;
   bool have_header = false;
-  while (std::getline(ss, line)) {
+  std::vector<Cell> cells;
+  const char* p = text.data();
+  const char* const text_end = p + text.size();
+  while (p < text_end) {
+    const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(text_end - p)));
+    if (!eol) eol = text_end;
+    const char* line_begin = p;
+    const char* line_end = eol;
+    p = eol + 1;
     ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos) continue;
-    std::vector<std::string> cells = splitLine(line);
+    if (blank(line_begin, line_end)) continue;
+    splitLine(line_begin, line_end, cells);
     if (!have_header) {
       for (std::size_t i = 0; i < cells.size(); ++i) {
-        double dummy;
-        char* end = nullptr;
-        dummy = std::strtod(cells[i].c_str(), &end);
-        (void)dummy;
-        if (cells[i].empty() || (end == cells[i].c_str() + cells[i].size()))
+        double number;
+        if (cells[i].empty() || parseDouble(cells[i].begin, cells[i].end, number))
           throw InputError(source + ":" + std::to_string(lineno) + ": header expected (column " +
-                           std::to_string(i + 1) + " is '" + cells[i] +
+                           std::to_string(i + 1) + " is '" + cells[i].str() +
                            "'); the first line must name the columns, e.g. t,range");
+        t.header.push_back(cells[i].str());
         for (std::size_t j = 0; j < i; ++j)
-          if (cells[j] == cells[i])
-            throw InputError(source + ":" + std::to_string(lineno) + ": column '" + cells[i] +
+          if (t.header[j] == t.header[i])
+            throw InputError(source + ":" + std::to_string(lineno) + ": column '" + t.header[i] +
                              "' appears twice in the header");
       }
-      t.header = std::move(cells);
       have_header = true;
       continue;
     }
@@ -75,16 +93,11 @@ CsvTable parseCsv(const std::string& text, const std::string& source, std::vecto
     std::vector<double> row(cells.size());
     bool ok = true;
     for (std::size_t i = 0; i < cells.size() && ok; ++i) {
-      errno = 0;
-      char* end = nullptr;
-      const double v = std::strtod(cells[i].c_str(), &end);
-      if (cells[i].empty() || end != cells[i].c_str() + cells[i].size() || errno == ERANGE ||
-          !std::isfinite(v)) {
-        bad(source + ":" + std::to_string(lineno) + ": column '" + t.header[i] + "': value '" + cells[i] +
+      if (!parseDouble(cells[i].begin, cells[i].end, row[i]) || !std::isfinite(row[i])) {
+        bad(source + ":" + std::to_string(lineno) + ": column '" + t.header[i] + "': value '" + cells[i].str() +
             "' is not a finite number");
         ok = false;
       }
-      row[i] = v;
     }
     if (!ok) continue;
     t.rows.push_back(std::move(row));
@@ -97,28 +110,83 @@ CsvTable parseCsv(const std::string& text, const std::string& source, std::vecto
 CsvTable readCsv(const std::string& path, std::vector<CsvRowError>* row_errors) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseCsv(ss.str(), path, row_errors);
+  std::string text;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size > 0) {
+    text.resize(static_cast<std::size_t>(size));
+    in.seekg(0);
+    in.read(text.data(), size);
+  }
+  if (!in) throw InputError(path + ": read failed");
+  return parseCsv(text, path, row_errors);
+}
+
+void appendCsvLine(std::string& out, const std::vector<double>& values) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (i) out += ',';
+    appendDouble(out, values[i]);
+  }
 }
 
 std::string csvLine(const std::vector<double>& values) {
   std::string out;
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (i) out += ",";
-    out += formatDouble(values[i]);
-  }
+  appendCsvLine(out, values);
   return out;
+}
+
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header) : path_(path) {
+  file_ = std::fopen(path.c_str(), "wb");
+  if (!file_) throw InputError(path + ": cannot write the file");
+  for (std::size_t i = 0; i < header.size(); ++i) (buffer_ += (i ? "," : "")) += header[i];
+  buffer_ += '\n';
+}
+
+CsvWriter::CsvWriter(const std::string& path, std::uint64_t length) : path_(path), written_(length) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size < length)
+    throw InputError(path + ": cannot continue it at byte " + std::to_string(length) + " (" +
+                     (ec ? ec.message() : "it has only " + std::to_string(size) + " bytes") + ")");
+  std::filesystem::resize_file(path, length, ec);
+  if (ec) throw InputError(path + ": cannot cut it at byte " + std::to_string(length) + ": " + ec.message());
+  file_ = std::fopen(path.c_str(), "ab");
+  if (!file_) throw InputError(path + ": cannot append to the file");
+}
+
+CsvWriter::~CsvWriter() {
+  if (!file_) return;
+  if (!buffer_.empty()) std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
+  std::fclose(file_);
+}
+
+void CsvWriter::row(const double* values, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i) buffer_ += ',';
+    appendDouble(buffer_, values[i]);
+  }
+  buffer_ += '\n';
+  if (buffer_.size() >= (1u << 20)) writeBuffer();  // ~1 MB blocks
+}
+
+void CsvWriter::writeBuffer() {
+  if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+    throw InputError(path_ + ": write failed (disk full?)");
+  written_ += buffer_.size();
+  buffer_.clear();
+}
+
+std::uint64_t CsvWriter::flush() {
+  writeBuffer();
+  if (std::fflush(file_) != 0) throw InputError(path_ + ": write failed (disk full?)");
+  return written_;
 }
 
 void writeCsv(const std::string& path, const std::vector<std::string>& header,
               const std::vector<std::vector<double>>& rows) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError(path + ": cannot write the file");
-  for (std::size_t i = 0; i < header.size(); ++i) out << (i ? "," : "") << header[i];
-  out << "\n";
-  for (const auto& r : rows) out << csvLine(r) << "\n";
-  if (!out) throw InputError(path + ": write failed");
+  CsvWriter out(path, header);
+  for (const auto& r : rows) out.row(r);
+  out.flush();
 }
 
 }  // namespace gssm::io

@@ -86,18 +86,6 @@ bool parseRows(const std::string& value, std::vector<std::vector<double>>& rows,
 }
 }  // namespace
 
-std::string formatDouble(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  // Prefer the shortest representation that round-trips.
-  for (int prec = 6; prec < 17; ++prec) {
-    char shorter[40];
-    std::snprintf(shorter, sizeof shorter, "%.*g", prec, v);
-    if (std::strtod(shorter, nullptr) == v) return shorter;
-  }
-  return buf;
-}
-
 IniDocument IniDocument::parse(const std::string& text, const std::string& source) {
   IniDocument doc;
   doc.source_ = source;

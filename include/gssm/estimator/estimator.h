@@ -125,6 +125,9 @@ class Estimator {
   /// The last call's report; its `detail` line is formatted here, on demand
   /// (formatting it on every update cost 10% of a fixed-lag update).
   const EstimatorReport& report() const;
+  /// The same numbers without formatting `detail` (which may be stale):
+  /// for loops that read a counter after every update.
+  const EstimatorReport& reportNumbers() const { return report_; }
   double time() const { return t_; }
   std::int64_t step() const { return k_; }
   const Model& model() const { return model_; }

@@ -1,5 +1,7 @@
 #pragma once
 // Numeric CSV tables with a header line. Errors name file, line, column and value.
+#include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -30,7 +32,36 @@ CsvTable readCsv(const std::string& path, std::vector<CsvRowError>* row_errors =
 /// Writes header and rows with round-trip number formatting (deterministic).
 void writeCsv(const std::string& path, const std::vector<std::string>& header,
               const std::vector<std::vector<double>>& rows);
+/// Writes a CSV table row by row (nothing held but a ~1 MB buffer), numbers
+/// in the same round-trip format. Errors (InputError) name the file.
+class CsvWriter {
+ public:
+  /// Creates `path` (replacing it) and writes the header line.
+  CsvWriter(const std::string& path, const std::vector<std::string>& header);
+  /// Continues a file this class wrote: cuts it at byte `length` (what
+  /// flush() returned then) and appends from there.
+  CsvWriter(const std::string& path, std::uint64_t length);
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+  ~CsvWriter();  ///< writes what is buffered (call flush() to see errors)
+
+  void row(const double* values, std::size_t n);
+  void row(const std::vector<double>& values) { row(values.data(), values.size()); }
+  /// Hands everything written so far to the operating system; returns the
+  /// file's length in bytes.
+  std::uint64_t flush();
+  const std::string& path() const { return path_; }
+
+ private:
+  void writeBuffer();
+  std::string path_, buffer_;
+  std::FILE* file_ = nullptr;
+  std::uint64_t written_ = 0;
+};
+
 /// One CSV line (no newline) in the same format.
 std::string csvLine(const std::vector<double>& values);
+/// Appends it to `out` (no allocation per number).
+void appendCsvLine(std::string& out, const std::vector<double>& values);
 
 }  // namespace gssm::io

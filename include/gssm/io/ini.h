@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "gssm/io/number_text.h"  // formatDouble, which the INI writer uses
+
 namespace gssm::io {
 
 class IniDocument {
@@ -73,7 +75,5 @@ class IniDocument {
   std::vector<Section> sections_;
 };
 
-/// Formats a double so that it reads back to the same bits.
-std::string formatDouble(double v);
 
 }  // namespace gssm::io
