@@ -252,5 +252,6 @@ TEST(Csv, WriteThenReadGivesTheSameDoubles) {
   writeCsv(path, {"a", "b", "c", "d"}, rows);
   const CsvTable t = readCsv(path);
   ASSERT_EQ(t.rows.size(), rows.size());
-  for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_EQ(t.rows[i], rows[i]) << "row " << i;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    EXPECT_EQ(std::vector<double>(t.rows[i].begin(), t.rows[i].end()), rows[i]) << "row " << i;
 }

@@ -54,6 +54,7 @@ CsvTable parseCsv(const std::string& text, const std::string& source, std::vecto
   int lineno = 0;
   bool have_header = false;
   std::vector<Cell> cells;
+  std::vector<double> row;
   const char* p = text.data();
   const char* const text_end = p + text.size();
   while (p < text_end) {
@@ -79,6 +80,7 @@ CsvTable parseCsv(const std::string& text, const std::string& source, std::vecto
                              "' appears twice in the header");
       }
       have_header = true;
+      t.rows = CsvRows(t.header.size());
       continue;
     }
     auto bad = [&](const std::string& message) {
@@ -90,7 +92,7 @@ CsvTable parseCsv(const std::string& text, const std::string& source, std::vecto
           " fields, the header has " + std::to_string(t.header.size()));
       continue;
     }
-    std::vector<double> row(cells.size());
+    row.resize(cells.size());
     bool ok = true;
     for (std::size_t i = 0; i < cells.size() && ok; ++i) {
       if (!parseDouble(cells[i].begin, cells[i].end, row[i]) || !std::isfinite(row[i])) {
@@ -100,7 +102,7 @@ CsvTable parseCsv(const std::string& text, const std::string& source, std::vecto
       }
     }
     if (!ok) continue;
-    t.rows.push_back(std::move(row));
+    t.rows.push_back(row.data());
     t.line_of_row.push_back(lineno);
   }
   if (!have_header) throw InputError(source + ": empty file (expected a header line and rows)");

@@ -170,6 +170,7 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
     if (by != "name" && by != "index")
       throw InputError(ini.source() + ": [dataset] channel_by = '" + by + "': expected name or index");
     std::size_t next_error = 0;
+    out.measurements.reserve(m.rows.size());
     for (std::size_t r = 0; r < m.rows.size(); ++r) {
       const int line = m.line_of_row[r];
       if (bad_rows == BadRows::Stop && next_error < errors.size() && errors[next_error].line < line) break;
@@ -233,6 +234,7 @@ void readDatasetData(const std::string& dir, const Model& model, Dataset& out, B
                              bad_rows == BadRows::Throw ? nullptr : &errors);
   checkHeader(m, model.names().measurement);
   out.measurements.clear();
+  out.measurements.reserve(m.rows.size());
   // Good rows in file order, with time-order errors found as we go.
   std::size_t next_error = 0;
   for (std::size_t r = 0; r < m.rows.size(); ++r) {
@@ -277,6 +279,8 @@ void readDatasetData(const std::string& dir, const Model& model, Dataset& out, B
     checkTable(t, model.stackedStateNames());
     Truth truth;
     const int n = model.dims().nc + model.dims().nb;
+    truth.times.reserve(t.rows.size());
+    truth.states.reserve(t.rows.size());
     for (const auto& row : t.rows) {
       truth.times.push_back(row[0]);
       truth.states.push_back(Eigen::Map<const Eigen::VectorXd>(row.data() + 1, n));

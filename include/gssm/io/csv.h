@@ -7,10 +7,47 @@
 
 namespace gssm::io {
 
+/// The numbers of a table, row-major in one block (no allocation per row:
+/// a 10⁶-row log reads without a million small vectors).
+class CsvRows {
+ public:
+  /// One row, a view into the block.
+  struct Row {
+    const double* p;
+    std::size_t n;
+    double operator[](std::size_t c) const { return p[c]; }
+    const double* data() const { return p; }
+    std::size_t size() const { return n; }
+    const double* begin() const { return p; }
+    const double* end() const { return p + n; }
+  };
+  struct Iterator {
+    const CsvRows* rows;
+    std::size_t r;
+    Row operator*() const { return (*rows)[r]; }
+    Iterator& operator++() { return ++r, *this; }
+    bool operator!=(const Iterator& o) const { return r != o.r; }
+  };
+  explicit CsvRows(std::size_t columns = 0) : cols_(columns) {}
+  std::size_t size() const { return cols_ ? values_.size() / cols_ : 0; }
+  bool empty() const { return values_.empty(); }
+  Row operator[](std::size_t r) const { return {values_.data() + r * cols_, cols_}; }
+  Row back() const { return (*this)[size() - 1]; }
+  Iterator begin() const { return {this, 0}; }
+  Iterator end() const { return {this, size()}; }
+  /// Appends a row of exactly columns() values.
+  void push_back(const double* values) { values_.insert(values_.end(), values, values + cols_); }
+  std::size_t columns() const { return cols_; }
+
+ private:
+  std::size_t cols_;
+  std::vector<double> values_;
+};
+
 struct CsvTable {
   std::string source;
   std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
+  CsvRows rows;
   std::vector<int> line_of_row;  ///< 1-based file line of each row
   /// Index of a column by name, or -1.
   int column(const std::string& name) const;
