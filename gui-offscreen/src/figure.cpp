@@ -121,9 +121,7 @@ void drawBand(mrpt::img::CImage& img, const Axes& ax, const Band& b) {
 Series decimated(const Series& s, int buckets) {
   const std::size_t n = std::min(s.x.size(), s.y.size());
   if (n <= static_cast<std::size_t>(4 * buckets)) return s;
-  Series out = s;
-  out.x.clear();
-  out.y.clear();
+  Series out{s.label, {}, {}, s.color, s.width, s.dashed};
   const bool increasing = std::is_sorted(s.x.begin(), s.x.begin() + static_cast<std::ptrdiff_t>(n));
   auto range = [&](const std::vector<double>& v) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -175,8 +173,7 @@ Band decimated(const Band& b, int buckets) {
   const std::size_t n = std::min({b.x.size(), b.lo.size(), b.hi.size()});
   if (n <= static_cast<std::size_t>(4 * buckets) || !std::is_sorted(b.x.begin(), b.x.begin() + static_cast<std::ptrdiff_t>(n)))
     return b;
-  Band out = b;
-  out.x.clear(), out.lo.clear(), out.hi.clear();
+  Band out{{}, {}, {}, b.color, b.alpha};
   const double x0 = b.x.front(), x1 = b.x[n - 1] > x0 ? b.x[n - 1] : x0 + 1;
   for (std::size_t i = 0; i < n;) {
     const long c = static_cast<long>((b.x[i] - x0) / (x1 - x0) * buckets);
@@ -205,13 +202,14 @@ Color paletteColor(std::size_t i) {
   return p[i % 10];
 }
 
-void savePng(const Figure& figure, const std::string& path, int width, int height) {
+void savePng(const Figure& fig, const std::string& path, int width, int height) {
   // Long runs (10⁵ points and more) are decimated first to what `width`
   // pixels can show: drawing cost and the axis quantiles then do not grow
   // with the run.
-  Figure fig = figure;
-  for (auto& s : fig.series) s = decimated(s, 2 * width);
-  for (auto& b : fig.bands) b = decimated(b, 2 * width);
+  std::vector<Series> series;
+  std::vector<Band> bands;
+  for (const auto& s : fig.series) series.push_back(decimated(s, 2 * width));
+  for (const auto& b : fig.bands) bands.push_back(decimated(b, 2 * width));
   mrpt::img::CImage img(width, height, mrpt::img::CH_RGB);
   img.filledRectangle(0, 0, width - 1, height - 1, TColor(255, 255, 255));
   img.selectTextFont("6x13");
@@ -219,7 +217,7 @@ void savePng(const Figure& figure, const std::string& path, int width, int heigh
   // ---- ranges --------------------------------------------------------------
   double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
   std::vector<double> ys;
-  for (const auto& s : fig.series)
+  for (const auto& s : series)
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i)
       if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) {
         xmin = std::min(xmin, s.x[i]);
@@ -285,14 +283,14 @@ void savePng(const Figure& figure, const std::string& path, int width, int heigh
   }
 
   // ---- data -----------------------------------------------------------------
-  for (const auto& b : fig.bands) drawBand(img, ax, b);
+  for (const auto& b : bands) drawBand(img, ax, b);
   for (const auto& b : fig.bars) {
     const int x0 = static_cast<int>(std::lround(ax.px(b.x0))), x1 = static_cast<int>(std::lround(ax.px(b.x1)));
     const int y = std::max(ax.top, static_cast<int>(std::lround(ax.py(b.height))));
     for (int col = std::max(x0, ax.left); col < std::min(x1, ax.right); ++col)
       for (int row = y; row < ax.bottom; ++row) blend(img, col, row, b.color, 0.55);
   }
-  for (const auto& s : fig.series) drawSeries(img, ax, s);
+  for (const auto& s : series) drawSeries(img, ax, s);
   img.rectangle(ax.left, ax.top, ax.right, ax.bottom, axis);
 
   // ---- text -----------------------------------------------------------------
@@ -303,7 +301,7 @@ void savePng(const Figure& figure, const std::string& path, int width, int heigh
   img.textOut(ax.left, ax.top - 20, fig.ylabel, text);
 
   std::vector<const Series*> labelled;
-  for (const auto& s : fig.series)
+  for (const auto& s : series)
     if (!s.label.empty()) labelled.push_back(&s);
   if (fig.legend && !labelled.empty()) {
     int w = 0;

@@ -45,6 +45,7 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
       Band b{{}, {}, {}, c, 0.15};
       std::optional<TimeMatcher> match;
       if (truth) match.emplace(truth->times);
+      for (auto* v : {&s.x, &s.y, &b.x, &b.lo, &b.hi}) v->reserve(runs[r].rows.size());
       for (const auto& row : runs[r].rows) {
         double ref = 0;
         if (!constant) {
