@@ -16,6 +16,7 @@
 #include "gssm/io/csv.h"
 #include "gssm/io/dataset.h"
 #include "gssm/io/metrics_json.h"
+#include "gssm/io/run_files.h"
 #include "gssm/analysis/metrics.h"
 #include "gssm/plot/run_figures.h"
 
@@ -23,23 +24,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-void writeEstimates(const std::string& path, const gssm::Model& model, const gssm::OfflineRun& run) {
-  std::vector<std::string> header{"t"};
-  const auto names = model.stackedStateNames();
-  for (const auto& n : names) header.push_back(n);
-  for (const auto& n : names) header.push_back("sd_" + n);
-  gssm::io::CsvWriter out(path, header);
-  std::vector<double> row;
-  for (const auto& r : run.rows) {
-    row.assign(1, r.t);
-    for (Eigen::Index i = 0; i < r.mean.size(); ++i) row.push_back(r.mean[i]);
-    for (Eigen::Index i = 0; i < r.mean.size(); ++i) row.push_back(std::sqrt(r.covariance(i, i)));
-    out.row(row);
+// A run resumed into another output folder continues the files its
+// checkpoint's folder holds: copied here first (the checkpoint records how
+// far they got; RunFiles cuts them there).
+void continueOutputsIn(const std::string& out, const std::string& checkpoint, gssm::Method method) {
+  const fs::path from = fs::absolute(checkpoint).parent_path();
+  if (fs::equivalent(from, fs::absolute(out))) return;
+  for (const auto& name : {gssm::io::RunFiles::estimatesName(method), gssm::io::RunFiles::recordsName(method)}) {
+    if (!fs::exists(from / name))
+      throw std::runtime_error(checkpoint + ": cannot resume: " + (from / name).string() +
+                               " (the output written up to the checkpoint) is missing");
+    fs::copy_file(from / name, fs::path(out) / name, fs::copy_options::overwrite_existing);
   }
-  out.flush();
 }
 
 }  // namespace
+
 
 int main(int argc, char** argv) {
   return gssm::apps::runApp("gssm-process", [&] {
@@ -77,6 +77,10 @@ int main(int argc, char** argv) {
       if (methods.size() != 1 || !gssm::methodInfo(methods[0]).streaming)
         throw std::invalid_argument(std::string("option --resume: resumes one streaming method; the checkpoint's is '") +
                                     gssm::methodName(info.method) + "'");
+      if (methods[0] != info.method)
+        throw std::invalid_argument(resume + ": cannot resume this run: it was written by method '" +
+                                    gssm::methodName(info.method) + "', this run is '" +
+                                    gssm::methodName(methods[0]) + "'");
     }
     const std::size_t checkpoint_every =
         cli.given("checkpoint-every") ? static_cast<std::size_t>(cli.getInt("checkpoint-every", 1, 1000000000)) : 0;
@@ -110,14 +114,21 @@ int main(int argc, char** argv) {
       options.method = method;
       const std::string m = gssm::methodName(method);
       const bool streaming = gssm::methodInfo(method).streaming;
+      // Estimates are written as the run goes; with checkpoints also the
+      // records the metrics need, so that a checkpoint holds only the
+      // estimator and how far these files got.
+      gssm::io::RunFiles files(out, *model, method, streaming && (checkpoint_every > 0 || !resume.empty()));
       gssm::StreamingCheckpoints checkpoints;
       if (streaming) {
         checkpoints = {checkpoint_every ? (fs::path(out) / ("checkpoint-" + m + ".ckpt")).string() : "",
-                       checkpoint_every, resume};
+                       checkpoint_every, resume, &files};
+        if (!resume.empty()) continueOutputsIn(out, resume, method);
       }
       gssm::OfflineRun run =
           gssm::runOffline(*model, options, ds.measurements, ds.inputs, progress(m), checkpoints, rows);
-      writeEstimates((fs::path(out) / ("estimates-" + m + ".csv")).string(), *model, run);
+      if (!streaming)
+        for (const auto& r : run.rows) files.row(r);
+      files.finish();
       metrics.push_back(gssm::computeMetrics(*model, run, ds.truth ? &*ds.truth : nullptr));
       const auto& last = run.rows.back();
       std::cout << std::left << std::setw(7) << m << " final (t = " << last.t << "):";

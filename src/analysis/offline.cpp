@@ -27,9 +27,10 @@ Values stateValues(const Model& model, const StateEstimate& e) {
   return x;
 }
 
-// The run so far, stored as a checkpoint's user data.
-// v2 adds whether a row is due, the down-weighted and gated counts.
-constexpr const char* kRunTag = "gssm offline run v2";
+// A checkpoint's user data: where the run is and its counters, then the
+// recorder's mark (v3; v1/v2 held every row inline and are refused with a
+// message: the run is restarted).
+constexpr const char* kRunTag = "gssm offline run v3";
 
 // Fingerprint of the measurements a checkpoint has consumed (folded in one
 // at a time), so a run is not resumed on another dataset.
@@ -40,66 +41,89 @@ std::uint64_t foldMeasurement(std::uint64_t h, const Measurement& m) {
                            static_cast<std::size_t>(m.y.size()) * sizeof(double), h);
 }
 
-std::string encodeRun(const OfflineRun& run, std::size_t next_measurement, std::size_t next_input,
-                      std::uint64_t data_fingerprint, bool row_due) {
+struct RunProgress {
+  std::size_t next_measurement = 0, next_input = 0;
+  std::uint64_t data_fingerprint = 0;
+  bool row_due = false;
+};
+
+std::string encodeRun(const OfflineRun& run, const RunProgress& p, const std::string& mark) {
   internal::ByteWriter w;
   w.str(kRunTag);
-  w.boolean(row_due);
+  w.str(methodName(run.method));
+  w.u64(p.next_measurement);
+  w.u64(p.next_input);
+  w.u64(p.data_fingerprint);
+  w.boolean(p.row_due);
   w.u64(run.downweighted);
   w.i64(run.rejected);
-  w.u64(data_fingerprint);
-  w.str(methodName(run.method));
-  w.u64(next_measurement);
-  w.u64(next_input);
   w.i32(run.iterations);
   w.f64(run.total_seconds);
-  w.u64(run.rows.size());
-  for (const auto& r : run.rows) {
-    w.f64(r.t);
-    w.vec(r.mean);
-    w.mat(r.covariance);
-  }
-  w.u64(run.update_seconds.size());
-  for (double s : run.update_seconds) w.f64(s);
-  w.u64(run.nis.size());
-  for (double v : run.nis) w.f64(v);
+  w.str(mark);
   return w.bytes();
 }
 
-OfflineRun decodeRun(const std::string& bytes, const std::string& source, std::size_t& next_measurement,
-                     std::size_t& next_input, std::uint64_t& data_fingerprint, bool& row_due) {
+OfflineRun decodeRun(const std::string& bytes, const std::string& source, RunProgress& p, std::string& mark) {
   internal::ByteReader r(bytes, source + " (run progress)");
   const std::string tag = r.str("run tag");
-  if (tag != kRunTag && tag != "gssm offline run v1") r.fail("not the checkpoint of an offline run (gssm-process)");
+  if (tag == "gssm offline run v1" || tag == "gssm offline run v2")
+    r.fail("written by an older gssm-process (" + tag + ", every row inline); start the run again");
+  if (tag != kRunTag) r.fail("not the checkpoint of an offline run (gssm-process)");
   OfflineRun run;
-  row_due = false;
-  if (tag == kRunTag) {
-    row_due = r.boolean("row due");
-    run.downweighted = r.u64("down-weighted count");
-    run.rejected = r.i64("gated count");
-  }
-  data_fingerprint = r.u64("data fingerprint");
   const std::string method = r.str("method");
   if (!methodNamed(method)) r.fail("unknown method '" + method + "'");
   run.method = *methodNamed(method);
-  next_measurement = r.u64("measurements consumed");
-  next_input = r.u64("inputs consumed");
+  p.next_measurement = r.u64("measurements consumed");
+  p.next_input = r.u64("inputs consumed");
+  p.data_fingerprint = r.u64("data fingerprint");
+  p.row_due = r.boolean("row due");
+  run.downweighted = r.u64("down-weighted count");
+  run.rejected = r.i64("gated count");
   run.iterations = r.i32("iterations");
   run.total_seconds = r.f64("seconds");
-  run.rows.resize(r.count("rows", 24));
-  for (auto& row : run.rows) {
-    row.t = r.f64("row time");
-    row.mean = r.vec("row mean");
-    row.covariance = r.mat("row covariance");
-  }
-  run.update_seconds.resize(r.count("latencies", 8));
-  for (double& s : run.update_seconds) s = r.f64("latency");
-  run.nis.resize(r.count("NIS values", 8));
-  for (double& v : run.nis) v = r.f64("NIS", true);
+  mark = r.str("recorder mark");
   if (!r.atEnd()) r.fail("unexpected bytes after the run progress");
-  if (run.update_seconds.size() != next_measurement) r.fail("latency count does not match the measurements consumed");
   return run;
 }
+
+// The recorder of a run without one: its mark is every record so far.
+class InlineRecorder final : public RunRecorder {
+ public:
+  explicit InlineRecorder(const OfflineRun& run) : run_(run) {}
+  void row(const EstimateRow&) override {}
+  void update(double, std::optional<double>) override {}
+  std::string mark() override {
+    internal::ByteWriter w;
+    w.u64(run_.rows.size());
+    for (const auto& r : run_.rows) {
+      w.f64(r.t);
+      w.vec(r.mean);
+      w.mat(r.covariance);
+    }
+    w.u64(run_.update_seconds.size());
+    for (double s : run_.update_seconds) w.f64(s);
+    w.u64(run_.nis.size());
+    for (double v : run_.nis) w.f64(v);
+    return w.bytes();
+  }
+  void resume(const std::string& mark, OfflineRun& run) override {
+    internal::ByteReader r(mark, "checkpoint (rows)");
+    run.rows.resize(r.count("rows", 24));
+    for (auto& row : run.rows) {
+      row.t = r.f64("row time");
+      row.mean = r.vec("row mean");
+      row.covariance = r.mat("row covariance");
+    }
+    run.update_seconds.resize(r.count("latencies", 8));
+    for (double& s : run.update_seconds) s = r.f64("latency");
+    run.nis.resize(r.count("NIS values", 8));
+    for (double& v : run.nis) v = r.f64("NIS", true);
+    if (!r.atEnd()) r.fail("unexpected bytes after the rows");
+  }
+
+ private:
+  const OfflineRun& run_;
+};
 }  // namespace
 
 OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
@@ -113,16 +137,18 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
   out.method = options.method;
   const std::size_t every = std::max<std::size_t>(1, measurements.size() / 100);
   const auto start = Clock::now();
+  InlineRecorder inline_recorder(out);
+  RunRecorder& recorder = checkpoints.recorder ? *checkpoints.recorder : inline_recorder;
   std::unique_ptr<Estimator> est;
-  std::size_t first = 0, next_input = 0;
-  bool row_due = false;  // rows at inputs: the newest state, made by an input, has no row yet
-  std::uint64_t data_hash = internal::kFnv1a64Basis;
+  RunProgress at;  // where the run is (what a checkpoint stores)
+  at.data_fingerprint = internal::kFnv1a64Basis;
   double seconds_before = 0;
   if (!checkpoints.resume_from.empty()) {
     CheckpointInfo info;
     est = restoreCheckpoint(model, checkpoints.resume_from, &info);
-    std::uint64_t fingerprint = 0;
-    out = decodeRun(info.user_data, checkpoints.resume_from, first, next_input, fingerprint, row_due);
+    RunProgress saved;
+    std::string mark;
+    out = decodeRun(info.user_data, checkpoints.resume_from, saved, mark);
     const auto fail = [&](const std::string& why) {
       throw CheckpointError(checkpoints.resume_from + ": cannot resume this run: " + why);
     };
@@ -132,10 +158,18 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
     if (est->report().window != options.window())
       fail("it was written with window " + std::to_string(est->report().window) + ", this run asks for " +
            std::to_string(options.window()));
-    if (first <= measurements.size())
-      for (std::size_t i = 0; i < first; ++i) data_hash = foldMeasurement(data_hash, measurements[i]);
-    if (first > measurements.size() || next_input > inputs.size() || data_hash != fingerprint)
-      fail("its first " + std::to_string(first) + " measurements differ from this dataset's (another dataset?)");
+    if (saved.next_measurement <= measurements.size())
+      for (std::size_t i = 0; i < saved.next_measurement; ++i)
+        at.data_fingerprint = foldMeasurement(at.data_fingerprint, measurements[i]);
+    if (saved.next_measurement > measurements.size() || saved.next_input > inputs.size() ||
+        at.data_fingerprint != saved.data_fingerprint)
+      fail("its first " + std::to_string(saved.next_measurement) +
+           " measurements differ from this dataset's (another dataset?)");
+    recorder.resume(mark, out);
+    if (out.update_seconds.size() != saved.next_measurement)
+      fail("its records hold " + std::to_string(out.update_seconds.size()) + " updates, its progress says " +
+           std::to_string(saved.next_measurement));
+    at = saved;
     seconds_before = out.total_seconds;
   } else {
     est = makeEstimator(model, options);
@@ -147,49 +181,56 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
   // at inputs, the row of a state an input made is taken just before the
   // first later event, so it holds every measurement at its time.
   const bool at_inputs = rows == RowTimes::Inputs;
-  const auto record = [&] {
-    const StateEstimate e = est->current();
+  const auto addRow = [&](const StateEstimate& e) {
     out.rows.push_back({e.t, e.mean, e.covariance});
+    recorder.row(out.rows.back());
   };
+  // at.row_due, with rows at inputs: the newest state, made by an input, has no row yet.
   auto feedInputsBefore = [&](double t) {
-    for (; next_input < inputs.size() && inputs[next_input].t < t; ++next_input) {
-      const double ti = std::max(inputs[next_input].t, est->time());
-      if (at_inputs && row_due && ti > est->time()) record();
+    for (; at.next_input < inputs.size() && inputs[at.next_input].t < t; ++at.next_input) {
+      const double ti = std::max(inputs[at.next_input].t, est->time());
+      if (at_inputs && at.row_due && ti > est->time()) addRow(est->current());
       const bool advances = ti > est->time();
-      est->addInput(ti, inputs[next_input].u);
-      if (at_inputs && advances) row_due = true;
+      est->addInput(ti, inputs[at.next_input].u);
+      if (at_inputs && advances) at.row_due = true;
     }
   };
-  for (std::size_t i = first; i < measurements.size(); ++i) {
+  for (std::size_t i = at.next_measurement; i < measurements.size(); ++i) {
     const Measurement& m = measurements[i];
     feedInputsBefore(m.t);
-    if (at_inputs && row_due && m.t > est->time()) {
-      record();
-      row_due = false;
+    if (at_inputs && at.row_due && m.t > est->time()) {
+      addRow(est->current());
+      at.row_due = false;
     }
     const auto t0 = Clock::now();
     est->addMeasurement(m);
-    out.update_seconds.push_back(since(t0));
-    data_hash = foldMeasurement(data_hash, m);
-    if (options.compute_nis) out.nis.push_back(est->reportNumbers().nis);
+    const double seconds = since(t0);
+    out.update_seconds.push_back(seconds);
+    at.data_fingerprint = foldMeasurement(at.data_fingerprint, m);
+    std::optional<double> nis;
+    if (options.compute_nis) out.nis.push_back(*(nis = est->reportNumbers().nis));
+    recorder.update(seconds, nis);
     // The EKF gates instead of weighting; the others' weight is the
     // measurement factor's own, at the estimate after its update.
     const bool weigh = model.channel(m.channel).loss.robust() && options.method != Method::Ekf;
     if (!at_inputs || weigh) {
       const StateEstimate e = est->current();
-      if (!at_inputs) out.rows.push_back({e.t, e.mean, e.covariance});
+      if (!at_inputs) addRow(e);
       if (weigh && MeasurementFactor(model, e.step, m).weight(stateValues(model, e)) < 1.0) ++out.downweighted;
     }
     out.rejected = est->reportNumbers().rejected;  // not report(): formatting its line costs ~15% of an EKF update
     out.iterations = std::max(out.iterations, est->reportNumbers().iterations);
     if (progress && ((i + 1) % every == 0 || i + 1 == measurements.size())) progress(i + 1, measurements.size());
     if (!checkpoints.path.empty() && (i + 1) % checkpoints.every == 0) {
+      at.next_measurement = i + 1;
       out.total_seconds = seconds_before + since(start);
-      saveCheckpoint(*est, checkpoints.path, encodeRun(out, i + 1, next_input, data_hash, row_due));
+      // The records first: a checkpoint never points past what is durable.
+      const std::string mark = recorder.mark();
+      saveCheckpoint(*est, checkpoints.path, encodeRun(out, at, mark));
     }
   }
   feedInputsBefore(std::numeric_limits<double>::infinity());  // inputs after the last measurement
-  if (at_inputs && row_due) record();
+  if (at_inputs && at.row_due) addRow(est->current());
   out.total_seconds = seconds_before + since(start);
   out.summary = est->report().detail;
   return out;

@@ -4,6 +4,7 @@
 // the dataset processor and the Monte Carlo runner.
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,14 +41,38 @@ struct OfflineRun {
 /// datasets), or at each state an input makes (a log's odometry steps).
 enum class RowTimes { Measurements, Inputs };
 
-/// Checkpoints of a streaming run (checkpoint.h): each holds the estimator
-/// and the run so far (rows, latencies, NIS), so a resumed run ends with the
-/// same rows, bit for bit, as an uninterrupted one. A checkpoint stores every
-/// row so far, (1 + n + n²)·8 bytes each for a stacked state of size n.
+/// Where a streaming run's records go as they are made, and what its
+/// checkpoints remember of them (docs/DESIGN.md §7). The run always keeps
+/// them in OfflineRun as well; a recorder also writes them somewhere (an
+/// application's output files: io::RunFiles) so that a checkpoint needs to
+/// hold only how far that got.
+class RunRecorder {
+ public:
+  virtual ~RunRecorder() = default;
+  virtual void row(const EstimateRow& row) = 0;
+  /// One measurement's update: its wall time and, with compute_nis, its NIS.
+  virtual void update(double seconds, std::optional<double> nis) = 0;
+  /// Makes every record so far durable (at least against the process
+  /// being killed); returns what a checkpoint stores to come back here.
+  virtual std::string mark() = 0;
+  /// Continues from a mark(): puts the records up to it into run.rows,
+  /// run.update_seconds and run.nis, and records on from there. Throws
+  /// CheckpointError naming what does not match.
+  virtual void resume(const std::string& mark, OfflineRun& run) = 0;
+};
+
+/// Checkpoints of a streaming run (checkpoint.h): each holds the estimator,
+/// the run's counters and the `recorder`'s mark, so a resumed run ends with
+/// the same rows, bit for bit, as an uninterrupted one. Without a recorder
+/// the mark is every record so far, (1 + n + n²)·8 bytes per row for a
+/// stacked state of size n; with one (gssm-process's output files) a
+/// checkpoint's size does not grow with the run (the estimator's own state
+/// aside: the full-history smoother's does).
 struct StreamingCheckpoints {
   std::string path;         ///< file written every `every` measurements ("" = none)
   std::size_t every = 0;
   std::string resume_from;  ///< checkpoint to continue from ("" = start at the beginning)
+  RunRecorder* recorder = nullptr;  ///< also gets every record; its mark() goes in the checkpoint
 };
 
 /// Streams the measurements (and inputs, in time order) through a streaming
