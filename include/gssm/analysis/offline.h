@@ -28,7 +28,7 @@ struct OfflineRun {
   std::vector<EstimateRow> rows;       ///< one per measurement (plus none for t0)
   std::vector<double> update_seconds;  ///< wall time of each update
   std::vector<double> nis;             ///< NIS of each measurement (streaming runs with compute_nis)
-  double total_seconds = 0;
+  double total_seconds = 0;            ///< the estimator's time: the loop, without the recorder's writing and checkpoints
   int iterations = 0;                  ///< solver iterations (batch), 0 for filters
   std::string summary;                 ///< the solver's own report line
   /// Measurements on robust channels whose weight ρ'(s) was below 1 at the
@@ -41,11 +41,11 @@ struct OfflineRun {
 /// datasets), or at each state an input makes (a log's odometry steps).
 enum class RowTimes { Measurements, Inputs };
 
-/// Where a streaming run's records go as they are made, and what its
-/// checkpoints remember of them (docs/DESIGN.md §7). The run always keeps
-/// them in OfflineRun as well; a recorder also writes them somewhere (an
-/// application's output files: io::RunFiles) so that a checkpoint needs to
-/// hold only how far that got.
+/// Where a streaming run's records go, and what its checkpoints remember of
+/// them (docs/DESIGN.md §7). The run keeps them in OfflineRun and hands the
+/// new ones to the recorder at each checkpoint (before its mark) and at the
+/// end; a recorder writes them somewhere (an application's output files:
+/// io::RunFiles) so that a checkpoint needs to hold only how far that got.
 class RunRecorder {
  public:
   virtual ~RunRecorder() = default;
