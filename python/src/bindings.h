@@ -30,6 +30,14 @@ inline py::array_t<double> toArray(const std::vector<double>& v) {
   return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
 }
 
+/// The time stamps (member t) of measurements, inputs or estimate rows, as a 1-D array.
+template <class Record>
+Eigen::VectorXd timesOf(const std::vector<Record>& records) {
+  Eigen::VectorXd t(static_cast<Eigen::Index>(records.size()));
+  for (std::size_t i = 0; i < records.size(); ++i) t[static_cast<Eigen::Index>(i)] = records[i].t;
+  return t;
+}
+
 /// True when the model calls back into Python (a gssm.models.PythonModel):
 /// such a model needs the GIL held while it runs, so loops over it cannot
 /// release it.

@@ -358,13 +358,7 @@ void bindEstimator(py::module_& m) {
   py::class_<PyRun>(m, "Run", "An offline run: one row per measurement (or per input for input-driven logs).")
       .def_property_readonly("method", [](const PyRun& r) { return std::string(methodName(r.run.method)); })
       .def_property_readonly("names", [](const PyRun& r) { return r.names; }, "names of the columns of mean and sd")
-      .def_property_readonly("t",
-                             [](const PyRun& r) {
-                               VectorXd t(static_cast<Eigen::Index>(r.run.rows.size()));
-                               for (std::size_t i = 0; i < r.run.rows.size(); ++i)
-                                 t[static_cast<Eigen::Index>(i)] = r.run.rows[i].t;
-                               return t;
-                             })
+      .def_property_readonly("t", [](const PyRun& r) { return timesOf(r.run.rows); }, "(N,) row times")
       .def_property_readonly("mean", [](const PyRun& r) {
         return stack(r.run.rows, static_cast<Eigen::Index>(r.names.size()), false);
       }, "(N, n) stacked [x_c; x_b] per row")

@@ -62,13 +62,8 @@ void bindIo(py::module_& io) {
   py::class_<PyDataset>(io, "Dataset",
                         "Measurements (with channels), inputs and optional truth of one run, with the model and "
                         "settings of its scenario.ini when it came from a folder or a simulation.")
-      .def_property_readonly("t",
-                             [](const PyDataset& d) {
-                               VectorXd t(static_cast<Eigen::Index>(d.data.measurements.size()));
-                               for (std::size_t i = 0; i < d.data.measurements.size(); ++i)
-                                 t[static_cast<Eigen::Index>(i)] = d.data.measurements[i].t;
-                               return t;
-                             }, "(N,) measurement times")
+      .def_property_readonly("t", [](const PyDataset& d) { return timesOf(d.data.measurements); },
+                             "(N,) measurement times")
       .def_property_readonly("y",
                              [](const PyDataset& d) {
                                std::vector<VectorXd> rows;
@@ -89,13 +84,8 @@ void bindIo(py::module_& io) {
                                  out.append(py::make_tuple(m.t, m.y, m.channel));
                                return out;
                              }, "[(t, y, channel), ...]")
-      .def_property_readonly("input_t",
-                             [](const PyDataset& d) {
-                               VectorXd t(static_cast<Eigen::Index>(d.data.inputs.size()));
-                               for (std::size_t i = 0; i < d.data.inputs.size(); ++i)
-                                 t[static_cast<Eigen::Index>(i)] = d.data.inputs[i].t;
-                               return t;
-                             }, "(M,) input times")
+      .def_property_readonly("input_t", [](const PyDataset& d) { return timesOf(d.data.inputs); },
+                             "(M,) input times")
       .def_property_readonly("u",
                              [](const PyDataset& d) {
                                std::vector<VectorXd> rows;
