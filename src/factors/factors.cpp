@@ -97,16 +97,20 @@ void ProcessFactor::linearize(const Values& x, Eigen::VectorXd& r,
   const Eigen::VectorXd& xk = x.at(keys()[0]);
   const Eigen::VectorXd& xk1 = x.at(keys()[1]);
   const Eigen::VectorXd& xb = constantsOrEmpty(*model_, x);
-  Eigen::MatrixXd J_f_xc, J_f_xb;
-  r = xk1 - model_->f(xk, xb, u_, dt_, J ? &J_f_xc : nullptr, J ? &J_f_xb : nullptr);
+  // The model writes its Jacobians straight into the caller's blocks (which a
+  // solver reuses from factor to factor): no allocation per linearization.
+  Eigen::MatrixXd no_constants;  // J_f_xb of a model without constants (n_b = 0: empty)
+  if (J) J->resize(keys().size());
+  Eigen::MatrixXd* J_f_xc = J ? &(*J)[0] : nullptr;
+  Eigen::MatrixXd* J_f_xb = J ? (keys().size() == 3 ? &(*J)[2] : &no_constants) : nullptr;
+  r = xk1 - model_->f(xk, xb, u_, dt_, J_f_xc, J_f_xb);
   wrapAngles(r, model_->angleStates());  // stacked indices below n_c are x_c's
   noise_.whitenInPlace(r);
   if (J) {
     const int nc = model_->dims().nc;
-    J->resize(keys().size());
-    (*J)[0] = -J_f_xc;
-    (*J)[1] = Eigen::MatrixXd::Identity(nc, nc);
-    if (keys().size() == 3) (*J)[2] = -J_f_xb;
+    (*J)[0] *= -1.0;
+    (*J)[1].setIdentity(nc, nc);
+    if (keys().size() == 3) (*J)[2] *= -1.0;
     for (auto& block : *J) noise_.whitenInPlace(block);
   }
 }
@@ -150,16 +154,15 @@ void MeasurementFactor::linearize(const Values& x, Eigen::VectorXd& r,
                                   std::vector<Eigen::MatrixXd>* J) const {
   const Eigen::VectorXd& xc = x.at(keys()[0]);
   const Eigen::VectorXd& xb = constantsOrEmpty(*model_, x);
-  Eigen::MatrixXd J_h_xc, J_h_xb;
-  r = model_->h(channel_, xc, xb, J ? &J_h_xc : nullptr, J ? &J_h_xb : nullptr) - y_;
+  Eigen::MatrixXd no_constants;  // as in ProcessFactor::linearize
+  if (J) J->resize(keys().size());
+  Eigen::MatrixXd* J_h_xc = J ? &(*J)[0] : nullptr;
+  Eigen::MatrixXd* J_h_xb = J ? (keys().size() == 2 ? &(*J)[1] : &no_constants) : nullptr;
+  r = model_->h(channel_, xc, xb, J_h_xc, J_h_xb) - y_;
   wrapAngles(r, model_->channel(channel_).angles);
   noise_.whitenInPlace(r);
-  if (J) {
-    J->resize(keys().size());
-    (*J)[0] = J_h_xc;
-    if (keys().size() == 2) (*J)[1] = J_h_xb;
+  if (J)
     for (auto& block : *J) noise_.whitenInPlace(block);
-  }
 }
 
 std::string MeasurementFactor::describe() const {
