@@ -124,7 +124,7 @@ struct BatchSolver::Impl {
       const auto& keys = f->keys();
       offs.resize(keys.size());
       for (std::size_t a = 0; a < keys.size(); ++a) offs[a] = offset[x.indexOf(keys[a])];
-      for (std::size_t a = 0; a < keys.size(); ++a) g.segment(offs[a], J[a].cols()) += J[a].transpose() * r;
+      for (std::size_t a = 0; a < keys.size(); ++a) g.segment(offs[a], J[a].cols()).noalias() += J[a].transpose() * r;
       internal::forEachUpperJtJ(offs, J, [&](Eigen::Index gi, Eigen::Index gj, double v, auto...) {
         if (first) chol.add(gi, gj, v);
         else chol.value(e) = v;
