@@ -98,15 +98,17 @@ Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {
 // A = J, b = J δ̂ − r(x̂). `extra` holds initial values of variables being added.
 LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) const {
   Values x;
-  std::vector<Eigen::VectorXd> deltas;
+  x.reserve(f.keys().size());
+  std::vector<const Eigen::VectorXd*> deltas;  // null: a new variable (δ̂ = 0)
+  deltas.reserve(f.keys().size());
   for (const auto& k : f.keys()) {
     const auto it = vars_.find(k);
     if (it != vars_.end()) {
       x.insert(k, it->second.anchor + it->second.delta);
-      deltas.push_back(it->second.delta);
+      deltas.push_back(&it->second.delta);
     } else {
       x.insert(k, extra.at(k));
-      deltas.push_back(Eigen::VectorXd::Zero(extra.at(k).size()));
+      deltas.push_back(nullptr);
     }
   }
   LinearFactor lf;
@@ -119,7 +121,8 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
     throw NumericalError("factor '" + f.describe() +
                          "' has a non-finite residual or Jacobian at the current estimate");
   lf.b = -r;
-  for (std::size_t i = 0; i < lf.keys.size(); ++i) lf.b += lf.A[i] * deltas[i];
+  for (std::size_t i = 0; i < lf.keys.size(); ++i)
+    if (deltas[i]) lf.b += lf.A[i] * *deltas[i];
   return lf;
 }
 
@@ -629,6 +632,7 @@ double BayesTreeEngine::linearizationError(int slot) const {
   const Slot& s = slots_.at(static_cast<std::size_t>(slot));
   if (!s.nonlinear) return 0.0;
   Values x;
+  x.reserve(s.linear.keys.size());
   Eigen::VectorXd rlin = -s.linear.b;
   for (std::size_t i = 0; i < s.linear.keys.size(); ++i) {
     const Var& v = vars_.at(s.linear.keys[i]);
@@ -653,6 +657,7 @@ std::vector<int> BayesTreeEngine::slotsOf(const Key& k) const {
   if (k.isConstants()) return nonlinearSlots();
   auto it = slots_by_key_.find(k);
   if (it != slots_by_key_.end()) list = &it->second;
+  if (list) out.reserve(list->size());
   if (list)
     for (int s : *list)
       if (slots_[static_cast<std::size_t>(s)].alive && slots_[static_cast<std::size_t>(s)].nonlinear) out.push_back(s);
