@@ -84,8 +84,8 @@ def _dataset_options(data, model, method):
     if data.scenario.strip():
         try:
             return data.options(method, model)
-        except InputError:
-            pass  # a scenario.ini for another model: its settings do not apply
+        except InputError as e:
+            raise InputError("%s (the dataset's settings for this model; pass options= to use others)" % e) from e
     o = EstimatorOptions(method)
     o.t0 = data.t0
     return o
