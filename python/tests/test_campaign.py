@@ -93,3 +93,13 @@ def test_process_folder_on_dask_writes_what_gssm_process_writes(repo, client, gs
         raise AssertionError("a broken log must fail the folder")
     except gssm.Error as e:
         assert "broken" in str(e) and "1 of 3" in str(e)
+
+
+def test_scheduler_address_scales_out(cluster):
+    """client= a scheduler address (how a campaign reaches a cluster of
+    machines): here the LocalCluster's own, over TCP on loopback."""
+    address = cluster.scheduler_address
+    assert address.startswith("tcp://127.0.0.1:")
+    remote = gc.monte_carlo("consistent", seeds=3, steps=40, client=address, progress=False)
+    local = gc.monte_carlo("consistent", seeds=3, steps=40, client=False, workers=1)
+    same(remote, local)
