@@ -44,16 +44,18 @@ Eigen::VectorXd& Values::at(const Key& k) {
   return entries_[i].second;
 }
 
-void Values::insert(const Key& k, const Eigen::VectorXd& v) {
+void Values::insert(const Key& k, const Eigen::VectorXd& v) { insert(k, Eigen::VectorXd(v)); }
+
+void Values::insert(const Key& k, Eigen::VectorXd&& v) {
   // Common cases first: appending the next step, or a step before the constants.
   if (entries_.empty() || entries_.back().first < k) {
-    entries_.emplace_back(k, v);
+    entries_.emplace_back(k, std::move(v));
     return;
   }
   const std::size_t i = lowerBound(k);
   if (entries_[i].first == k)
     throw InvalidArgument("Values: variable " + k.toString() + " already has a value");
-  entries_.insert(entries_.begin() + static_cast<std::ptrdiff_t>(i), Entry(k, v));
+  entries_.insert(entries_.begin() + static_cast<std::ptrdiff_t>(i), Entry(k, std::move(v)));
 }
 
 void Values::insertOrAssign(const Key& k, const Eigen::VectorXd& v) {

@@ -25,6 +25,7 @@ class Values {
   const Eigen::VectorXd& at(const Key& k) const;
   Eigen::VectorXd& at(const Key& k);
   void insert(const Key& k, const Eigen::VectorXd& v);  ///< throws if present
+  void insert(const Key& k, Eigen::VectorXd&& v);       ///< the same, taking v's storage
   void insertOrAssign(const Key& k, const Eigen::VectorXd& v);
   void erase(const Key& k);
   std::size_t size() const { return entries_.size(); }
