@@ -235,7 +235,8 @@ TEST(NumberText, SameTextAsThePrintfLoopAndExactRoundTrip) {
   }
   EXPECT_EQ(mismatches, 0);
   double x = 0;
-  EXPECT_TRUE(parseDouble("+2.5", "+2.5" + 4, x) && x == 2.5);
+  const std::string plus = "+2.5";
+  EXPECT_TRUE(parseDouble(plus.data(), plus.data() + plus.size(), x) && x == 2.5);
   for (const char* bad : {"", "+", "1.5x", " 1", "0x10", "1e999"}) {
     const std::string s(bad);
     EXPECT_FALSE(parseDouble(s.data(), s.data() + s.size(), x)) << "'" << s << "'";
