@@ -300,6 +300,7 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
 // into the conditional on v and the marginal factor on its separator.
 void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   std::vector<const LinearFactor*> fptrs;
+  fptrs.reserve(p.inputs.size());
   for (const auto& in : p.inputs) fptrs.push_back(in.first);
   p.ordering = order(p.keys, fptrs, p.new_variables);
   const std::vector<Key>& ordering = p.ordering;
@@ -316,6 +317,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   std::vector<std::vector<std::size_t>> pending_of(ordering.size());
   std::vector<const LinearFactor*> pend;
   std::vector<std::optional<InputSource>> pend_source;  // nullopt: a marginal made here
+  pend.reserve(p.inputs.size() + ordering.size());  // the inputs, then one marginal per clique at most
+  pend_source.reserve(pend.capacity());
   auto addPending = [&](const LinearFactor* f, std::optional<InputSource> source) {
     const std::size_t id = pend.size();
     pend.push_back(f);
@@ -413,6 +416,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     m.keys = sep;
     const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
     m.b = Rfull.block(dv, ncols, mrows, 1);
+    m.A.reserve(sep.size());
     for (const auto& k : sep) m.A.push_back(Rfull.block(dv, colOf.at(k), mrows, dims.at(k)));
     if (!sep.empty() && mrows > 0) addPending(&m, std::nullopt);
   }
