@@ -40,7 +40,6 @@ void continueOutputsIn(const std::string& out, const std::string& checkpoint, gs
 
 }  // namespace
 
-
 int main(int argc, char** argv) {
   return gssm::apps::runApp("gssm-process", [&] {
     gssm::apps::CommandLine cli("gssm-process",

@@ -113,6 +113,28 @@ void drawBand(mrpt::img::CImage& img, const Axes& ax, const Band& b) {
   }
 }
 
+// Calls slice(i, j) for each run [i, j) of points whose x falls in one of
+// `buckets` equal slices of [x0, x1] (x increasing).
+template <class Slice>
+void forEachSlice(const std::vector<double>& x, std::size_t n, double x0, double x1, int buckets, Slice slice) {
+  auto bucket = [&](double v) { return std::isfinite(v) ? static_cast<long>((v - x0) / (x1 - x0) * buckets) : -1; };
+  for (std::size_t i = 0; i < n;) {
+    const long b = bucket(x[i]);
+    std::size_t j = i + 1;
+    while (j < n && bucket(x[j]) == b) ++j;
+    slice(i, j);
+    i = j;
+  }
+}
+
+// The finite range of v's first n values (a unit one when they are all equal).
+std::pair<double, double> finiteRange(const std::vector<double>& v, std::size_t n) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::isfinite(v[i])) lo = std::min(lo, v[i]), hi = std::max(hi, v[i]);
+  return {lo, hi > lo ? hi : lo + 1};
+}
+
 // What a PNG can show of a long series: x increasing, at most first, min,
 // max and last of each of `buckets` equal slices of x (the line drawn
 // through them covers the same pixels as through all points). Other
@@ -122,40 +144,29 @@ Series decimated(const Series& s, int buckets) {
   const std::size_t n = std::min(s.x.size(), s.y.size());
   if (n <= static_cast<std::size_t>(4 * buckets)) return s;
   Series out{s.label, {}, {}, s.color, s.width, s.dashed};
-  const bool increasing = std::is_sorted(s.x.begin(), s.x.begin() + static_cast<std::ptrdiff_t>(n));
-  auto range = [&](const std::vector<double>& v) {
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (std::size_t i = 0; i < n; ++i)
-      if (std::isfinite(v[i])) lo = std::min(lo, v[i]), hi = std::max(hi, v[i]);
-    return std::make_pair(lo, hi > lo ? hi : lo + 1);
-  };
-  const auto [x0, x1] = range(s.x);
-  auto cell = [&](double v, double lo, double hi) {
-    return std::isfinite(v) ? static_cast<long>((v - lo) / (hi - lo) * buckets) : -1;
-  };
-  if (increasing) {
-    std::size_t i = 0;
-    while (i < n) {
-      const long b = cell(s.x[i], x0, x1);
-      std::size_t j = i, lo = i, hi = i;
-      for (; j < n && cell(s.x[j], x0, x1) == b; ++j) {
-        if (!std::isfinite(s.y[j])) continue;
-        if (!std::isfinite(s.y[lo]) || s.y[j] < s.y[lo]) lo = j;
-        if (!std::isfinite(s.y[hi]) || s.y[j] > s.y[hi]) hi = j;
+  const auto [x0, x1] = finiteRange(s.x, n);
+  if (std::is_sorted(s.x.begin(), s.x.begin() + static_cast<std::ptrdiff_t>(n))) {
+    forEachSlice(s.x, n, x0, x1, buckets, [&](std::size_t i, std::size_t j) {
+      std::size_t lo = i, hi = i;
+      for (std::size_t k = i; k < j; ++k) {
+        if (!std::isfinite(s.y[k])) continue;
+        if (!std::isfinite(s.y[lo]) || s.y[k] < s.y[lo]) lo = k;
+        if (!std::isfinite(s.y[hi]) || s.y[k] > s.y[hi]) hi = k;
       }
-      std::size_t keep[4] = {i, std::min(lo, hi), std::max(lo, hi), j - 1};
       std::size_t last = n;
-      for (std::size_t k : keep)
+      for (std::size_t k : {i, std::min(lo, hi), std::max(lo, hi), j - 1})
         if (k != last) {
           out.x.push_back(s.x[k]);
           out.y.push_back(s.y[k]);
           last = k;
         }
-      i = j;
-    }
+    });
     return out;
   }
-  const auto [y0, y1] = range(s.y);
+  const auto [y0, y1] = finiteRange(s.y, n);
+  auto cell = [&](double v, double lo, double hi) {
+    return std::isfinite(v) ? static_cast<long>((v - lo) / (hi - lo) * buckets) : -1;
+  };
   long cx = -2, cy = -2;
   for (std::size_t i = 0; i < n; ++i) {
     const long bx = cell(s.x[i], x0, x1), by = cell(s.y[i], y0, y1);
@@ -174,18 +185,12 @@ Band decimated(const Band& b, int buckets) {
   if (n <= static_cast<std::size_t>(4 * buckets) || !std::is_sorted(b.x.begin(), b.x.begin() + static_cast<std::ptrdiff_t>(n)))
     return b;
   Band out{{}, {}, {}, b.color, b.alpha};
-  const double x0 = b.x.front(), x1 = b.x[n - 1] > x0 ? b.x[n - 1] : x0 + 1;
-  for (std::size_t i = 0; i < n;) {
-    const long c = static_cast<long>((b.x[i] - x0) / (x1 - x0) * buckets);
-    double lo = b.lo[i], hi = b.hi[i];
-    std::size_t j = i;
-    for (; j < n && static_cast<long>((b.x[j] - x0) / (x1 - x0) * buckets) == c; ++j)
-      lo = std::min(lo, b.lo[j]), hi = std::max(hi, b.hi[j]);
+  const auto [x0, x1] = finiteRange(b.x, n);
+  forEachSlice(b.x, n, x0, x1, buckets, [&](std::size_t i, std::size_t j) {
     out.x.push_back(b.x[i]);
-    out.lo.push_back(lo);
-    out.hi.push_back(hi);
-    i = j;
-  }
+    out.lo.push_back(*std::min_element(b.lo.begin() + static_cast<std::ptrdiff_t>(i), b.lo.begin() + static_cast<std::ptrdiff_t>(j)));
+    out.hi.push_back(*std::max_element(b.hi.begin() + static_cast<std::ptrdiff_t>(i), b.hi.begin() + static_cast<std::ptrdiff_t>(j)));
+  });
   return out;
 }
 

@@ -34,6 +34,8 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
     const bool constant = static_cast<int>(i) >= nc;
     const Eigen::Index tcol = truthColumn(truth, idx);
     if (!constant && tcol < 0) continue;  // an error needs the truth of this state
+    const auto& angles = model.angleStates();
+    const bool angle = std::find(angles.begin(), angles.end(), static_cast<int>(idx)) != angles.end();
     Figure f;
     f.title = constant ? names[i] + ": estimate and 3-sigma band (" + scenario_label + ")"
                        : names[i] + " error: estimate - truth, with 3-sigma band (" + scenario_label + ")";
@@ -54,9 +56,7 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
           ref = truth->states[*j][tcol];
         }
         double v = row.mean[idx] - ref;
-        if (std::find(model.angleStates().begin(), model.angleStates().end(), static_cast<int>(idx)) !=
-            model.angleStates().end())
-          v = wrapAngle(v);
+        if (angle) v = wrapAngle(v);
         const double sd = std::sqrt(row.covariance(idx, idx));
         s.x.push_back(row.t);
         s.y.push_back(v);

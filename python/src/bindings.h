@@ -13,6 +13,7 @@
 #include "gssm/estimator/estimator.h"
 #include "gssm/io/dataset.h"
 #include "gssm/model/model.h"
+#include "gssm/model/simulation.h"
 
 namespace py = pybind11;
 
@@ -42,6 +43,10 @@ Eigen::VectorXd timesOf(const std::vector<Record>& records) {
 /// such a model needs the GIL held while it runs, so loops over it cannot
 /// release it.
 bool callsPython(const Model& model);
+
+/// The N(0, 1) source of a seed that gssm-simulate and gssm-montecarlo use
+/// (MRPT's generator), so Python simulations give their bytes (io.cpp).
+NormalSampler simulationSampler(unsigned seed);
 
 /// The method named `name` (every name gssm-process takes); InvalidArgument
 /// naming the valid ones otherwise.

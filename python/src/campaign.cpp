@@ -11,8 +11,6 @@
 
 namespace gssm::python {
 
-NormalSampler simulationSampler(unsigned seed);  // io.cpp
-
 namespace {
 
 using Eigen::MatrixXd;

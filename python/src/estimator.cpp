@@ -40,10 +40,8 @@ int channelOf(const Model& model, const py::object& channel) {
   return c;
 }
 
-const char* orderingName(EliminationOrdering o) { return o == EliminationOrdering::TimeOrdered ? "time" : "colamd"; }
-EliminationOrdering orderingNamed(const std::string& s) {
-  if (s == "time") return EliminationOrdering::TimeOrdered;
-  if (s == "colamd") return EliminationOrdering::ConstrainedColamd;
+EliminationOrdering orderingFromName(const std::string& s) {
+  if (const auto o = orderingNamed(s)) return *o;
   throw InvalidArgument("ordering '" + s + "': expected colamd or time");
 }
 
@@ -88,14 +86,11 @@ void bindEstimator(py::module_& m) {
       .def(py::init<>())
       .def_property(
           "algorithm",
-          [](const BatchSolverOptions& o) {
-            return o.method == BatchSolverOptions::Method::GaussNewton ? "gauss-newton" : "levenberg-marquardt";
-          },
+          [](const BatchSolverOptions& o) { return BatchSolverOptions::methodName(o.method); },
           [](BatchSolverOptions& o, const std::string& s) {
-            if (s != "gauss-newton" && s != "levenberg-marquardt")
-              throw InvalidArgument("batch algorithm '" + s + "': expected levenberg-marquardt or gauss-newton");
-            o.method = s == "gauss-newton" ? BatchSolverOptions::Method::GaussNewton
-                                           : BatchSolverOptions::Method::LevenbergMarquardt;
+            const auto m = BatchSolverOptions::methodNamed(s);
+            if (!m) throw InvalidArgument("batch algorithm '" + s + "': expected levenberg-marquardt or gauss-newton");
+            o.method = *m;
           })
       .def_readwrite("max_iterations", &BatchSolverOptions::max_iterations)
       .def_readwrite("relative_cost_tolerance", &BatchSolverOptions::relative_cost_tolerance)
@@ -120,7 +115,7 @@ void bindEstimator(py::module_& m) {
       .def_readwrite("batch", &EstimatorOptions::batch)
       .def_property(
           "ordering", [](const EstimatorOptions& o) { return orderingName(o.incremental.ordering); },
-          [](EstimatorOptions& o, const std::string& s) { o.incremental.ordering = orderingNamed(s); },
+          [](EstimatorOptions& o, const std::string& s) { o.incremental.ordering = orderingFromName(s); },
           "incremental: elimination ordering, 'colamd' or 'time'")
       .def_property(
           "fixed_lag_window", [](const EstimatorOptions& o) { return o.fixed_lag.window; },
@@ -167,7 +162,7 @@ void bindEstimator(py::module_& m) {
             o.smoother.convergence_tolerance = s[6].cast<double>();
             o.smoother.max_iterations = s[7].cast<int>();
             o.smoother.newton_polish_steps = s[8].cast<int>();
-            o.incremental.ordering = orderingNamed(t[6].cast<std::string>());
+            o.incremental.ordering = orderingFromName(t[6].cast<std::string>());
             o.fixed_lag.window = t[7].cast<int>();
             o.paper_window.window = t[8].cast<int>();
             const py::tuple b = t[9];

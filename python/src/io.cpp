@@ -30,18 +30,12 @@ MatrixXd stackRows(const std::vector<VectorXd>& rows, const char* what) {
   return m;
 }
 
-/// The N(0, 1) source gssm-simulate and gssm-montecarlo use for a seed.
-NormalSampler mrptSampler(unsigned seed) {
-  auto rng = std::make_shared<mrpt::random::CRandomGenerator>(seed);
-  return [rng] { return rng->drawGaussian1D_normalized(); };
-}
-
 PyDataset simulateScenario(const std::string& name, unsigned seed, int steps) {
   PyDataset out;
   out.data.scenario = io::builtinScenario(name, seed, steps);
   out.model = std::shared_ptr<Model>(io::makeModel(out.data.scenario));
   out.simulated = std::make_shared<SimulatedRun>(
-      simulate(*out.model, io::simulationSpec(out.data.scenario, *out.model), mrptSampler(seed)));
+      simulate(*out.model, io::simulationSpec(out.data.scenario, *out.model), simulationSampler(seed)));
   return out;
 }
 
@@ -56,7 +50,10 @@ void fillFromSimulation(PyDataset& d) {
 
 }  // namespace
 
-NormalSampler simulationSampler(unsigned seed) { return mrptSampler(seed); }
+NormalSampler simulationSampler(unsigned seed) {
+  auto rng = std::make_shared<mrpt::random::CRandomGenerator>(seed);
+  return [rng] { return rng->drawGaussian1D_normalized(); };
+}
 
 void bindIo(py::module_& io) {
   py::class_<PyDataset>(io, "Dataset",
@@ -251,7 +248,7 @@ void bindIo(py::module_& io) {
             spec.channels.push_back(py::isinstance<py::str>(c) ? model->channelIndex(c.cast<std::string>())
                                                                : c.cast<int>());
         }
-        d.simulated = std::make_shared<SimulatedRun>(simulate(*model, spec, mrptSampler(seed)));
+        d.simulated = std::make_shared<SimulatedRun>(simulate(*model, spec, simulationSampler(seed)));
         try {
           io::writeModel(*model, d.data.scenario);  // writable when the model has an INI form
         } catch (const InvalidArgument&) {

@@ -318,11 +318,11 @@ void readSmoother(const IniDocument& ini, EstimatorOptions& eo) {
   o.convergence_tolerance = ini.getDouble(smoother, "convergence_tolerance", o.convergence_tolerance);
   o.max_iterations = static_cast<int>(ini.getInt(smoother, "max_iterations", o.max_iterations));
   o.newton_polish_steps = static_cast<int>(ini.getInt(smoother, "newton_polish_steps", o.newton_polish_steps));
-  const std::string ordering = ini.getString(smoother, "ordering", "colamd");
-  if (ordering != "colamd" && ordering != "time")
+  const std::string ordering = ini.getString(smoother, "ordering", orderingName(eo.incremental.ordering));
+  const auto named = orderingNamed(ordering);
+  if (!named)
     throw InputError(ini.source() + ": [" + smoother + "] ordering = '" + ordering + "': expected colamd or time");
-  eo.incremental.ordering =
-      ordering == "time" ? EliminationOrdering::TimeOrdered : EliminationOrdering::ConstrainedColamd;
+  eo.incremental.ordering = *named;
   std::string why;
   if (!o.validate(&why)) throw InputError(ini.source() + ": [" + smoother + "] " + why);
 }
@@ -338,12 +338,12 @@ int readWindow(const IniDocument& ini, const std::string& section, int fallback)
 void readBatch(const IniDocument& ini, BatchSolverOptions& o) {
   const std::string batch = sectionOf(Method::Batch);
   ini.requireOnlyKeys(batch, {"algorithm", "max_iterations", "newton_polish_steps"});
-  const std::string algorithm = ini.getString(batch, "algorithm", "levenberg-marquardt");
-  if (algorithm != "levenberg-marquardt" && algorithm != "gauss-newton")
+  const std::string algorithm = ini.getString(batch, "algorithm", BatchSolverOptions::methodName(o.method));
+  const auto named = BatchSolverOptions::methodNamed(algorithm);
+  if (!named)
     throw InputError(ini.source() + ": [" + batch + "] algorithm = '" + algorithm +
                      "': expected levenberg-marquardt or gauss-newton");
-  o.method = algorithm == "gauss-newton" ? BatchSolverOptions::Method::GaussNewton
-                                         : BatchSolverOptions::Method::LevenbergMarquardt;
+  o.method = *named;
   o.max_iterations = static_cast<int>(ini.getInt(batch, "max_iterations", o.max_iterations));
   o.newton_polish_steps = static_cast<int>(ini.getInt(batch, "newton_polish_steps", o.newton_polish_steps));
   std::string why;

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 
 #include "gssm/core/error.h"
@@ -124,64 +123,33 @@ CsvTable readCsv(const std::string& path, std::vector<CsvRowError>* row_errors) 
   return parseCsv(text, path, row_errors);
 }
 
-void appendCsvLine(std::string& out, const std::vector<double>& values) {
-  for (std::size_t i = 0; i < values.size(); ++i) {
+namespace {
+void appendCsvLine(std::string& out, const double* values, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
     if (i) out += ',';
     appendDouble(out, values[i]);
   }
 }
+}  // namespace
 
 std::string csvLine(const std::vector<double>& values) {
   std::string out;
-  appendCsvLine(out, values);
+  appendCsvLine(out, values.data(), values.size());
   return out;
 }
 
-CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header) : path_(path) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_) throw InputError(path + ": cannot write the file");
-  for (std::size_t i = 0; i < header.size(); ++i) (buffer_ += (i ? "," : "")) += header[i];
-  buffer_ += '\n';
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header) : file_(path) {
+  std::string& b = file_.buffer();
+  for (std::size_t i = 0; i < header.size(); ++i) (b += (i ? "," : "")) += header[i];
+  b += '\n';
 }
 
-CsvWriter::CsvWriter(const std::string& path, std::uint64_t length) : path_(path), written_(length) {
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec || size < length)
-    throw InputError(path + ": cannot continue it at byte " + std::to_string(length) + " (" +
-                     (ec ? ec.message() : "it has only " + std::to_string(size) + " bytes") + ")");
-  std::filesystem::resize_file(path, length, ec);
-  if (ec) throw InputError(path + ": cannot cut it at byte " + std::to_string(length) + ": " + ec.message());
-  file_ = std::fopen(path.c_str(), "ab");
-  if (!file_) throw InputError(path + ": cannot append to the file");
-}
-
-CsvWriter::~CsvWriter() {
-  if (!file_) return;
-  if (!buffer_.empty()) std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
-  std::fclose(file_);
-}
+CsvWriter::CsvWriter(const std::string& path, std::uint64_t length) : file_(path, length) {}
 
 void CsvWriter::row(const double* values, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) {
-    if (i) buffer_ += ',';
-    appendDouble(buffer_, values[i]);
-  }
-  buffer_ += '\n';
-  if (buffer_.size() >= (1u << 20)) writeBuffer();  // ~1 MB blocks
-}
-
-void CsvWriter::writeBuffer() {
-  if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-    throw InputError(path_ + ": write failed (disk full?)");
-  written_ += buffer_.size();
-  buffer_.clear();
-}
-
-std::uint64_t CsvWriter::flush() {
-  writeBuffer();
-  if (std::fflush(file_) != 0) throw InputError(path_ + ": write failed (disk full?)");
-  return written_;
+  appendCsvLine(file_.buffer(), values, n);
+  file_.buffer() += '\n';
+  file_.maybeWrite();
 }
 
 void writeCsv(const std::string& path, const std::vector<std::string>& header,

@@ -19,8 +19,7 @@ std::string RunFiles::estimatesName(Method method) { return std::string("estimat
 std::string RunFiles::recordsName(Method method) { return std::string("run-") + methodName(method) + ".bin"; }
 
 RunFiles::RunFiles(const std::string& dir, const Model& model, Method method, bool records)
-    : dir_(dir),
-      estimates_path_((fs::path(dir) / estimatesName(method)).string()),
+    : estimates_path_((fs::path(dir) / estimatesName(method)).string()),
       records_path_((fs::path(dir) / recordsName(method)).string()),
       records_(records) {
   header_.push_back("t");
@@ -29,19 +28,9 @@ RunFiles::RunFiles(const std::string& dir, const Model& model, Method method, bo
   for (const auto& n : names) header_.push_back("sd_" + n);
 }
 
-RunFiles::~RunFiles() {
-  if (bin_) {
-    if (!bin_buffer_.empty()) std::fwrite(bin_buffer_.data(), 1, bin_buffer_.size(), bin_);
-    std::fclose(bin_);
-  }
-}
-
 void RunFiles::open() {
   csv_ = std::make_unique<CsvWriter>(estimates_path_, header_);
-  if (records_) {
-    bin_ = std::fopen(records_path_.c_str(), "wb");
-    if (!bin_) throw InputError(records_path_ + ": cannot write the file");
-  }
+  if (records_) bin_ = std::make_unique<AppendFile>(records_path_);
 }
 
 void RunFiles::row(const EstimateRow& r) {
@@ -57,8 +46,8 @@ void RunFiles::row(const EstimateRow& r) {
   w.f64(r.t);
   w.vec(r.mean);
   w.mat(r.covariance);
-  bin_buffer_ += w.bytes();
-  if (bin_buffer_.size() >= (1u << 20)) writeRecords();
+  bin_->buffer() += w.bytes();
+  bin_->maybeWrite();
 }
 
 void RunFiles::update(double seconds, std::optional<double> nis) {
@@ -69,28 +58,19 @@ void RunFiles::update(double seconds, std::optional<double> nis) {
   w.f64(seconds);
   w.boolean(nis.has_value());
   if (nis) w.f64(*nis);
-  bin_buffer_ += w.bytes();
-  if (bin_buffer_.size() >= (1u << 20)) writeRecords();
-}
-
-void RunFiles::writeRecords() {
-  if (bin_buffer_.empty()) return;
-  if (std::fwrite(bin_buffer_.data(), 1, bin_buffer_.size(), bin_) != bin_buffer_.size())
-    throw InputError(records_path_ + ": write failed (disk full?)");
-  bin_written_ += bin_buffer_.size();
-  bin_buffer_.clear();
+  bin_->buffer() += w.bytes();
+  bin_->maybeWrite();
 }
 
 std::string RunFiles::mark() {
   if (!records_) throw InvalidArgument("RunFiles: a mark needs the records file (construct with records = true)");
   if (!csv_) open();
   const std::uint64_t csv_length = csv_->flush();
-  writeRecords();
-  if (std::fflush(bin_) != 0) throw InputError(records_path_ + ": write failed (disk full?)");
+  const std::uint64_t bin_length = bin_->flush();
   internal::ByteWriter w;
   w.str(kMarkTag);
   w.u64(csv_length);
-  w.u64(bin_written_);
+  w.u64(bin_length);
   return w.bytes();
 }
 
@@ -128,21 +108,13 @@ void RunFiles::resume(const std::string& mark, OfflineRun& run) {
   }
   // Continue both files at the mark.
   csv_ = std::make_unique<CsvWriter>(estimates_path_, csv_length);
-  std::error_code ec;
-  fs::resize_file(records_path_, bin_length, ec);
-  if (ec) throw CheckpointError(records_path_ + ": cannot cut it at byte " + std::to_string(bin_length) + ": " + ec.message());
-  bin_ = std::fopen(records_path_.c_str(), "ab");
-  if (!bin_) throw CheckpointError(records_path_ + ": cannot append to the file");
-  bin_written_ = bin_length;
+  bin_ = std::make_unique<AppendFile>(records_path_, bin_length);
 }
 
 void RunFiles::finish() {
   if (!csv_) open();  // a run with no rows still writes its header
   csv_->flush();
-  if (bin_) {
-    writeRecords();
-    if (std::fflush(bin_) != 0) throw InputError(records_path_ + ": write failed (disk full?)");
-  }
+  if (bin_) bin_->flush();
 }
 
 }  // namespace gssm::io

@@ -1,7 +1,8 @@
 #pragma once
 // Internal: a symmetric positive-definite sparse system H x = b factored by
-// CHOLMOD (supernodal LLᵀ, so an indefinite or singular H is detected and
-// the failing column reported). H is given by its upper triangle as
+// CHOLMOD (LLᵀ — simplicial where the factor is thin, supernodal where its
+// columns are long — so an indefinite or singular H is detected and the
+// failing column reported). H is given by its upper triangle as
 // triplets whose pattern is fixed after the first analyze(). Systems of at
 // most kDenseMax unknowns (a paper window, a start-up batch) are factored
 // densely instead: CHOLMOD's symbolic analysis and supernodal machinery cost

@@ -14,6 +14,16 @@
 
 namespace gssm {
 
+const char* BatchSolverOptions::methodName(Method m) {
+  return m == Method::GaussNewton ? "gauss-newton" : "levenberg-marquardt";
+}
+
+std::optional<BatchSolverOptions::Method> BatchSolverOptions::methodNamed(const std::string& name) {
+  for (auto m : {Method::LevenbergMarquardt, Method::GaussNewton})
+    if (name == methodName(m)) return m;
+  return std::nullopt;
+}
+
 bool BatchSolverOptions::validate(std::string* why) const {
   auto fail = [&](const std::string& msg) {
     if (why) *why = "BatchSolverOptions: " + msg;

@@ -12,6 +12,16 @@
 
 namespace gssm {
 
+const char* orderingName(EliminationOrdering ordering) {
+  return ordering == EliminationOrdering::TimeOrdered ? "time" : "colamd";
+}
+
+std::optional<EliminationOrdering> orderingNamed(const std::string& name) {
+  for (auto o : {EliminationOrdering::ConstrainedColamd, EliminationOrdering::TimeOrdered})
+    if (name == orderingName(o)) return o;
+  return std::nullopt;
+}
+
 std::string UpdateReport::toString() const {
   std::ostringstream os;
   os << "update: +" << new_factors << " factors, +" << new_variables << " variables; "

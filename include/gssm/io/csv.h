@@ -1,9 +1,10 @@
 #pragma once
 // Numeric CSV tables with a header line. Errors name file, line, column and value.
 #include <cstdint>
-#include <cstdio>
 #include <string>
 #include <vector>
+
+#include "gssm/io/append_file.h"
 
 namespace gssm::io {
 
@@ -78,27 +79,19 @@ class CsvWriter {
   /// Continues a file this class wrote: cuts it at byte `length` (what
   /// flush() returned then) and appends from there.
   CsvWriter(const std::string& path, std::uint64_t length);
-  CsvWriter(const CsvWriter&) = delete;
-  CsvWriter& operator=(const CsvWriter&) = delete;
-  ~CsvWriter();  ///< writes what is buffered (call flush() to see errors)
+  // Destroying it writes what is buffered (call flush() to see errors).
 
   void row(const double* values, std::size_t n);
   void row(const std::vector<double>& values) { row(values.data(), values.size()); }
   /// Hands everything written so far to the operating system; returns the
   /// file's length in bytes.
-  std::uint64_t flush();
-  const std::string& path() const { return path_; }
+  std::uint64_t flush() { return file_.flush(); }
 
  private:
-  void writeBuffer();
-  std::string path_, buffer_;
-  std::FILE* file_ = nullptr;
-  std::uint64_t written_ = 0;
+  AppendFile file_;
 };
 
 /// One CSV line (no newline) in the same format.
 std::string csvLine(const std::vector<double>& values);
-/// Appends it to `out` (no allocation per number).
-void appendCsvLine(std::string& out, const std::vector<double>& values);
 
 }  // namespace gssm::io

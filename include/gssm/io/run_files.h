@@ -10,6 +10,7 @@
 #include <string>
 
 #include "gssm/analysis/offline.h"
+#include "gssm/io/append_file.h"
 #include "gssm/io/csv.h"
 
 namespace gssm::io {
@@ -19,7 +20,6 @@ class RunFiles final : public RunRecorder {
   /// The files of `method`'s run in `dir`; none is touched until the first
   /// record (created then) or resume() (continued).
   RunFiles(const std::string& dir, const Model& model, Method method, bool records);
-  ~RunFiles() override;
 
   void row(const EstimateRow& row) override;
   void update(double seconds, std::optional<double> nis) override;
@@ -33,14 +33,11 @@ class RunFiles final : public RunRecorder {
 
  private:
   void open();
-  void writeRecords();
-  std::string dir_, estimates_path_, records_path_;
+  std::string estimates_path_, records_path_;
   std::vector<std::string> header_;
   bool records_;
   std::unique_ptr<CsvWriter> csv_;
-  std::FILE* bin_ = nullptr;
-  std::string bin_buffer_;
-  std::uint64_t bin_written_ = 0;
+  std::unique_ptr<AppendFile> bin_;  // the records (when records_)
   std::vector<double> line_;
 };
 

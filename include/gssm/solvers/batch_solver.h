@@ -6,6 +6,7 @@
 // reference for every other estimator.
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,10 @@ namespace gssm {
 
 struct BatchSolverOptions {
   enum class Method { LevenbergMarquardt, GaussNewton };
+  /// "levenberg-marquardt" or "gauss-newton": the algorithm's name in INI files and in Python.
+  static const char* methodName(Method m);
+  /// The algorithm called `name`, if any.
+  static std::optional<Method> methodNamed(const std::string& name);
   /// LM is the default: the radar start-up (x ≈ 0, range insensitive to x)
   /// makes undamped Gauss–Newton overshoot from the paper's prior.
   Method method = Method::LevenbergMarquardt;

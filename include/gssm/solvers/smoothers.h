@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,10 @@ enum class EliminationOrdering {
   /// States by time step, constants last: the oldest state is always a leaf.
   TimeOrdered,
 };
+/// "colamd" or "time": the ordering's name in INI files and in Python.
+const char* orderingName(EliminationOrdering ordering);
+/// The ordering called `name`, if any.
+std::optional<EliminationOrdering> orderingNamed(const std::string& name);
 
 /// The relinearization policy both smoothers share (the ordering is the
 /// IncrementalSmoother's choice; the fixed lag always orders by time).
