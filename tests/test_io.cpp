@@ -121,6 +121,7 @@ TEST(Config, EstimatorSectionsAreReadAndChecked) {
   ini.set("smoother", "newton_polish_steps", "4");
   ini.set("batch", "algorithm", "gauss-newton");
   ini.set("batch", "newton_polish_steps", "2");
+  ini.set("batch", "initial_lambda", "1e-3");
   const auto parsed = IniDocument::parse(ini.toString(), "s.ini");
   const auto model = makeModel(parsed);
   const EstimatorOptions eo = estimatorOptions(parsed, *model);
@@ -133,6 +134,7 @@ TEST(Config, EstimatorSectionsAreReadAndChecked) {
   EXPECT_EQ(eo.paper_window.window, 10);
   EXPECT_EQ(eo.batch.method, BatchSolverOptions::Method::GaussNewton);
   EXPECT_EQ(eo.batch.newton_polish_steps, 2);
+  EXPECT_EQ(eo.batch.initial_lambda, 1e-3);
   EXPECT_EQ(estimatorOptions(parsed, *model, Method::PaperWindow).window(), 10);
   EXPECT_EQ(estimatorOptions(parsed, *model, Method::FixedLag).window(), 25);
   ini.set("smoother", "wildfire", "1");

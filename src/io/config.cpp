@@ -337,7 +337,7 @@ int readWindow(const IniDocument& ini, const std::string& section, int fallback)
 
 void readBatch(const IniDocument& ini, BatchSolverOptions& o) {
   const std::string batch = sectionOf(Method::Batch);
-  ini.requireOnlyKeys(batch, {"algorithm", "max_iterations", "newton_polish_steps"});
+  ini.requireOnlyKeys(batch, {"algorithm", "max_iterations", "newton_polish_steps", "initial_lambda"});
   const std::string algorithm = ini.getString(batch, "algorithm", BatchSolverOptions::methodName(o.method));
   const auto named = BatchSolverOptions::methodNamed(algorithm);
   if (!named)
@@ -346,6 +346,7 @@ void readBatch(const IniDocument& ini, BatchSolverOptions& o) {
   o.method = *named;
   o.max_iterations = static_cast<int>(ini.getInt(batch, "max_iterations", o.max_iterations));
   o.newton_polish_steps = static_cast<int>(ini.getInt(batch, "newton_polish_steps", o.newton_polish_steps));
+  o.initial_lambda = ini.getDouble(batch, "initial_lambda", o.initial_lambda);
   std::string why;
   if (!o.validate(&why)) throw InputError(ini.source() + ": [" + batch + "] " + why);
 }
