@@ -57,8 +57,17 @@ TEST(SparseCholesky, DenseAndSparsePathsEqualADenseReference) {
           EXPECT_TRUE(S.lookup(i, j, v)) << "pattern entry missing";
         }
       }
-    // Refilled values, same pattern: the factorization follows.
-    for (std::size_t e = 0; e < c.entries(); ++e) c.value(e) *= 2;
+    // Values overwritten in place through the entries' slots (each entry
+    // was added as two parts, in fill()'s order): H doubled, same pattern.
+    std::fill(c.values(), c.values() + c.nonzeros(), 0.0);
+    std::size_t e = 0;
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i <= j; ++i)
+        if (H(i, j) != 0) {
+          c.values()[c.slot(e++)] += 0.5 * H(i, j);
+          c.values()[c.slot(e++)] += 1.5 * H(i, j);
+        }
+    ASSERT_EQ(e, c.entries());
     ASSERT_EQ(c.factorize(), -1);
     EXPECT_LT((2 * H * c.solve(B) - B).norm() / B.norm(), 1e-12) << n;
   }

@@ -7,22 +7,48 @@
 
 namespace gssm::internal {
 
-/// Calls emit(row, col, v, a, i, b, j) for every upper-triangle entry
-/// (row ≤ col) of JᵀJ, where block J[a] occupies columns offs[a]… and
-/// v = J[a].col(i)·J[b].col(j). Same order on every call for the same
-/// shapes, so callers may address entries by their running index.
+/// Calls emit(row, col, a, i, b, j) for every upper-triangle entry
+/// (row ≤ col) of the blocks of `count` variables, variable a occupying
+/// columns offs[a] … offs[a] + cols[a] − 1. Same order on every call for the
+/// same shapes, so callers may address entries by their running index: a
+/// pattern laid out once from the shapes is refilled from the Jacobians.
 template <class Emit>
-void forEachUpperJtJ(const std::vector<Eigen::Index>& offs, const std::vector<Eigen::MatrixXd>& J, Emit&& emit) {
-  for (std::size_t a = 0; a < J.size(); ++a)
-    for (std::size_t b = 0; b < J.size(); ++b) {
+void forEachUpperEntry(const Eigen::Index* offs, const Eigen::Index* cols, std::size_t count, Emit&& emit) {
+  for (std::size_t a = 0; a < count; ++a)
+    for (std::size_t b = 0; b < count; ++b) {
       if (offs[a] > offs[b]) continue;
-      // entry by entry: no temporary on this hot path
-      for (Eigen::Index j = 0; j < J[b].cols(); ++j)
+      for (Eigen::Index j = 0; j < cols[b]; ++j)
+        for (Eigen::Index i = 0; i < cols[a]; ++i) {
+          const Eigen::Index gi = offs[a] + i, gj = offs[b] + j;
+          if (gi > gj) continue;  // diagonal block: keep its upper half
+          emit(gi, gj, a, i, b, j);
+        }
+    }
+}
+
+/// Calls emit(row, col, v, a, i, b, j) for every upper-triangle entry of
+/// JᵀJ, where block J[a] occupies columns offs[a]… and
+/// v = J[a].col(i)·J[b].col(j) (forEachUpperEntry's order; summed row by
+/// row: a residual has a few rows, too few for a vectorized dot to pay).
+template <class Emit>
+void forEachUpperJtJ(const Eigen::Index* offs, const std::vector<Eigen::MatrixXd>& J, Emit&& emit) {
+  const std::size_t count = J.size();
+  if (count == 0) return;
+  const Eigen::Index m = J[0].rows();
+  for (std::size_t a = 0; a < count; ++a)
+    for (std::size_t b = 0; b < count; ++b) {
+      if (offs[a] > offs[b]) continue;
+      for (Eigen::Index j = 0; j < J[b].cols(); ++j) {
+        const double* cb = J[b].data() + j * m;
         for (Eigen::Index i = 0; i < J[a].cols(); ++i) {
           const Eigen::Index gi = offs[a] + i, gj = offs[b] + j;
           if (gi > gj) continue;  // diagonal block: keep its upper half
-          emit(gi, gj, J[a].col(i).dot(J[b].col(j)), a, i, b, j);
+          const double* ca = J[a].data() + i * m;
+          double v = 0;
+          for (Eigen::Index r = 0; r < m; ++r) v += ca[r] * cb[r];
+          emit(gi, gj, v, a, i, b, j);
         }
+      }
     }
 }
 

@@ -48,6 +48,7 @@ void SparseCholesky::reset(Eigen::Index n, std::size_t capacity) {
 }
 
 void SparseCholesky::add(Eigen::Index i, Eigen::Index j, double v) {
+  if (matrix_) throw NumericalError("SparseCholesky::add after assemble(): call reset() for a new pattern");
   if (count_ == triplet_->nzmax) {
     if (!cholmod_reallocate_triplet(2 * triplet_->nzmax, triplet_, &common_))
       throw NumericalError("CHOLMOD could not grow the system matrix");
@@ -59,18 +60,87 @@ void SparseCholesky::add(Eigen::Index i, Eigen::Index j, double v) {
   triplet_->nnz = count_;
 }
 
-double& SparseCholesky::value(std::size_t e) { return static_cast<double*>(triplet_->x)[e]; }
+void SparseCholesky::assemble() {
+  if (matrix_) return;
+  const int* Ti = static_cast<const int*>(triplet_->i);
+  const int* Tj = static_cast<const int*>(triplet_->j);
+  std::vector<std::size_t> start(static_cast<std::size_t>(n_) + 1, 0);
+  for (std::size_t e = 0; e < count_; ++e) ++start[static_cast<std::size_t>(Tj[e]) + 1];
+  for (std::size_t j = 0; j < static_cast<std::size_t>(n_); ++j) start[j + 1] += start[j];
+  std::vector<std::uint32_t> by_column(count_);
+  std::vector<std::size_t> next(start.begin(), start.end() - 1);
+  for (std::size_t e = 0; e < count_; ++e) by_column[next[static_cast<std::size_t>(Tj[e])]++] = static_cast<std::uint32_t>(e);
+  assembleColumns(start, by_column, Ti, static_cast<const double*>(triplet_->x));
+  cholmod_free_triplet(&triplet_, &common_);
+}
+
+// Rows sorted within each column (stable: duplicates keep the order they
+// were added, in which they are summed), then H in compressed columns and
+// each entry's position. Insertion sort for the short columns of the states,
+// a merge sort for the constants' long ones.
+void SparseCholesky::assembleColumns(const std::vector<std::size_t>& start, std::vector<std::uint32_t>& by_column,
+                                     const int* row, const double* value) {
+  const std::size_t n = static_cast<std::size_t>(n_);
+  std::size_t unique = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    std::uint32_t* b = by_column.data() + start[j];
+    std::uint32_t* e = by_column.data() + start[j + 1];
+    if (e - b > 32) {
+      std::stable_sort(b, e, [&](std::uint32_t x, std::uint32_t y) { return row[x] < row[y]; });
+    } else {
+      for (std::uint32_t* p = b + 1; p < e; ++p) {
+        const std::uint32_t v = *p;
+        std::uint32_t* q = p;
+        for (; q > b && row[*(q - 1)] > row[v]; --q) *q = *(q - 1);
+        *q = v;
+      }
+    }
+    for (std::uint32_t* p = b; p < e; ++p)
+      if (p == b || row[*p] != row[*(p - 1)]) ++unique;
+  }
+  matrix_ = cholmod_allocate_sparse(n, n, unique, /*sorted=*/true, /*packed=*/true, /*stype=*/1, CHOLMOD_REAL, &common_);
+  if (!matrix_) throw NumericalError("CHOLMOD could not allocate the system matrix");
+  int* Ap = static_cast<int*>(matrix_->p);
+  int* Ai = static_cast<int*>(matrix_->i);
+  double* Ax = static_cast<double*>(matrix_->x);
+  slot_.resize(count_);
+  int q = -1;
+  for (std::size_t j = 0; j < n; ++j) {
+    Ap[j] = q + 1;
+    for (std::size_t p = start[j]; p < start[j + 1]; ++p) {
+      const std::uint32_t e = by_column[p];
+      if (p == start[j] || row[e] != row[by_column[p - 1]]) {
+        Ai[++q] = row[e];
+        Ax[q] = 0.0;
+      }
+      if (value) Ax[q] += value[e];
+      slot_[e] = q;
+    }
+  }
+  Ap[n] = q + 1;
+}
+
+double* SparseCholesky::values() {
+  assemble();
+  return static_cast<double*>(matrix_->x);
+}
+
+std::size_t SparseCholesky::nonzeros() const {
+  return matrix_ ? static_cast<std::size_t>(static_cast<const int*>(matrix_->p)[n_]) : 0;
+}
 
 Eigen::Index SparseCholesky::factorize() {
+  assemble();
+  const int* Ap = static_cast<const int*>(matrix_->p);
+  const int* Ai = static_cast<const int*>(matrix_->i);
+  const double* Ax = static_cast<const double*>(matrix_->x);
   if (dense_) {
-    // H from its upper-triangle triplets (duplicates summed), then a plain
-    // column Cholesky that reports the first column that is not positive.
+    // H from its upper triangle, then a plain column Cholesky that reports
+    // the first column that is not positive.
     Eigen::MatrixXd& L = L_;
     L.setZero(n_, n_);
-    const int* Ti = static_cast<const int*>(triplet_->i);
-    const int* Tj = static_cast<const int*>(triplet_->j);
-    const double* Tx = static_cast<const double*>(triplet_->x);
-    for (std::size_t e = 0; e < count_; ++e) L(Tj[e], Ti[e]) += Tx[e];  // lower triangle: L(j, i), i <= j
+    for (Eigen::Index j = 0; j < n_; ++j)
+      for (int p = Ap[j]; p < Ap[j + 1]; ++p) L(j, Ai[p]) = Ax[p];  // lower triangle: L(j, i), i <= j
     factored_ = false;
     for (Eigen::Index j = 0; j < n_; ++j) {
       const double d = L(j, j) - L.row(j).head(j).squaredNorm();
@@ -82,30 +152,6 @@ Eigen::Index SparseCholesky::factorize() {
     }
     factored_ = true;
     return -1;
-  }
-  if (!matrix_ || slot_.size() != count_) {
-    // First factorization of this pattern: let CHOLMOD assemble (sort, sum
-    // duplicates), then record where each triplet entry landed.
-    if (matrix_) cholmod_free_sparse(&matrix_, &common_);
-    matrix_ = cholmod_triplet_to_sparse(triplet_, count_, &common_);
-    if (!matrix_) throw NumericalError("CHOLMOD could not assemble the system matrix");
-    const int* Ap = static_cast<const int*>(matrix_->p);
-    const int* Ai = static_cast<const int*>(matrix_->i);
-    const int* Ti = static_cast<const int*>(triplet_->i);
-    const int* Tj = static_cast<const int*>(triplet_->j);
-    slot_.resize(count_);
-    for (std::size_t e = 0; e < count_; ++e) {
-      const int* b = Ai + Ap[Tj[e]];
-      const int* end = Ai + Ap[Tj[e] + 1];
-      slot_[e] = static_cast<int>(std::lower_bound(b, end, Ti[e]) - Ai);
-    }
-  } else {
-    // Same pattern: refill the values (a triplet→sparse conversion was 7% of
-    // a million-step batch solve).
-    double* Ax = static_cast<double*>(matrix_->x);
-    const double* Tx = static_cast<const double*>(triplet_->x);
-    std::fill(Ax, Ax + static_cast<const int*>(matrix_->p)[n_], 0.0);
-    for (std::size_t e = 0; e < count_; ++e) Ax[slot_[e]] += Tx[e];
   }
   if (!factor_) {
     // Simplicial (column by column) where the factor is thin — a chain of

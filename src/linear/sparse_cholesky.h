@@ -9,6 +9,7 @@
 // far more than a 34 × 34 Cholesky.
 #include <Eigen/Core>
 #include <cholmod.h>
+#include <cstdint>
 #include <vector>
 
 namespace gssm::internal {
@@ -26,12 +27,28 @@ class SparseCholesky {
   void reset(Eigen::Index n, std::size_t capacity);
   /// Appends H(i, j) += v (i <= j required). Duplicates are summed.
   void add(Eigen::Index i, Eigen::Index j, double v);
-  /// Overwrites the values of entry e (in the order they were added).
-  double& value(std::size_t e);
   std::size_t entries() const { return count_; }
 
-  /// Factors the current values (analyzing the pattern the first time,
-  /// natural ordering: callers order variables so that fill stays small).
+  /// Sums the entries added so far (in the order added) into H's upper
+  /// triangle in compressed columns, rows sorted. From then on H's values
+  /// live in values(), which a caller that refills H at every iteration
+  /// overwrites in place through slot(): no entries to sort or sum again.
+  /// factorize() assembles when needed; reset() starts a new pattern.
+  void assemble();
+  /// reset(n) + add(i, j, 0) for every entry + assemble(), without holding
+  /// the entries: each(emit) calls emit(i, j) (i <= j) for every entry, in
+  /// the same order both times it is called.
+  template <class ForEachEntry>
+  void assemblePattern(Eigen::Index n, ForEachEntry&& each);
+  /// Where entry e (in the order added) landed in values(), after assemble().
+  int slot(std::size_t e) const { return slot_[e]; }
+  const int* slots() const { return slot_.data(); }
+  double* values();
+  std::size_t nonzeros() const;
+
+  /// Factors H as it stands in values() (assembling and analyzing the
+  /// pattern the first time, natural ordering: callers order variables so
+  /// that fill stays small).
   /// Returns -1 on success, else the column at which H is not positive definite.
   Eigen::Index factorize();
   /// Solves H X = B for a dense right-hand side (n × m).
@@ -52,11 +69,13 @@ class SparseCholesky {
 
  private:
   void freeAll();
+  void assembleColumns(const std::vector<std::size_t>& start, std::vector<std::uint32_t>& by_column, const int* row,
+                       const double* value);
   cholmod_common common_;
   cholmod_triplet* triplet_ = nullptr;
   cholmod_factor* factor_ = nullptr;
   // H in compressed columns, assembled from the triplets once per pattern;
-  // later factorizations refill its values through slot_ (entry → position).
+  // slot_: entry → position in its values.
   cholmod_sparse* matrix_ = nullptr;
   std::vector<int> slot_;
   Eigen::Index n_ = 0;
@@ -65,5 +84,24 @@ class SparseCholesky {
   Eigen::MatrixXd L_;  // dense path: the lower Cholesky factor
   bool factored_ = false;
 };
+
+template <class ForEachEntry>
+void SparseCholesky::assemblePattern(Eigen::Index n, ForEachEntry&& each) {
+  reset(n, 0);
+  std::vector<std::size_t> start(static_cast<std::size_t>(n) + 1, 0);
+  each([&](Eigen::Index, Eigen::Index j) { ++start[static_cast<std::size_t>(j) + 1]; });
+  for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) start[j + 1] += start[j];
+  count_ = start.back();
+  std::vector<int> row(count_);
+  std::vector<std::uint32_t> by_column(count_);
+  std::vector<std::size_t> next(start.begin(), start.end() - 1);
+  std::uint32_t e = 0;
+  each([&](Eigen::Index i, Eigen::Index j) {
+    row[e] = static_cast<int>(i);
+    by_column[next[static_cast<std::size_t>(j)]++] = e++;
+  });
+  assembleColumns(start, by_column, row.data(), nullptr);
+  if (triplet_) cholmod_free_triplet(&triplet_, &common_);
+}
 
 }  // namespace gssm::internal

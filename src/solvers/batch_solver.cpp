@@ -1,5 +1,6 @@
 #include "gssm/solvers/batch_solver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 #include <map>
@@ -61,8 +62,10 @@ std::string BatchSolverSummary::toString() const {
   return os.str();
 }
 
-// The linearized system of one graph: variable offsets, per-factor block
-// offsets into the triplet list, and the factorization.
+// The linearized system of one graph. setup() lays out, from the keys and
+// sizes alone, each factor's columns and where each entry of its JᵀJ lands
+// in H's compressed columns; every linearization then writes H in place
+// (no triplets, no key lookups, no re-sorting).
 struct BatchSolver::Impl {
   Values layout;                         // the variables (keys; values unused) in column order
   std::vector<Eigen::Index> offset;      // first column of each, by Values position; then n
@@ -70,7 +73,14 @@ struct BatchSolver::Impl {
   std::vector<Eigen::Index> dims_by_column;
   Eigen::Index n = 0;
   internal::SparseCholesky chol;
-  std::size_t damping_begin = 0;         // triplet index of the first diagonal damping entry
+  std::vector<Eigen::Index> factor_cols;  // each factor's first column per key, concatenated
+  std::vector<std::size_t> factor_begin;  // factor i's keys: factor_cols[factor_begin[i] ...]
+  const int* entry_slot = nullptr;        // H's value index of every JᵀJ entry, factor by factor (chol's)
+  const int* diagonal_slot = nullptr;     // H(i, i)'s value index
+  std::vector<std::size_t> factor_shape;  // index into jacobians (same keys count and residual size)
+  // Jacobian buffers per factor shape, so alternating process and
+  // measurement factors reuse their storage.
+  std::vector<std::vector<Eigen::MatrixXd>> jacobians;
   bool has_solution = false;
   // H⁻¹ on the factor's pattern, computed on the first covariance query.
   mutable std::optional<internal::SparseCholesky::SelectedInverse> selected;
@@ -92,38 +102,66 @@ struct BatchSolver::Impl {
       n += kv.second.size();
     }
     offset.push_back(n);
-    std::size_t nnz = 0;
+    factor_cols.clear();
+    factor_begin.assign(1, 0);
+    factor_shape.clear();
+    jacobians.clear();
+    std::map<std::pair<std::size_t, int>, std::size_t> shapes;
+    std::vector<Eigen::Index> dims;  // parallel to factor_cols: each key's size
+    factor_cols.reserve(3 * graph.size());
+    dims.reserve(3 * graph.size());
+    factor_begin.reserve(graph.size() + 1);
+    factor_shape.reserve(graph.size());
     for (const auto& f : graph) {
-      Eigen::Index d = 0;
       for (const auto& k : f->keys()) {
         if (!values.contains(k))
           throw InvalidArgument("BatchSolver: factor '" + f->describe() + "' uses " +
                                 k.toString() + ", which has no initial value");
-        d += values.at(k).size();
+        const std::size_t i = values.indexOf(k);
+        factor_cols.push_back(offset[i]);
+        dims.push_back(offset[i + 1] - offset[i]);
       }
-      nnz += static_cast<std::size_t>(d * (d + 1) / 2);
+      factor_begin.push_back(factor_cols.size());
+      const auto key = std::make_pair(f->keys().size(), f->dim());
+      auto shape = shapes.find(key);
+      if (shape == shapes.end()) shape = shapes.emplace(key, shapes.size()).first;
+      factor_shape.push_back(shape->second);
     }
-    chol.reset(n, nnz + static_cast<std::size_t>(n));
+    jacobians.resize(shapes.size());
+    // The pattern: every factor's upper JᵀJ entries, then the diagonal
+    // (which the damping needs even where no factor reaches).
+    std::size_t entries = 0;
+    chol.assemblePattern(n, [&](auto&& emit) {
+      entries = 0;
+      for (std::size_t fi = 0; fi < graph.size(); ++fi) {
+        const std::size_t b = factor_begin[fi];
+        internal::forEachUpperEntry(&factor_cols[b], &dims[b], factor_begin[fi + 1] - b,
+                                    [&](Eigen::Index gi, Eigen::Index gj, auto...) {
+                                      emit(gi, gj);
+                                      ++entries;
+                                    });
+      }
+      for (Eigen::Index i = 0; i < n; ++i) emit(i, i);
+    });
+    entry_slot = chol.slots();
+    diagonal_slot = entry_slot + entries;
   }
 
-  // Jacobian buffers per factor shape (number of keys, residual size), so
-  // alternating process and measurement factors reuse their storage.
-  std::map<std::pair<std::size_t, int>, std::vector<Eigen::MatrixXd>> jacobians;
-
-  // Linearizes every factor at x: fills the triplet values of H = JᵀJ (+ the
-  // damping diagonal, zero here), the gradient g = Jᵀr and returns the cost.
-  // A non-finite residual throws, or with `trial` (an LM candidate) returns
-  // +∞, leaving the triplets to be refilled at the previous point.
+  // Linearizes every factor at x: writes H = JᵀJ into the factorization's
+  // values (undamped; `diag` gets its diagonal), the gradient g = Jᵀr, and
+  // returns the cost. A non-finite residual throws, or with `trial` (an LM
+  // candidate) returns +∞, leaving H to be rewritten at the previous point.
   double linearize(const FactorGraph& graph, const Values& x, Eigen::VectorXd& g,
-                   Eigen::VectorXd& diag, bool first, bool trial = false) {
+                   Eigen::VectorXd& diag, bool trial = false) {
     g.setZero(n);
-    diag.setZero(n);
+    double* H = chol.values();
+    std::fill(H, H + chol.nonzeros(), 0.0);
     double cost = 0;
-    std::size_t e = 0;
+    const int* slot = entry_slot;
     Eigen::VectorXd r;
-    std::vector<Eigen::Index> offs;
+    std::size_t fi = 0;
     for (const auto& f : graph) {
-      std::vector<Eigen::MatrixXd>& J = jacobians[{f->keys().size(), f->dim()}];
+      std::vector<Eigen::MatrixXd>& J = jacobians[factor_shape[fi]];
       const double c = f->linearizeRobust(x, r, &J);  // reweighted at every linearization
       if (!r.allFinite()) {
         if (trial) return std::numeric_limits<double>::infinity();
@@ -131,28 +169,21 @@ struct BatchSolver::Impl {
                              "' has a non-finite residual at the current estimate");
       }
       cost += c;
-      const auto& keys = f->keys();
-      offs.resize(keys.size());
-      for (std::size_t a = 0; a < keys.size(); ++a) offs[a] = offset[x.indexOf(keys[a])];
-      for (std::size_t a = 0; a < keys.size(); ++a) g.segment(offs[a], J[a].cols()).noalias() += J[a].transpose() * r;
-      internal::forEachUpperJtJ(offs, J, [&](Eigen::Index gi, Eigen::Index gj, double v, auto...) {
-        if (first) chol.add(gi, gj, v);
-        else chol.value(e) = v;
-        if (gi == gj) diag[gi] += v;
-        ++e;
-      });
+      const Eigen::Index* offs = &factor_cols[factor_begin[fi]];
+      for (std::size_t a = 0; a < J.size(); ++a) g.segment(offs[a], J[a].cols()).noalias() += J[a].transpose() * r;
+      internal::forEachUpperJtJ(offs, J, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
+      ++fi;
     }
-    if (first) {
-      damping_begin = chol.entries();
-      for (Eigen::Index i = 0; i < n; ++i) chol.add(i, i, 0.0);
-    }
+    diag.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) diag[i] = H[diagonal_slot[i]];
     return cost;
   }
 
+  // H's diagonal = its undamped value (diag) + λ·max(diag, 1e-12).
   void setDamping(const Eigen::VectorXd& diag, double lambda) {
+    double* H = chol.values();
     for (Eigen::Index i = 0; i < n; ++i)
-      chol.value(damping_begin + static_cast<std::size_t>(i)) =
-          lambda * std::max(diag[i], 1e-12);
+      H[diagonal_slot[i]] = diag[i] + lambda * std::max(diag[i], 1e-12);
   }
 
   [[noreturn]] void throwSingular(Eigen::Index column) const {
@@ -192,7 +223,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
 
   Values x = values;
   Eigen::VectorXd g, diag, g_new, diag_new;
-  double cost = s.linearize(graph, x, g, diag, true);
+  double cost = s.linearize(graph, x, g, diag);
   sum.initial_cost = cost;
   const bool lm = options_.method == BatchSolverOptions::Method::LevenbergMarquardt;
   internal::LevenbergMarquardtPolicy policy(options_.initial_lambda, options_.max_lambda, lm);
@@ -245,7 +276,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       if (policy.undamped()) {  // a tiny undamped step is still the exact correction: take it
         applyStep(x, delta, candidate);
         std::swap(x, candidate);
-        cost = s.linearize(graph, x, g, diag, false);
+        cost = s.linearize(graph, x, g, diag);
       }
       if (converge(T::StepConverged)) break;
       continue;
@@ -254,12 +285,12 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     // Linearize at the candidate right away (its cost comes with it): one
     // pass over the factors per accepted step instead of two; a rejected
     // step refills H at x.
-    const double new_cost = s.linearize(graph, candidate, g_new, diag_new, false, true);
+    const double new_cost = s.linearize(graph, candidate, g_new, diag_new, true);
     if (!std::isfinite(new_cost) && !lm)  // Gauss–Newton cannot back off: say which factor
-      s.linearize(graph, candidate, g_new, diag_new, false);
+      s.linearize(graph, candidate, g_new, diag_new);
     if (!policy.accept(new_cost, cost)) {
       ++sum.rejected_steps;
-      cost = s.linearize(graph, x, g, diag, false);
+      cost = s.linearize(graph, x, g, diag);
       if (policy.undamped()) {  // the damped solution was already converged
         sum.termination = T::CostConverged;
         break;
@@ -312,7 +343,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
         });
     sum.newton_steps = polish.steps;
     cost = polish.cost;
-    if (sum.newton_steps > 0) cost = s.linearize(graph, x, g, diag, false);  // JᵀJ at the solution
+    if (sum.newton_steps > 0) cost = s.linearize(graph, x, g, diag);  // JᵀJ at the solution
   }
   // Factor the undamped information matrix at the solution: it gives the
   // marginal covariances and tells whether the solution is determined.
@@ -338,7 +369,7 @@ void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
   s.selected.reset();
   s.setup(graph, values);
   Eigen::VectorXd g, diag;
-  s.linearize(graph, values, g, diag, true);
+  s.linearize(graph, values, g, diag);
   s.setDamping(diag, 0.0);
   const Eigen::Index bad = s.chol.factorize();
   if (bad >= 0) s.throwSingular(bad);

@@ -56,7 +56,7 @@ void NewtonSystem::add(const std::vector<Key>& keys, const Eigen::VectorXd& r,
     local[a + 1] = local[a] + J[a].cols();
     g_.segment(col[a], J[a].cols()) += J[a].transpose() * r;
   }
-  forEachUpperJtJ(col, J, [&](Eigen::Index gi, Eigen::Index gj, double v, std::size_t a, Eigen::Index i,
+  forEachUpperJtJ(col.data(), J, [&](Eigen::Index gi, Eigen::Index gj, double v, std::size_t a, Eigen::Index i,
                               std::size_t b, Eigen::Index j) {
     if (curvature) v += (*curvature)(local[a] + i, local[b] + j);
     chol_.add(gi, gj, v);  // duplicates are summed
