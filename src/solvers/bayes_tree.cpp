@@ -635,17 +635,19 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
 double BayesTreeEngine::linearizationError(int slot) const {
   const Slot& s = slots_.at(static_cast<std::size_t>(slot));
   if (!s.nonlinear) return 0.0;
-  Values x;
-  x.reserve(s.linear.keys.size());
-  Eigen::VectorXd rlin = -s.linear.b;
+  ErrorScratch& e = error_scratch_;
+  if (e.x.size() > 64) e.x = Values();
+  e.rlin = -s.linear.b;
   for (std::size_t i = 0; i < s.linear.keys.size(); ++i) {
-    const Var& v = vars_.at(s.linear.keys[i]);
-    x.insert(s.linear.keys[i], v.anchor + v.delta);
-    rlin += s.linear.A[i] * v.delta;
+    const Key& k = s.linear.keys[i];
+    const Var& v = vars_.at(k);
+    if (!e.x.contains(k)) e.x.insert(k, Eigen::VectorXd(v.anchor.size()));
+    e.x.at(k) = v.anchor + v.delta;
+    e.term.noalias() = s.linear.A[i] * v.delta;
+    e.rlin += e.term;
   }
-  Eigen::VectorXd r;
-  s.nonlinear->linearizeRobust(x, r, nullptr);  // a moved weight is a linearization error too
-  return (r - rlin).norm();
+  s.nonlinear->linearizeRobust(e.x, e.r, nullptr);  // a moved weight is a linearization error too
+  return (e.r - e.rlin).norm();
 }
 
 std::vector<int> BayesTreeEngine::nonlinearSlots() const {

@@ -186,6 +186,15 @@ class BayesTreeEngine {
   std::size_t slots_alive_ = 0, cliques_alive_ = 0;
   std::int64_t next_rank_ = 0;
   int root_ = -1;
+  // Reused by linearizationError (called for every candidate factor of
+  // every update): the variables at anchor + delta, r, its linear model.
+  // Not state: never saved, not compared; stale keys are harmless (a
+  // factor reads its own) and dropped when the set outgrows a window.
+  struct ErrorScratch {
+    Values x;
+    Eigen::VectorXd r, rlin, term;
+  };
+  mutable ErrorScratch error_scratch_;
 };
 
 }  // namespace gssm::internal
