@@ -84,7 +84,7 @@ ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::Ve
       dt_(dt),
       noise_(model.processNoiseDependsOnInput()
                  ? GaussianNoise(model.processNoiseOf(dt, u), "process noise of step " + std::to_string(k))
-                 : model.processNoiseModel(dt, "process noise of step " + std::to_string(k))) {
+                 : model.processNoiseModel(dt, k)) {
   if (!(dt > 0) || !std::isfinite(dt))
     throw InvalidArgument("process factor x_c(" + std::to_string(k) + ") -> x_c(" +
                           std::to_string(k + 1) + "): time step must be > 0, got " +

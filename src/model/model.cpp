@@ -137,14 +137,14 @@ struct Model::NoiseCache {
   std::size_t used = 0, next = 0;
 };
 
-GaussianNoise Model::processNoiseModel(double dt, const std::string& what) const {
+GaussianNoise Model::processNoiseModel(double dt, std::int64_t step) const {
   NoiseCache& c = *q_cache_;
   {
     std::lock_guard<std::mutex> lock(c.mutex);
     for (std::size_t i = 0; i < c.used; ++i)
       if (c.entries[i].first == dt) return c.entries[i].second;
   }
-  GaussianNoise q(processNoise(dt), what);  // may throw: nothing cached
+  GaussianNoise q(processNoise(dt), "process noise of step " + std::to_string(step));  // may throw: nothing cached
   std::lock_guard<std::mutex> lock(c.mutex);
   c.entries[c.next] = {dt, q};
   c.next = (c.next + 1) % c.entries.size();

@@ -186,15 +186,16 @@ class BayesTreeEngine {
   std::size_t slots_alive_ = 0, cliques_alive_ = 0;
   std::int64_t next_rank_ = 0;
   int root_ = -1;
-  // Reused by linearizationError (called for every candidate factor of
-  // every update): the variables at anchor + delta, r, its linear model.
-  // Not state: never saved, not compared; stale keys are harmless (a
-  // factor reads its own) and dropped when the set outgrows a window.
-  struct ErrorScratch {
+  // Buffers reused by the per-update hot paths (linearizationError for
+  // every candidate factor, backSubstitute for every touched clique), so
+  // they allocate once, not per call. Not state: never saved or compared.
+  // x: variables at anchor + delta; stale keys are harmless (a factor reads
+  // its own) and dropped when the set outgrows a window.
+  struct Scratch {
     Values x;
-    Eigen::VectorXd r, rlin, term;
+    Eigen::VectorXd r, rlin, term, rhs;
   };
-  mutable ErrorScratch error_scratch_;
+  mutable Scratch scratch_;
 };
 
 }  // namespace gssm::internal

@@ -115,9 +115,9 @@ class Model {
   /// Q(dt) as a noise model, factored once per distinct dt among the last
   /// few asked for (time stamps k·T differenced give a handful of dt values
   /// that differ in the last bits) and shared; processNoise must be a pure
-  /// function of dt. `what` names it in the error if Q(dt) is not positive
-  /// definite.
-  GaussianNoise processNoiseModel(double dt, const std::string& what) const;
+  /// function of dt. The error if Q(dt) is not positive definite names
+  /// `step` (the message is built only then: this runs once per step).
+  GaussianNoise processNoiseModel(double dt, std::int64_t step) const;
   const Gaussian& priorState() const { return noise_.prior_state; }
   const Gaussian& priorConstants() const { return noise_.prior_constants; }
 
