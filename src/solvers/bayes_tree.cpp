@@ -23,6 +23,7 @@ namespace {
 template <class T>
 class KeyTable {
  public:
+  KeyTable() { small_.reserve(kSmall); }  // one allocation, not one per doubling
   void set(const Key& k, T v) {
     if (!big_.empty()) {
       big_[k] = v;
@@ -97,23 +98,18 @@ Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {
 // Linearizes f at the current estimate: r(x) ≈ r(x̂) + J (δ − δ̂), i.e.
 // A = J, b = J δ̂ − r(x̂). `extra` holds initial values of variables being added.
 LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) const {
-  Values x;
-  x.reserve(f.keys().size());
-  std::vector<const Eigen::VectorXd*> deltas;  // null: a new variable (δ̂ = 0)
-  deltas.reserve(f.keys().size());
+  Values& x = scratch_.x;  // see linearizationError
+  if (x.size() > 64) x = Values();
   for (const auto& k : f.keys()) {
     const auto it = vars_.find(k);
-    if (it != vars_.end()) {
-      x.insert(k, it->second.anchor + it->second.delta);
-      deltas.push_back(&it->second.delta);
-    } else {
-      x.insert(k, extra.at(k));
-      deltas.push_back(nullptr);
-    }
+    const Eigen::VectorXd& value = it != vars_.end() ? it->second.anchor : extra.at(k);
+    if (!x.contains(k)) x.insert(k, Eigen::VectorXd(value.size()));
+    if (it != vars_.end()) x.at(k) = it->second.anchor + it->second.delta;
+    else x.at(k) = value;
   }
   LinearFactor lf;
   lf.keys = f.keys();
-  Eigen::VectorXd r;
+  Eigen::VectorXd& r = scratch_.r;
   f.linearizeRobust(x, r, &lf.A);  // robust factors reweighted at each linearization
   bool finite = r.allFinite();
   for (const auto& a : lf.A) finite = finite && a.allFinite();
@@ -121,8 +117,11 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
     throw NumericalError("factor '" + f.describe() +
                          "' has a non-finite residual or Jacobian at the current estimate");
   lf.b = -r;
-  for (std::size_t i = 0; i < lf.keys.size(); ++i)
-    if (deltas[i]) lf.b += lf.A[i] * *deltas[i];
+  for (std::size_t i = 0; i < lf.keys.size(); ++i) {
+    const auto it = vars_.find(lf.keys[i]);
+    if (it == vars_.end()) continue;  // a new variable: δ̂ = 0
+    lf.b += lf.A[i] * it->second.delta;
+  }
   return lf;
 }
 
@@ -343,6 +342,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     cl.frontal = v;
     // Union of keys, v first then by position.
     std::vector<Key> sep;
+    sep.reserve(8);
     Eigen::Index rows = 0;
     for (std::size_t id : pending_of[vi]) {
       rows += pend[id]->b.size();
@@ -410,15 +410,15 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     cl.R = Rfull.topLeftCorner(dv, dv);
     cl.S = Rfull.block(0, dv, dv, ncols - dv);
     cl.d = Rfull.block(0, ncols, dv, 1);
-    cl.separator = sep;
     // The remaining rows are the marginal factor on the separator.
     LinearFactor& m = cl.marginal;
-    m.keys = sep;
     const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
     m.b = Rfull.block(dv, ncols, mrows, 1);
     m.A.reserve(sep.size());
     for (const auto& k : sep) m.A.push_back(Rfull.block(dv, colOf.at(k), mrows, dims.at(k)));
-    if (!sep.empty() && mrows > 0) addPending(&m, std::nullopt);
+    m.keys = sep;
+    cl.separator = std::move(sep);  // sep is empty from here
+    if (!m.keys.empty() && mrows > 0) addPending(&m, std::nullopt);
   }
 }
 

@@ -186,8 +186,9 @@ class BayesTreeEngine {
   std::size_t slots_alive_ = 0, cliques_alive_ = 0;
   std::int64_t next_rank_ = 0;
   int root_ = -1;
-  // Buffers reused by the per-update hot paths (linearizationError for
-  // every candidate factor, backSubstitute for every touched clique), so
+  // Buffers reused by the per-update hot paths (linearize and
+  // linearizationError for every new or candidate factor, backSubstitute
+  // for every touched clique), so
   // they allocate once, not per call. Not state: never saved or compared.
   // x: variables at anchor + delta; stale keys are harmless (a factor reads
   // its own) and dropped when the set outgrows a window.

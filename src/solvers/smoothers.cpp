@@ -207,6 +207,7 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
     // being re-eliminated anyway.
     for (int it = 0; it < options.max_local_iterations; ++it) {
       std::vector<int> local;
+      local.reserve(16);
       for (const auto& k : counts.top)
         if (!k.isConstants())
           for (int s : engine.slotsOf(k)) local.push_back(s);
