@@ -158,6 +158,51 @@ TEST(IncrementalSmoother, RadarPaperEqualsBatchAfterEveryUpdateWhenIterated) {
             << worst << "\n";
 }
 
+// An iteration that stops while damped (here: one LM step per update) must
+// not leave its Marquardt rows in the tree: the covariances it reports are
+// those of the undamped information matrix, which the batch solver gives at
+// the estimate by evaluateAt() (a damped tree's were ~100× too small).
+TEST(IncrementalSmoother, IterationStoppedWhileDampedReportsUndampedCovariances) {
+  // A prior at the truth: each update's single LM step is kept, so the tree
+  // is linearized at the estimate (a rejected step would leave the new
+  // factors at their initial points, which the batch here does not model).
+  models::Radar2D::Params prm;
+  prm.prior_x = 0;
+  prm.prior_xdot = 100;
+  prm.prior_h = 1000;
+  const models::Radar2D radar(prm);
+  SimulationSpec spec;
+  spec.steps = 40;
+  spec.x0 = Eigen::VectorXd::Constant(1, 0.0);
+  spec.xb = Eigen::Vector2d(100, 1000);
+  spec.process_noise = false;
+  const SimulatedRun run = simulate(radar, spec, normalSampler(4));
+  SmootherOptions o;
+  o.iterate_to_convergence = true;
+  o.max_iterations = 1;  // one damped step (λ = 1e-4) per update, never converged
+  IncrementalSmoother smoother(o);
+  auto [f0, v0] = gssm::testing::initialStep(radar);
+  smoother.update(f0, v0);
+  for (int k = 1; k <= spec.steps; ++k) {
+    auto [f, v] = gssm::testing::nextStep(radar, smoother, k, run.measurements[k - 1].y,
+                                          run.times[k] - run.times[k - 1]);
+    smoother.update(f, v);
+    if (k % 5) continue;
+    const std::vector<Measurement> upto(run.measurements.begin(), run.measurements.begin() + k);
+    Problem p = buildProblem(radar, upto);
+    const Values x = smoother.calculateEstimate();
+    BatchSolver batch;
+    batch.evaluateAt(p.graph, x);
+    const std::vector<Key> keys{Key::state(k), Key::constants()};
+    const Eigen::MatrixXd expected = batch.jointMarginalCovariance(keys);
+    const Eigen::MatrixXd got = smoother.jointMarginalCovariance(keys);
+    // The tree is linearized one Gauss–Newton step behind its solution, so
+    // the two agree to first order (≤ 5e-4 here); a damped tree is ~100×
+    // too small (relative error ≈ 1).
+    EXPECT_LT((got - expected).norm() / expected.norm(), 1e-2) << "step " << k << "\n" << got << "\nvs\n" << expected;
+  }
+}
+
 namespace {
 // Streams `steps` radar paper-scenario measurements through a smoother and
 // returns the reports at the requested steps.

@@ -120,13 +120,15 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
   Values previous = engine.allEstimates();
   double previous_cost = engine.cost();
   internal::LevenbergMarquardtPolicy policy;  // the policy's defaults (λ₀ = 1e-4: see damping.h)
+  double tree_lambda = 0;  // the damping in the tree as it stands
   for (int it = 0; it < options.max_iterations; ++it) {
     const std::vector<int> all = engine.nonlinearSlots();
     if (all.empty()) break;
     internal::BayesTreeEngine snapshot = engine;
     internal::EngineCounts trial = counts;
+    const double lambda = policy.lambda();
     try {
-      engine.update(internal::EngineUpdate::relinearizing(all, policy.lambda()), trial);
+      engine.update(internal::EngineUpdate::relinearizing(all, lambda), trial);
     } catch (const NumericalError& e) {
       engine = std::move(snapshot);
       if (policy.undamped() || !policy.rejected()) {
@@ -145,12 +147,32 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
       continue;
     }
     counts = trial;
+    tree_lambda = lambda;
     Values now = engine.allEstimates();
     const double change = relChange(now, previous);
     previous = std::move(now);
     previous_cost = cost;
     policy.accepted();
     if (change <= options.convergence_tolerance && policy.converged()) break;
+  }
+  if (tree_lambda > 0) {
+    // The tree still holds Marquardt rows from its last kept step (the
+    // undamped finish was rejected, or the iteration stopped damped), which
+    // make every covariance read from it too small (~100× on the radar
+    // start-up). Re-eliminate it undamped at the estimate reached: the
+    // estimate becomes that tree's solution, one Gauss–Newton step on
+    // (negligible where the iteration had converged).
+    internal::BayesTreeEngine snapshot = engine;
+    internal::EngineCounts trial = counts;
+    try {
+      engine.update(internal::EngineUpdate::relinearizing(engine.nonlinearSlots(), 0.0), trial);
+      trial.variables_backsubstituted += engine.solveAll();
+      counts = trial;
+      ++rep.iterations;
+    } catch (const NumericalError& e) {
+      engine = std::move(snapshot);
+      rep.note = std::string("covariances keep the last damping (the undamped system did not factor: ") + e.what() + ")";
+    }
   }
   // Newton polish: quadratic convergence where the iteration above crawls.
   internal::BayesTreeEngine snapshot = engine;
