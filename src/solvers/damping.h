@@ -14,12 +14,9 @@ namespace gssm::internal {
 
 class LevenbergMarquardtPolicy {
  public:
-  /// The iterated smoother's defaults. The batch solver passes its own
-  /// BatchSolverOptions: λ₀ = 1e-8 there (it starts from an EKF pass, and
-  /// relative damping slows the weakly determined constants most). With
-  /// 1e-8 the iterated robust smoother stops elsewhere along its linear
-  /// IRLS tail (covariances 0.5% from the batch's on the beacon test).
-  static constexpr double kInitialLambda = 1e-4;
+  /// The batch solver's options carry these defaults (BatchSolverOptions:
+  /// why λ₀ is small there).
+  static constexpr double kInitialLambda = 1e-8;
   static constexpr double kMaxLambda = 1e12;
   static constexpr double kMinLambda = 1e-12;
   /// Near the minimum the cost change (∝ ‖δ‖²) is below rounding, so an

@@ -119,7 +119,7 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
   counts.variables_backsubstituted += engine.solveAll();
   Values previous = engine.allEstimates();
   double previous_cost = engine.cost();
-  internal::LevenbergMarquardtPolicy policy;  // the policy's defaults (λ₀ = 1e-4: see damping.h)
+  internal::LevenbergMarquardtPolicy policy;  // the batch solver's policy and defaults
   double tree_lambda = 0;  // the damping in the tree as it stands
   for (int it = 0; it < options.max_iterations; ++it) {
     const std::vector<int> all = engine.nonlinearSlots();
