@@ -346,7 +346,9 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
 
   // Each pending factor waits at the first of its variables in the ordering;
   // the marginal a clique leaves on its separator joins the queue.
-  std::vector<std::vector<std::size_t>> pending_of(ordering.size());
+  std::vector<std::vector<std::size_t>>& pending_of = scratch_.pending_of;
+  if (pending_of.size() < ordering.size()) pending_of.resize(ordering.size());
+  for (std::size_t i = 0; i < ordering.size(); ++i) pending_of[i].clear();
   std::vector<const LinearFactor*> pend;
   std::vector<std::optional<InputSource>> pend_source;  // nullopt: a marginal made here
   pend.reserve(p.inputs.size() + ordering.size());  // the inputs, then one marginal per clique at most
@@ -366,7 +368,22 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     addPending(in.first, in.second.kind == InputSource::Kind::Orphan ? std::nullopt
                                                                       : std::optional<InputSource>(in.second));
   }
-  p.fresh.assign(ordering.size(), Clique{});
+  // Fresh cliques, from the pool where it has some: their matrices and lists
+  // are overwritten below (same shapes: no allocation).
+  p.fresh.clear();
+  p.fresh.reserve(ordering.size());
+  for (std::size_t i = 0; i < ordering.size(); ++i) {
+    if (pool_.spare.empty()) {
+      p.fresh.emplace_back();
+      continue;
+    }
+    p.fresh.push_back(std::move(pool_.spare.back()));
+    pool_.spare.pop_back();
+    Clique& c = p.fresh.back();
+    c.owned.clear();
+    c.children.clear();
+    c.parent = -1;
+  }
   p.fresh_owned.clear();
   const double damping = p.update.damping;
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
@@ -374,8 +391,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     Clique& cl = p.fresh[vi];
     cl.frontal = v;
     // Union of keys, v first then by position.
-    std::vector<Key> sep;
-    sep.reserve(8);
+    std::vector<Key>& sep = scratch_.separator;
+    sep.clear();
     Eigen::Index rows = 0;
     for (std::size_t id : pending_of[vi]) {
       rows += pend[id]->b.size();
@@ -392,7 +409,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
       ncols += dims.at(k);
     }
     const Eigen::Index damp_rows = damping > 0 ? dv : 0;
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(rows + damp_rows, ncols + 1);
+    Eigen::MatrixXd& M = scratch_.stacked;
+    M.setZero(rows + damp_rows, ncols + 1);
     Eigen::Index r0 = 0;
     for (std::size_t id : pending_of[vi]) {
       const LinearFactor& f = *pend[id];
@@ -447,11 +465,11 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     LinearFactor& m = cl.marginal;
     const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
     m.b = Rfull.block(dv, ncols, mrows, 1);
-    m.A.reserve(sep.size());
-    for (const auto& k : sep) m.A.push_back(Rfull.block(dv, colOf.at(k), mrows, dims.at(k)));
-    m.keys = sep;
-    cl.separator = std::move(sep);  // sep is empty from here
-    if (!m.keys.empty() && mrows > 0) addPending(&m, std::nullopt);
+    m.A.resize(sep.size());
+    for (std::size_t i = 0; i < sep.size(); ++i) m.A[i] = Rfull.block(dv, colOf.at(sep[i]), mrows, dims.at(sep[i]));
+    m.keys.assign(sep.begin(), sep.end());
+    cl.separator.assign(sep.begin(), sep.end());
+    if (!sep.empty() && mrows > 0) addPending(&m, std::nullopt);
   }
 }
 
@@ -465,6 +483,7 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   }
   for (int c : p.removed_order) {
     clique_alive_[static_cast<std::size_t>(c)] = false;
+    if (pool_.spare.size() < CliquePool::kMax) pool_.spare.push_back(std::move(cliques_[static_cast<std::size_t>(c)]));
     cliques_[static_cast<std::size_t>(c)] = Clique{};
     free_cliques_.push_back(c);
     --cliques_alive_;
@@ -789,6 +808,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   } else {
     root_ = -1;
   }
+  if (pool_.spare.size() < CliquePool::kMax) pool_.spare.push_back(std::move(cliques_[static_cast<std::size_t>(c)]));
   cliques_[static_cast<std::size_t>(c)] = Clique{};
   clique_alive_[static_cast<std::size_t>(c)] = false;
   free_cliques_.push_back(c);

@@ -195,8 +195,25 @@ class BayesTreeEngine {
   struct Scratch {
     Values x;
     Eigen::VectorXd r, rlin, term, rhs;
+    Eigen::MatrixXd stacked;  // a clique's [A | b] while it is triangularized
+    std::vector<Key> separator;
+    std::vector<std::vector<std::size_t>> pending_of;  // eliminateTop's queue, per ordering entry
   };
   mutable Scratch scratch_;
+  // Cliques replaced by an update, kept so the next elimination refills
+  // their matrices and lists in place instead of allocating new ones (a
+  // fixed-lag update replaces the same few cliques every step). Bounded;
+  // a copy of the engine starts with none.
+  struct CliquePool {
+    static constexpr std::size_t kMax = 64;
+    std::vector<Clique> spare;
+    CliquePool() = default;
+    CliquePool(const CliquePool&) {}
+    CliquePool& operator=(const CliquePool&) { return *this; }
+    CliquePool(CliquePool&&) noexcept = default;
+    CliquePool& operator=(CliquePool&&) noexcept = default;
+  };
+  mutable CliquePool pool_;
 };
 
 }  // namespace gssm::internal
