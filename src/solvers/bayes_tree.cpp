@@ -368,28 +368,28 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     addPending(in.first, in.second.kind == InputSource::Kind::Orphan ? std::nullopt
                                                                       : std::optional<InputSource>(in.second));
   }
-  // Fresh cliques, from the pool where it has some: their matrices and lists
-  // are overwritten below (same shapes: no allocation).
-  p.fresh.clear();
-  p.fresh.reserve(ordering.size());
-  for (std::size_t i = 0; i < ordering.size(); ++i) {
-    if (pool_.spare.empty()) {
-      p.fresh.emplace_back();
-      continue;
-    }
-    p.fresh.push_back(std::move(pool_.spare.back()));
-    pool_.spare.pop_back();
-    Clique& c = p.fresh.back();
-    c.owned.clear();
-    c.children.clear();
-    c.parent = -1;
-  }
+  p.fresh.assign(ordering.size(), Clique{});  // empty: no allocation
   p.fresh_owned.clear();
+  // A pooled clique of the same shape, if any, whose storage the new one
+  // then overwrites without allocating.
+  auto reuse = [&](Clique& cl, Eigen::Index dv, Eigen::Index sep_cols, std::size_t sep_count) {
+    auto& spare = pool_.spare;
+    for (std::size_t i = spare.size(); i-- > 0;) {
+      const Clique& c = spare[i];
+      if (c.R.rows() != dv || c.S.cols() != sep_cols || c.separator.size() != sep_count) continue;
+      cl = std::move(spare[i]);
+      spare[i] = std::move(spare.back());
+      spare.pop_back();
+      cl.owned.clear();
+      cl.children.clear();
+      cl.parent = -1;
+      return;
+    }
+  };
   const double damping = p.update.damping;
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
     const Key& v = ordering[vi];
     Clique& cl = p.fresh[vi];
-    cl.frontal = v;
     // Union of keys, v first then by position.
     std::vector<Key>& sep = scratch_.separator;
     sep.clear();
@@ -408,6 +408,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
       colOf.set(k, ncols);
       ncols += dims.at(k);
     }
+    reuse(cl, dv, ncols - dv, sep.size());
+    cl.frontal = v;
     const Eigen::Index damp_rows = damping > 0 ? dv : 0;
     Eigen::MatrixXd& M = scratch_.stacked;
     M.setZero(rows + damp_rows, ncols + 1);
