@@ -652,12 +652,26 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
     // One clique, the root (the constants, checked after every update):
     // Σ = R⁻¹R⁻ᵀ of its own conditional, densely, without assembling a
     // sparse system (8k instructions per fixed-lag update before).
-    const Clique& root = cliques_[static_cast<std::size_t>(path[0])];
-    const Eigen::MatrixXd Rt = root.R.transpose();
-    const Eigen::MatrixXd Y = Rt.triangularView<Eigen::Lower>().solve(
-        Eigen::MatrixXd::Identity(root.R.rows(), root.R.rows()));
-    const Eigen::MatrixXd S = Y.transpose() * Y;
-    return 0.5 * (S + S.transpose());
+    // Y = R⁻ᵀ by forward substitution, column by column; Σ = YᵀY is
+    // symmetric as computed (entry (i, j) and (j, i) sum the same products).
+    const Eigen::MatrixXd& R = cliques_[static_cast<std::size_t>(path[0])].R;
+    const Eigen::Index n = R.rows();
+    Eigen::MatrixXd& Y = scratch_.stacked;
+    Y.setIdentity(n, n);
+    for (Eigen::Index c = 0; c < n; ++c)
+      for (Eigen::Index i = c; i < n; ++i) {
+        double v = Y(i, c);
+        for (Eigen::Index k = c; k < i; ++k) v -= R(k, i) * Y(k, c);
+        Y(i, c) = v / R(i, i);
+      }
+    Eigen::MatrixXd S(n, n);
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i < n; ++i) {
+        double v = 0;
+        for (Eigen::Index k = std::max(i, j); k < n; ++k) v += Y(k, i) * Y(k, j);  // Y is lower triangular
+        S(i, j) = v;
+      }
+    return S;
   }
   std::sort(path.begin(), path.end(), [&](int a, int b) {
     return vars_.at(cliques_[static_cast<std::size_t>(a)].frontal).rank <
