@@ -630,7 +630,8 @@ int BayesTreeEngine::solveAll() {
 }
 
 void BayesTreeEngine::solvePath(const Key& k) {
-  std::vector<int> path;
+  std::vector<int>& path = scratch_.path;
+  path.clear();
   for (int c = vars_.at(k).clique; c >= 0; c = cliques_[static_cast<std::size_t>(c)].parent) path.push_back(c);
   for (auto it = path.rbegin(); it != path.rend(); ++it) backSubstitute(*it);
 }

@@ -188,7 +188,7 @@ class BayesTreeEngine {
   int root_ = -1;
   // Buffers reused by the per-update hot paths (linearize and
   // linearizationError for every new or candidate factor, backSubstitute
-  // for every touched clique), so
+  // for every touched clique, eliminateTop, solvePath), so
   // they allocate once, not per call. Not state: never saved or compared.
   // x: variables at anchor + delta; stale keys are harmless (a factor reads
   // its own) and dropped when the set outgrows a window.
@@ -198,6 +198,7 @@ class BayesTreeEngine {
     Eigen::MatrixXd stacked;  // a clique's [A | b] while it is triangularized
     std::vector<Key> separator;
     std::vector<std::vector<std::size_t>> pending_of;  // eliminateTop's queue, per ordering entry
+    std::vector<int> path;                             // solvePath's cliques, leaf to root
   };
   mutable Scratch scratch_;
   // Cliques replaced by an update, kept so the next elimination refills
