@@ -234,7 +234,6 @@ struct BayesTreeEngine::UpdatePlan {
   std::vector<LinearFactor> linearized_new;         // of new_factors, same order
   std::unordered_map<int, LinearFactor> relinearized;  // by slot
   // detachTop
-  std::unordered_set<int> removed;
   std::vector<int> removed_order;                   // cliques of the top, leaf to root
   std::vector<int> orphans;                         // subtrees hanging below the top
   std::vector<Key> keys;                            // variables to eliminate
@@ -289,12 +288,15 @@ void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
 // its cliques owned (relinearized where asked), the new factors, and the
 // marginals of the orphaned subtrees below it.
 void BayesTreeEngine::detachTop(UpdatePlan& p) const {
+  // Cliques in the top, marked by id (a reused buffer, cleared on the way out).
+  std::vector<char>& removed = scratch_.in_top;
+  if (removed.size() < cliques_.size()) removed.resize(cliques_.size(), 0);
   auto markUp = [&](const Key& k) {
     auto it = vars_.find(k);
     if (it == vars_.end()) return;
-    for (int c = it->second.clique; c >= 0 && !p.removed.count(c);
+    for (int c = it->second.clique; c >= 0 && !removed[static_cast<std::size_t>(c)];
          c = cliques_[static_cast<std::size_t>(c)].parent) {
-      p.removed.insert(c);
+      removed[static_cast<std::size_t>(c)] = 1;
       p.removed_order.push_back(c);
     }
   };
@@ -315,7 +317,7 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
                           {Kind::Slot, s}});
     }
     for (int ch : cl.children)
-      if (!p.removed.count(ch)) p.orphans.push_back(ch);
+      if (!removed[static_cast<std::size_t>(ch)]) p.orphans.push_back(ch);
   }
   for (const auto& kv : p.new_variables) p.keys.push_back(kv.first);
   for (std::size_t i = 0; i < p.linearized_new.size(); ++i)
@@ -323,6 +325,7 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
   for (std::size_t i = 0; i < p.new_linear.size(); ++i)
     p.inputs.push_back({&p.new_linear[i], {Kind::NewLinear, static_cast<int>(i)}});
   for (int o : p.orphans) p.inputs.push_back({&cliques_[static_cast<std::size_t>(o)].marginal, {Kind::Orphan, o}});
+  for (int c : p.removed_order) removed[static_cast<std::size_t>(c)] = 0;
 }
 
 // Phase 3: order the top's variables and eliminate them one at a time into

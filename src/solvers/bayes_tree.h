@@ -199,6 +199,7 @@ class BayesTreeEngine {
     std::vector<Key> separator;
     std::vector<std::vector<std::size_t>> pending_of;  // eliminateTop's queue, per ordering entry
     std::vector<int> path;                             // solvePath's cliques, leaf to root
+    std::vector<char> in_top;                          // detachTop's marks, by clique id (all 0 between calls)
   };
   mutable Scratch scratch_;
   // Cliques replaced by an update, kept so the next elimination refills
