@@ -146,7 +146,11 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
     else x.at(k) = value;
   }
   LinearFactor lf;
-  lf.keys = f.keys();
+  if (!pool_.spare_linear.empty()) {  // its vectors and matrices get overwritten (same shapes: no allocation)
+    lf = std::move(pool_.spare_linear.back());
+    pool_.spare_linear.pop_back();
+  }
+  lf.keys.assign(f.keys().begin(), f.keys().end());
   Eigen::VectorXd& r = scratch_.r;
   f.linearizeRobust(x, r, &lf.A);  // robust factors reweighted at each linearization
   bool finite = r.allFinite();
@@ -488,7 +492,9 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
 // cliques. Nothing here throws short of memory.
 void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   for (auto& kv : p.relinearized) {
-    slots_[static_cast<std::size_t>(kv.first)].linear = std::move(kv.second);
+    LinearFactor& linear = slots_[static_cast<std::size_t>(kv.first)].linear;
+    std::swap(linear, kv.second);
+    if (pool_.spare_linear.size() < CliquePool::kMax) pool_.spare_linear.push_back(std::move(kv.second));
     ++counts.factors_relinearized;
   }
   for (int c : p.removed_order) {
@@ -813,6 +819,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
       auto& v = it->second;
       v.erase(std::remove(v.begin(), v.end(), s), v.end());
     }
+    if (pool_.spare_linear.size() < CliquePool::kMax) pool_.spare_linear.push_back(std::move(slot.linear));
     slot = Slot{};
     free_slots_.push_back(s);
     --slots_alive_;

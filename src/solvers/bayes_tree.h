@@ -202,13 +202,15 @@ class BayesTreeEngine {
     std::vector<char> in_top;                          // detachTop's marks, by clique id (all 0 between calls)
   };
   mutable Scratch scratch_;
-  // Cliques replaced by an update, kept so the next elimination refills
-  // their matrices and lists in place instead of allocating new ones (a
-  // fixed-lag update replaces the same few cliques every step). Bounded;
-  // a copy of the engine starts with none.
+  // Cliques replaced by an update and linearizations of dropped factors,
+  // kept so the next elimination and linearization refill their matrices
+  // and lists in place instead of allocating new ones (a fixed-lag update
+  // replaces the same few cliques and factors every step). Bounded; a copy
+  // of the engine starts with none.
   struct CliquePool {
     static constexpr std::size_t kMax = 64;
     std::vector<Clique> spare;
+    std::vector<LinearFactor> spare_linear;  // linearizations of dropped factors, refilled by linearize()
     CliquePool() = default;
     CliquePool(const CliquePool&) {}
     CliquePool& operator=(const CliquePool&) { return *this; }
