@@ -218,20 +218,23 @@ std::vector<Key> BayesTreeEngine::order(const std::vector<Key>& keys,
   return out;
 }
 
-// Where an input of the elimination comes from, so that commit() can give
-// each consumed factor its slot.
-struct InputSource {
-  enum class Kind { Slot, NewFactor, NewLinear, Orphan };
-  Kind kind;
-  int index;  // slot, or index into the new factors / new linear factors; unused for Orphan
-};
-
 struct BayesTreeEngine::UpdatePlan {
-  explicit UpdatePlan(const EngineUpdate& u)
+  UpdatePlan(const EngineUpdate& u, UpdateLists& l)
       : update(u),
         new_variables(u.new_variables ? *u.new_variables : none),
         new_factors(u.new_factors ? *u.new_factors : no_factors),
-        new_linear(u.new_linear ? *u.new_linear : no_linear) {}
+        new_linear(u.new_linear ? *u.new_linear : no_linear),
+        lists(&l),
+        linearized_new(l.linearized_new),
+        removed_order(l.removed_order),
+        orphans(l.orphans),
+        keys(l.keys),
+        inputs(l.inputs),
+        fresh(l.fresh),
+        fresh_owned(l.fresh_owned),
+        fresh_id(l.fresh_id) {
+    l.clear();
+  }
   const EngineUpdate& update;
   const Values none{};
   const std::vector<FactorPtr> no_factors{};
@@ -239,26 +242,23 @@ struct BayesTreeEngine::UpdatePlan {
   const Values& new_variables;
   const std::vector<FactorPtr>& new_factors;
   const std::vector<LinearFactor>& new_linear;
-  // linearizeInputs
-  std::vector<LinearFactor> linearized_new;         // of new_factors, same order
-  std::unordered_map<int, LinearFactor> relinearized;  // by slot
-  // detachTop
-  std::vector<int> removed_order;                   // cliques of the top, leaf to root
-  std::vector<int> orphans;                         // subtrees hanging below the top
-  std::vector<Key> keys;                            // variables to eliminate
-  std::vector<std::pair<const LinearFactor*, InputSource>> inputs;
-  // eliminateTop
+  std::unordered_map<int, LinearFactor> relinearized;  // by slot (linearizeInputs)
+  // The rest lives in the engine's UpdateLists, emptied here, so that its
+  // vectors keep their capacity from update to update.
+  UpdateLists* lists = nullptr;
+  std::vector<LinearFactor>& linearized_new;
+  std::vector<int>& removed_order;
+  std::vector<int>& orphans;
+  std::vector<Key>& keys;
+  std::vector<std::pair<const LinearFactor*, InputSource>>& inputs;
   std::vector<Key> ordering;
-  std::vector<Clique> fresh;                        // one per ordering entry
-  // The factor inputs each fresh clique consumed, as (clique, source) in
-  // clique order (one list per update, not one per clique).
-  std::vector<std::pair<std::size_t, InputSource>> fresh_owned;
-  // commit
-  std::vector<int> fresh_id;
+  std::vector<Clique>& fresh;
+  std::vector<std::pair<std::size_t, InputSource>>& fresh_owned;
+  std::vector<int>& fresh_id;
 };
 
 void BayesTreeEngine::update(const EngineUpdate& u, EngineCounts& counts) {
-  UpdatePlan plan(u);
+  UpdatePlan plan(u, lists_);
   linearizeInputs(plan);  // validates; nothing modified until commit()
   detachTop(plan);
   eliminateTop(plan);

@@ -46,6 +46,45 @@ struct Clique {
   std::vector<int> children;
 };
 
+// Where an input of the elimination comes from, so that commit() can give
+// each consumed factor its slot.
+struct InputSource {
+  enum class Kind { Slot, NewFactor, NewLinear, Orphan };
+  Kind kind;
+  int index;  // slot, or index into the new factors / new linear factors; unused for Orphan
+};
+
+// The lists one engine update fills (bayes_tree.cpp's UpdatePlan), kept by
+// the engine so their capacity carries over; a copy of the engine starts
+// with empty ones.
+struct UpdateLists {
+  std::vector<LinearFactor> linearized_new;         // of the new factors, same order
+  std::vector<int> removed_order;                   // cliques of the top, leaf to root
+  std::vector<int> orphans;                         // subtrees hanging below the top
+  std::vector<Key> keys;                            // variables to eliminate
+  std::vector<std::pair<const LinearFactor*, InputSource>> inputs;
+  std::vector<Clique> fresh;                        // one per ordering entry
+  // The factor inputs each fresh clique consumed, as (clique, source) in
+  // clique order (one list per update, not one per clique).
+  std::vector<std::pair<std::size_t, InputSource>> fresh_owned;
+  std::vector<int> fresh_id;
+  UpdateLists() = default;
+  UpdateLists(const UpdateLists&) {}
+  UpdateLists& operator=(const UpdateLists&) { return *this; }
+  UpdateLists(UpdateLists&&) noexcept = default;
+  UpdateLists& operator=(UpdateLists&&) noexcept = default;
+  void clear() {
+    linearized_new.clear();
+    removed_order.clear();
+    orphans.clear();
+    keys.clear();
+    inputs.clear();
+    fresh.clear();
+    fresh_owned.clear();
+    fresh_id.clear();
+  }
+};
+
 enum class OrderingMode {
   TimeOrdered,        ///< states by step, constants last (oldest state always a leaf)
   ConstrainedColamd,  ///< CCOLAMD with constants last and the newest variables next to them
@@ -218,6 +257,7 @@ class BayesTreeEngine {
     CliquePool& operator=(CliquePool&&) noexcept = default;
   };
   mutable CliquePool pool_;
+  UpdateLists lists_;
 };
 
 }  // namespace gssm::internal
