@@ -73,15 +73,25 @@ struct UpdateLists {
   UpdateLists& operator=(const UpdateLists&) { return *this; }
   UpdateLists(UpdateLists&&) noexcept = default;
   UpdateLists& operator=(UpdateLists&&) noexcept = default;
+  /// Empties every list; one that a large update (a relinearization of the
+  /// whole history) grew past kKeep entries gives its memory back.
   void clear() {
-    linearized_new.clear();
-    removed_order.clear();
-    orphans.clear();
-    keys.clear();
-    inputs.clear();
-    fresh.clear();
-    fresh_owned.clear();
-    fresh_id.clear();
+    reset(linearized_new);
+    reset(removed_order);
+    reset(orphans);
+    reset(keys);
+    reset(inputs);
+    reset(fresh);
+    reset(fresh_owned);
+    reset(fresh_id);
+  }
+
+ private:
+  static constexpr std::size_t kKeep = 256;
+  template <class V>
+  static void reset(V& v) {
+    if (v.capacity() > kKeep) V().swap(v);
+    else v.clear();
   }
 };
 
