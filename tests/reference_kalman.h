@@ -20,6 +20,17 @@ inline NormalSampler normalSampler(unsigned seed) {
   return [rng, dist] { return (*dist)(*rng); };
 }
 
+/// The radar paper scenario's truth (x(0) = 0, ẋ = 100, h = 1000, no
+/// process noise), simulated for `steps` steps with seeded noise.
+inline SimulatedRun radarPaperRun(const Model& radar, int steps, unsigned seed) {
+  SimulationSpec spec;
+  spec.steps = steps;
+  spec.x0 = Eigen::VectorXd::Constant(1, 0.0);
+  spec.xb = Eigen::Vector2d(100, 1000);
+  spec.process_noise = false;
+  return simulate(radar, spec, normalSampler(seed));
+}
+
 struct StackedLinear {
   Eigen::MatrixXd F, Qz, H, R;
   Eigen::VectorXd z0;

@@ -19,15 +19,7 @@ using gssm::testing::relativeError;
 namespace {
 
 using gssm::testing::normalSampler;
-
-SimulatedRun radarPaperRun(const models::Radar2D& radar, int steps, unsigned seed) {
-  SimulationSpec spec;
-  spec.steps = steps;
-  spec.x0 = Eigen::VectorXd::Constant(1, 0.0);
-  spec.xb = Eigen::Vector2d(100, 1000);
-  spec.process_noise = false;
-  return simulate(radar, spec, normalSampler(seed));
-}
+using gssm::testing::radarPaperRun;
 
 // Dense information matrix JᵀJ and gradient Jᵀr assembled independently of
 // the solver, from each factor's Jacobian blocks.
