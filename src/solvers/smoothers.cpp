@@ -158,8 +158,8 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
   if (tree_lambda > 0) {
     // The tree still holds Marquardt rows from its last kept step (the
     // undamped finish was rejected, or the iteration stopped damped), which
-    // make every covariance read from it too small (~100× on the radar
-    // start-up). Re-eliminate it undamped at the estimate reached: the
+    // make every covariance read from it too small (~100× on the robust
+    // beacon test when λ₀ was 1e-4). Re-eliminate it undamped at the estimate reached: the
     // estimate becomes that tree's solution, one Gauss–Newton step on
     // (negligible where the iteration had converged).
     internal::BayesTreeEngine snapshot = engine;
@@ -169,6 +169,7 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
       trial.variables_backsubstituted += engine.solveAll();
       counts = trial;
       ++rep.iterations;
+      previous_cost = engine.cost();
     } catch (const NumericalError& e) {
       engine = std::move(snapshot);
       rep.note = std::string("covariances keep the last damping (the undamped system did not factor: ") + e.what() + ")";
