@@ -224,7 +224,6 @@ struct BayesTreeEngine::UpdatePlan {
         new_variables(u.new_variables ? *u.new_variables : none),
         new_factors(u.new_factors ? *u.new_factors : no_factors),
         new_linear(u.new_linear ? *u.new_linear : no_linear),
-        lists(&l),
         linearized_new(l.linearized_new),
         removed_order(l.removed_order),
         orphans(l.orphans),
@@ -245,7 +244,6 @@ struct BayesTreeEngine::UpdatePlan {
   std::unordered_map<int, LinearFactor> relinearized;  // by slot (linearizeInputs)
   // The rest lives in the engine's UpdateLists, emptied here, so that its
   // vectors keep their capacity from update to update.
-  UpdateLists* lists = nullptr;
   std::vector<LinearFactor>& linearized_new;
   std::vector<int>& removed_order;
   std::vector<int>& orphans;
@@ -663,7 +661,7 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
          c = cliques_[static_cast<std::size_t>(c)].parent)
       path.push_back(c);
   }
-  if (path.size() == 1) {
+  if (path.size() == 1 && keys.size() == 1) {
     // One clique, the root (the constants, checked after every update):
     // Σ = R⁻¹R⁻ᵀ of its own conditional, densely, without assembling a
     // sparse system (8k instructions per fixed-lag update before).
