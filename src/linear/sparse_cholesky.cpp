@@ -30,6 +30,9 @@ SparseCholesky::~SparseCholesky() {
 }
 
 void SparseCholesky::freeAll() {
+  if (solution_) cholmod_free_dense(&solution_, &common_);
+  if (work_y_) cholmod_free_dense(&work_y_, &common_);
+  if (work_e_) cholmod_free_dense(&work_e_, &common_);
   if (triplet_) cholmod_free_triplet(&triplet_, &common_);
   if (factor_) cholmod_free_factor(&factor_, &common_);
   if (matrix_) cholmod_free_sparse(&matrix_, &common_);
@@ -70,7 +73,8 @@ void SparseCholesky::assemble() {
   std::vector<std::uint32_t> by_column(count_);
   std::vector<std::size_t> next(start.begin(), start.end() - 1);
   for (std::size_t e = 0; e < count_; ++e) by_column[next[static_cast<std::size_t>(Tj[e])]++] = static_cast<std::uint32_t>(e);
-  assembleColumns(start, by_column, Ti, static_cast<const double*>(triplet_->x));
+  slot_.resize(count_);
+  assembleColumns(start, by_column, Ti, static_cast<const double*>(triplet_->x), slot_.data());
   cholmod_free_triplet(&triplet_, &common_);
 }
 
@@ -79,7 +83,7 @@ void SparseCholesky::assemble() {
 // each entry's position. Insertion sort for the short columns of the states,
 // a merge sort for the constants' long ones.
 void SparseCholesky::assembleColumns(const std::vector<std::size_t>& start, std::vector<std::uint32_t>& by_column,
-                                     const int* row, const double* value) {
+                                     const int* row, const double* value, int* slot) {
   const std::size_t n = static_cast<std::size_t>(n_);
   std::size_t unique = 0;
   for (std::size_t j = 0; j < n; ++j) {
@@ -103,18 +107,22 @@ void SparseCholesky::assembleColumns(const std::vector<std::size_t>& start, std:
   int* Ap = static_cast<int*>(matrix_->p);
   int* Ai = static_cast<int*>(matrix_->i);
   double* Ax = static_cast<double*>(matrix_->x);
-  slot_.resize(count_);
+  // `slot` may be `row` itself: an entry's row is read before its slot
+  // overwrites it, and the previous entry's row is kept aside.
   int q = -1;
   for (std::size_t j = 0; j < n; ++j) {
     Ap[j] = q + 1;
+    int previous_row = -1;
     for (std::size_t p = start[j]; p < start[j + 1]; ++p) {
       const std::uint32_t e = by_column[p];
-      if (p == start[j] || row[e] != row[by_column[p - 1]]) {
-        Ai[++q] = row[e];
+      const int r = row[e];
+      if (p == start[j] || r != previous_row) {
+        Ai[++q] = r;
         Ax[q] = 0.0;
       }
+      previous_row = r;
       if (value) Ax[q] += value[e];
-      slot_[e] = q;
+      slot[e] = q;
     }
   }
   Ap[n] = q + 1;
@@ -172,6 +180,25 @@ Eigen::Index SparseCholesky::factorize() {
   if (common_.status == CHOLMOD_NOT_POSDEF) return static_cast<Eigen::Index>(factor_->minor);
   if (common_.status < CHOLMOD_OK) throw NumericalError("CHOLMOD numeric factorization failed");
   return -1;
+}
+
+void SparseCholesky::solveInPlace(Eigen::VectorXd& b) {
+  if (dense_) {  // small: as solve() does it (matrix kernels, the same rounding)
+    b = solve(b);
+    return;
+  }
+  // b's storage as CHOLMOD's right-hand side; the solution and workspace are
+  // kept from call to call (at a million unknowns, fresh ones per LM step
+  // were tens of MB of page faults).
+  cholmod_dense B{};
+  B.nrow = B.nzmax = B.d = static_cast<std::size_t>(b.size());
+  B.ncol = 1;
+  B.x = b.data();
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  if (!cholmod_solve2(CHOLMOD_A, factor_, &B, nullptr, &solution_, nullptr, &work_y_, &work_e_, &common_))
+    throw NumericalError("CHOLMOD solve failed");
+  std::memcpy(b.data(), solution_->x, sizeof(double) * static_cast<std::size_t>(b.size()));
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& B) {

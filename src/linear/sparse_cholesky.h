@@ -51,6 +51,8 @@ class SparseCholesky {
   /// that fill stays small).
   /// Returns -1 on success, else the column at which H is not positive definite.
   Eigen::Index factorize();
+  /// Solves H x = b in place (no allocation after the first call).
+  void solveInPlace(Eigen::VectorXd& b);
   /// Solves H X = B for a dense right-hand side (n × m).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& B);
 
@@ -70,7 +72,7 @@ class SparseCholesky {
  private:
   void freeAll();
   void assembleColumns(const std::vector<std::size_t>& start, std::vector<std::uint32_t>& by_column, const int* row,
-                       const double* value);
+                       const double* value, int* slot);
   cholmod_common common_;
   cholmod_triplet* triplet_ = nullptr;
   cholmod_factor* factor_ = nullptr;
@@ -78,6 +80,9 @@ class SparseCholesky {
   // slot_: entry → position in its values.
   cholmod_sparse* matrix_ = nullptr;
   std::vector<int> slot_;
+  cholmod_dense* solution_ = nullptr;  // solveInPlace's result and workspace, reused
+  cholmod_dense* work_y_ = nullptr;
+  cholmod_dense* work_e_ = nullptr;
   Eigen::Index n_ = 0;
   std::size_t count_ = 0;
   bool dense_ = false;
@@ -100,7 +105,8 @@ void SparseCholesky::assemblePattern(Eigen::Index n, ForEachEntry&& each) {
     row[e] = static_cast<int>(i);
     by_column[next[static_cast<std::size_t>(j)]++] = e++;
   });
-  assembleColumns(start, by_column, row.data(), nullptr);
+  assembleColumns(start, by_column, row.data(), nullptr, row.data());  // each entry's row becomes its slot
+  slot_ = std::move(row);
   if (triplet_) cholmod_free_triplet(&triplet_, &common_);
 }
 

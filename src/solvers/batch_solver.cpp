@@ -227,7 +227,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   sum.initial_cost = cost;
   const bool lm = options_.method == BatchSolverOptions::Method::LevenbergMarquardt;
   internal::LevenbergMarquardtPolicy policy(options_.initial_lambda, options_.max_lambda, lm);
-  Eigen::VectorXd delta;
+  Eigen::VectorXd delta, xflat;  // reused across iterations (8 MB each at 10⁶ steps)
 
   // candidate = from + d, written in place (both hold the same keys in the
   // same order): copying a million-node map per LM step cost 12% of a solve.
@@ -266,8 +266,9 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       ++sum.rejected_steps;
       continue;
     }
-    delta = -s.chol.solve(g);
-    Eigen::VectorXd xflat(s.n);
+    delta = -g;
+    s.chol.solveInPlace(delta);  // −H⁻¹g, exactly the negated solution
+    xflat.resize(s.n);
     {
       std::size_t i = 0;
       for (const auto& kv : x) xflat.segment(s.offset[i++], kv.second.size()) = kv.second;
