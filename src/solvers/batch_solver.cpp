@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <optional>
@@ -69,15 +70,16 @@ std::string BatchSolverSummary::toString() const {
 struct BatchSolver::Impl {
   Values layout;                         // the variables (keys; values unused) in column order
   std::vector<Eigen::Index> offset;      // first column of each, by Values position; then n
-  std::vector<Key> keys_by_column;       // for error messages
-  std::vector<Eigen::Index> dims_by_column;
   Eigen::Index n = 0;
   internal::SparseCholesky chol;
-  std::vector<Eigen::Index> factor_cols;  // each factor's first column per key, concatenated
-  std::vector<std::size_t> factor_begin;  // factor i's keys: factor_cols[factor_begin[i] ...]
+  // Compact (a million-step run has 2M factors): each factor's variables as
+  // positions in the layout, concatenated; factor i's are
+  // factor_vars[factor_begin[i] ...].
+  std::vector<std::uint32_t> factor_vars;
+  std::vector<std::uint32_t> factor_begin;
   const int* entry_slot = nullptr;        // H's value index of every JᵀJ entry, factor by factor (chol's)
   const int* diagonal_slot = nullptr;     // H(i, i)'s value index
-  std::vector<std::size_t> factor_shape;  // index into jacobians (same keys count and residual size)
+  std::vector<std::uint32_t> factor_shape;  // index into jacobians (same keys count and residual size)
   // Jacobian buffers per factor shape, so alternating process and
   // measurement factors reuse their storage.
   std::vector<std::vector<Eigen::MatrixXd>> jacobians;
@@ -89,63 +91,68 @@ struct BatchSolver::Impl {
     offset.clear();
     layout = Values();
     layout.reserve(values.size());
-    keys_by_column.clear();
-    dims_by_column.clear();
     n = 0;
     for (const auto& kv : values) {  // std::map order: states by step, constants last
       offset.push_back(n);
       layout.insert(kv.first, Eigen::VectorXd());
-      for (Eigen::Index i = 0; i < kv.second.size(); ++i) {
-        keys_by_column.push_back(kv.first);
-        dims_by_column.push_back(i);
-      }
       n += kv.second.size();
     }
     offset.push_back(n);
-    factor_cols.clear();
+    factor_vars.clear();
     factor_begin.assign(1, 0);
     factor_shape.clear();
     jacobians.clear();
-    std::map<std::pair<std::size_t, int>, std::size_t> shapes;
-    std::vector<Eigen::Index> dims;  // parallel to factor_cols: each key's size
-    factor_cols.reserve(3 * graph.size());
-    dims.reserve(3 * graph.size());
+    std::map<std::pair<std::size_t, int>, std::uint32_t> shapes;
+    factor_vars.reserve(3 * graph.size());
     factor_begin.reserve(graph.size() + 1);
     factor_shape.reserve(graph.size());
+    std::size_t max_keys = 0;
     for (const auto& f : graph) {
       for (const auto& k : f->keys()) {
         if (!values.contains(k))
           throw InvalidArgument("BatchSolver: factor '" + f->describe() + "' uses " +
                                 k.toString() + ", which has no initial value");
-        const std::size_t i = values.indexOf(k);
-        factor_cols.push_back(offset[i]);
-        dims.push_back(offset[i + 1] - offset[i]);
+        factor_vars.push_back(static_cast<std::uint32_t>(values.indexOf(k)));
       }
-      factor_begin.push_back(factor_cols.size());
+      factor_begin.push_back(static_cast<std::uint32_t>(factor_vars.size()));
+      max_keys = std::max(max_keys, f->keys().size());
       const auto key = std::make_pair(f->keys().size(), f->dim());
       auto shape = shapes.find(key);
-      if (shape == shapes.end()) shape = shapes.emplace(key, shapes.size()).first;
+      if (shape == shapes.end()) shape = shapes.emplace(key, static_cast<std::uint32_t>(shapes.size())).first;
       factor_shape.push_back(shape->second);
     }
     jacobians.resize(shapes.size());
+    factor_offs.resize(max_keys);
+    factor_dims.resize(max_keys);
     // The pattern: every factor's upper JᵀJ entries, then the diagonal
     // (which the damping needs even where no factor reaches).
     std::size_t entries = 0;
     chol.assemblePattern(n, [&](auto&& emit) {
       entries = 0;
-      for (std::size_t fi = 0; fi < graph.size(); ++fi) {
-        const std::size_t b = factor_begin[fi];
-        internal::forEachUpperEntry(&factor_cols[b], &dims[b], factor_begin[fi + 1] - b,
+      for (std::size_t fi = 0; fi < graph.size(); ++fi)
+        internal::forEachUpperEntry(factor_offs.data(), factor_dims.data(), columnsOf(fi),
                                     [&](Eigen::Index gi, Eigen::Index gj, auto...) {
                                       emit(gi, gj);
                                       ++entries;
                                     });
-      }
       for (Eigen::Index i = 0; i < n; ++i) emit(i, i);
     });
     entry_slot = chol.slots();
     diagonal_slot = entry_slot + entries;
   }
+
+  // Factor fi's variables' first columns and sizes into factor_offs and
+  // factor_dims; returns how many.
+  std::size_t columnsOf(std::size_t fi) {
+    const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
+    for (std::size_t a = 0; a < count; ++a) {
+      const std::size_t v = factor_vars[b + a];
+      factor_offs[a] = offset[v];
+      factor_dims[a] = offset[v + 1] - offset[v];
+    }
+    return count;
+  }
+  std::vector<Eigen::Index> factor_offs, factor_dims;
 
   // Linearizes every factor at x: writes H = JᵀJ into the factorization's
   // values (undamped; `diag` gets its diagonal), the gradient g = Jᵀr, and
@@ -169,7 +176,8 @@ struct BatchSolver::Impl {
                              "' has a non-finite residual at the current estimate");
       }
       cost += c;
-      const Eigen::Index* offs = &factor_cols[factor_begin[fi]];
+      columnsOf(fi);
+      const Eigen::Index* offs = factor_offs.data();
       for (std::size_t a = 0; a < J.size(); ++a) g.segment(offs[a], J[a].cols()).noalias() += J[a].transpose() * r;
       internal::forEachUpperJtJ(offs, J, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
       ++fi;
@@ -187,10 +195,12 @@ struct BatchSolver::Impl {
   }
 
   [[noreturn]] void throwSingular(Eigen::Index column) const {
-    const Key k = keys_by_column.at(static_cast<std::size_t>(column));
+    // The variable holding this column: the last offset at or before it.
+    const std::size_t v = static_cast<std::size_t>(std::upper_bound(offset.begin(), offset.end(), column) - offset.begin()) - 1;
+    const Key k = (layout.begin() + static_cast<std::ptrdiff_t>(v))->first;
     std::ostringstream os;
     os << "BatchSolver: the information matrix is not positive definite at variable "
-       << k.toString() << " component " << dims_by_column.at(static_cast<std::size_t>(column))
+       << k.toString() << " component " << column - offset[v]
        << (k.isConstants() ? " (a constant)" : " (a time-series state)")
        << ": the data and priors do not determine it (unobserved, a zero Jacobian such as a "
           "range at x = h = 0, or a non-finite value). Add a prior on it or check the model.";
