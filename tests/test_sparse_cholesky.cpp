@@ -11,6 +11,19 @@
 using gssm::internal::SparseCholesky;
 
 namespace {
+// The upper-triangle entries of H in the order fill() adds them: column by
+// column, rows ascending in the band and descending in the border (so the
+// long border columns arrive unsorted, as the constants' do from a graph).
+template <class F>
+void forEachUpper(const Eigen::MatrixXd& H, F&& f) {
+  const Eigen::Index n = H.rows();
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index k = 0; k <= j; ++k) {
+      const Eigen::Index i = j >= n - 2 ? j - k : k;
+      if (H(i, j) != 0) f(i, j);
+    }
+}
+
 // A banded SPD matrix with a dense border (the GSSM's shape), given to the
 // factorization as upper-triangle triplets with every entry split in two
 // (duplicates must be summed).
@@ -26,12 +39,10 @@ Eigen::MatrixXd fill(SparseCholesky& c, Eigen::Index n, unsigned seed, Eigen::In
   for (Eigen::Index j = 0; j < n; ++j)
     for (Eigen::Index i = 0; i <= j; ++i) nnz += H(i, j) != 0 ? 2 : 0;
   c.reset(n, nnz);
-  for (Eigen::Index j = 0; j < n; ++j)
-    for (Eigen::Index i = 0; i <= j; ++i)
-      if (H(i, j) != 0) {
-        c.add(i, j, 0.25 * H(i, j));
-        c.add(i, j, 0.75 * H(i, j));
-      }
+  forEachUpper(H, [&](Eigen::Index i, Eigen::Index j) {
+    c.add(i, j, 0.25 * H(i, j));
+    c.add(i, j, 0.75 * H(i, j));
+  });
   return H;
 }
 }  // namespace
@@ -61,12 +72,10 @@ TEST(SparseCholesky, DenseAndSparsePathsEqualADenseReference) {
     // was added as two parts, in fill()'s order): H doubled, same pattern.
     std::fill(c.values(), c.values() + c.nonzeros(), 0.0);
     std::size_t e = 0;
-    for (Eigen::Index j = 0; j < n; ++j)
-      for (Eigen::Index i = 0; i <= j; ++i)
-        if (H(i, j) != 0) {
-          c.values()[c.slot(e++)] += 0.5 * H(i, j);
-          c.values()[c.slot(e++)] += 1.5 * H(i, j);
-        }
+    forEachUpper(H, [&](Eigen::Index i, Eigen::Index j) {
+      c.values()[c.slot(e++)] += 0.5 * H(i, j);
+      c.values()[c.slot(e++)] += 1.5 * H(i, j);
+    });
     ASSERT_EQ(e, c.entries());
     ASSERT_EQ(c.factorize(), -1);
     EXPECT_LT((2 * H * c.solve(B) - B).norm() / B.norm(), 1e-12) << n;

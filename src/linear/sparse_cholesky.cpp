@@ -81,16 +81,27 @@ void SparseCholesky::assemble() {
 // Rows sorted within each column (stable: duplicates keep the order they
 // were added, in which they are summed), then H in compressed columns and
 // each entry's position. Insertion sort for the short columns of the states,
-// a merge sort for the constants' long ones.
+// a counting sort for the constants' long ones.
 void SparseCholesky::assembleColumns(const std::vector<std::size_t>& start, std::vector<std::uint32_t>& by_column,
                                      const int* row, const double* value, int* slot) {
   const std::size_t n = static_cast<std::size_t>(n_);
   std::size_t unique = 0;
+  std::vector<std::uint32_t> count, sorted;  // the long columns' counting sort
   for (std::size_t j = 0; j < n; ++j) {
     std::uint32_t* b = by_column.data() + start[j];
     std::uint32_t* e = by_column.data() + start[j + 1];
     if (e - b > 32) {
-      std::stable_sort(b, e, [&](std::uint32_t x, std::uint32_t y) { return row[x] < row[y]; });
+      // Stable counting sort by row (rows ≤ j): linear in the column's
+      // length where a merge sort of the constants' columns (3M entries
+      // each at a million steps) took 0.3 s.
+      if (!std::is_sorted(b, e, [&](std::uint32_t x, std::uint32_t y) { return row[x] < row[y]; })) {
+        count.assign(j + 2, 0);
+        for (const std::uint32_t* p = b; p < e; ++p) ++count[static_cast<std::size_t>(row[*p]) + 1];
+        for (std::size_t r = 0; r <= j; ++r) count[r + 1] += count[r];
+        sorted.resize(static_cast<std::size_t>(e - b));
+        for (const std::uint32_t* p = b; p < e; ++p) sorted[count[static_cast<std::size_t>(row[*p])]++] = *p;
+        std::copy(sorted.begin(), sorted.end(), b);
+      }
     } else {
       for (std::uint32_t* p = b + 1; p < e; ++p) {
         const std::uint32_t v = *p;

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdint>
 #include <limits>
-#include <map>
 #include <optional>
 #include <sstream>
 
@@ -92,7 +91,7 @@ struct BatchSolver::Impl {
     layout = Values();
     layout.reserve(values.size());
     n = 0;
-    for (const auto& kv : values) {  // std::map order: states by step, constants last
+    for (const auto& kv : values) {  // Key order: states by step, constants last
       offset.push_back(n);
       layout.insert(kv.first, Eigen::VectorXd());
       n += kv.second.size();
@@ -102,23 +101,28 @@ struct BatchSolver::Impl {
     factor_begin.assign(1, 0);
     factor_shape.clear();
     jacobians.clear();
-    std::map<std::pair<std::size_t, int>, std::uint32_t> shapes;
+    // Few distinct shapes (process, measurement, prior): a short list, not a map.
+    std::vector<std::pair<std::pair<std::size_t, int>, std::uint32_t>> shapes;
     factor_vars.reserve(3 * graph.size());
     factor_begin.reserve(graph.size() + 1);
     factor_shape.reserve(graph.size());
     std::size_t max_keys = 0;
     for (const auto& f : graph) {
       for (const auto& k : f->keys()) {
-        if (!values.contains(k))
-          throw InvalidArgument("BatchSolver: factor '" + f->describe() + "' uses " +
-                                k.toString() + ", which has no initial value");
-        factor_vars.push_back(static_cast<std::uint32_t>(values.indexOf(k)));
+        std::size_t i = 0;
+        try {  // one lookup per key (a million-step run has 5M)
+          i = values.indexOf(k);
+        } catch (const InvalidArgument&) {
+          throw InvalidArgument("BatchSolver: factor '" + f->describe() + "' uses " + k.toString() +
+                                ", which has no initial value");
+        }
+        factor_vars.push_back(static_cast<std::uint32_t>(i));
       }
       factor_begin.push_back(static_cast<std::uint32_t>(factor_vars.size()));
       max_keys = std::max(max_keys, f->keys().size());
       const auto key = std::make_pair(f->keys().size(), f->dim());
-      auto shape = shapes.find(key);
-      if (shape == shapes.end()) shape = shapes.emplace(key, static_cast<std::uint32_t>(shapes.size())).first;
+      auto shape = std::find_if(shapes.begin(), shapes.end(), [&](const auto& e) { return e.first == key; });
+      if (shape == shapes.end()) shape = shapes.insert(shapes.end(), {key, static_cast<std::uint32_t>(shapes.size())});
       factor_shape.push_back(shape->second);
     }
     jacobians.resize(shapes.size());
