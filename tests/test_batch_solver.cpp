@@ -167,6 +167,13 @@ TEST(BatchSolver, MarginalCovariancesEqualDenseInverse) {
   const Eigen::MatrixXd far = solver.jointMarginalCovariance({Key::state(0), Key::state(25)});
   EXPECT_NEAR(far(0, 1), Sigma(0, 25), tol * std::sqrt(Sigma(0, 0) * Sigma(25, 25)));
   EXPECT_NEAR(far(1, 1), Sigma(25, 25), tol * Sigma(25, 25));
+  // A key the solve never had is named.
+  try {
+    solver.marginalCovariance(Key::state(26));
+    FAIL() << "unknown variable accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find(Key::state(26).toString()), std::string::npos) << e.what();
+  }
 }
 
 TEST(BatchSolver, SingularSystemNamesTheVariableAndLeavesValuesUnchanged) {

@@ -67,7 +67,7 @@ std::string BatchSolverSummary::toString() const {
 // in H's compressed columns; every linearization then writes H in place
 // (no triplets, no key lookups, no re-sorting).
 struct BatchSolver::Impl {
-  Values layout;                         // the variables (keys; values unused) in column order
+  std::vector<Key> layout;               // the variables' keys in column order (Key order)
   std::vector<Eigen::Index> offset;      // first column of each, by Values position; then n
   Eigen::Index n = 0;
   internal::SparseCholesky chol;
@@ -88,12 +88,12 @@ struct BatchSolver::Impl {
 
   void setup(const FactorGraph& graph, const Values& values) {
     offset.clear();
-    layout = Values();
+    layout.clear();
     layout.reserve(values.size());
     n = 0;
     for (const auto& kv : values) {  // Key order: states by step, constants last
       offset.push_back(n);
-      layout.insert(kv.first, Eigen::VectorXd());
+      layout.push_back(kv.first);
       n += kv.second.size();
     }
     offset.push_back(n);
@@ -143,6 +143,19 @@ struct BatchSolver::Impl {
     });
     entry_slot = chol.slots();
     diagonal_slot = entry_slot + entries;
+  }
+
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+  // Position of k in the layout, or npos (consecutive steps: found directly).
+  std::size_t positionOf(const Key& k) const {
+    if (layout.empty()) return npos;
+    const Key& first = layout.front();
+    if (!first.isConstants() && !k.isConstants() && k.step >= first.step) {
+      const auto guess = static_cast<std::size_t>(k.step - first.step);
+      if (guess < layout.size() && layout[guess] == k) return guess;
+    }
+    const auto it = std::lower_bound(layout.begin(), layout.end(), k);
+    return it != layout.end() && *it == k ? static_cast<std::size_t>(it - layout.begin()) : npos;
   }
 
   // Factor fi's variables' first columns and sizes into factor_offs and
@@ -201,7 +214,7 @@ struct BatchSolver::Impl {
   [[noreturn]] void throwSingular(Eigen::Index column) const {
     // The variable holding this column: the last offset at or before it.
     const std::size_t v = static_cast<std::size_t>(std::upper_bound(offset.begin(), offset.end(), column) - offset.begin()) - 1;
-    const Key k = (layout.begin() + static_cast<std::ptrdiff_t>(v))->first;
+    const Key k = layout[v];
     std::ostringstream os;
     os << "BatchSolver: the information matrix is not positive definite at variable "
        << k.toString() << " component " << column - offset[v]
@@ -398,9 +411,9 @@ Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& key
   std::vector<Eigen::Index> offs, dims;
   Eigen::Index m = 0;
   for (const auto& k : keys) {
-    if (!s.layout.contains(k))
+    const std::size_t i = s.positionOf(k);
+    if (i == Impl::npos)
       throw InvalidArgument("BatchSolver: " + k.toString() + " is not a variable of the last solve");
-    const std::size_t i = s.layout.indexOf(k);
     offs.push_back(s.offset[i]);
     dims.push_back(s.offset[i + 1] - s.offset[i]);
     m += dims.back();
