@@ -248,7 +248,31 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   sum.num_variables = values.size();
   sum.dimension = s.n;
 
-  Values x = values;
+  // The iterate lives in `values` itself (a copy of a million-step run is
+  // 64 MB of fresh memory and a million small allocations); a flat copy of
+  // the start puts it back if the solve throws (strong guarantee).
+  Values& x = values;
+  Eigen::VectorXd start_flat(s.n);
+  {
+    Eigen::Index off = 0;
+    for (const auto& kv : values) {
+      start_flat.segment(off, kv.second.size()) = kv.second;
+      off += kv.second.size();
+    }
+  }
+  struct RestoreOnThrow {
+    Values& v;
+    const Eigen::VectorXd& flat;
+    bool armed = true;
+    ~RestoreOnThrow() {
+      if (!armed) return;
+      Eigen::Index off = 0;
+      for (auto& kv : v) {  // same keys and sizes: no allocation
+        kv.second = flat.segment(off, kv.second.size());
+        off += kv.second.size();
+      }
+    }
+  } restore{values, start_flat};
   Eigen::VectorXd g, diag, g_new, diag_new;
   double cost = s.linearize(graph, x, g, diag);
   sum.initial_cost = cost;
@@ -288,7 +312,10 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     ++sum.factorizations;
     const Eigen::Index bad = s.chol.factorize();
     if (bad >= 0) {
-      if (!policy.canDampMore()) s.throwSingular(bad);
+      // Undamped (Gauss–Newton, or LM finishing after its tests passed) the
+      // information matrix itself is singular: the final factorization would
+      // fail the same way, and damping again only led back here, forever.
+      if (policy.undamped() || !policy.canDampMore()) s.throwSingular(bad);
       policy.singular();
       ++sum.rejected_steps;
       continue;
@@ -380,7 +407,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   const Eigen::Index bad = s.chol.factorize();
   if (bad >= 0) s.throwSingular(bad);
   s.has_solution = true;
-  values = std::move(x);
+  restore.armed = false;
 
   sum.final_cost = cost;
   sum.gradient_norm = g.lpNorm<Eigen::Infinity>();
