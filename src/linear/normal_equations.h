@@ -9,16 +9,16 @@ namespace gssm::internal {
 
 /// Calls emit(row, col, a, i, b, j) for every upper-triangle entry
 /// (row ≤ col) of the blocks of `count` variables, variable a occupying
-/// columns offs[a] … offs[a] + cols[a] − 1. Same order on every call for the
+/// columns offs[a] … offs[a] + cols(a) − 1. Same order on every call for the
 /// same shapes, so callers may address entries by their running index: a
 /// pattern laid out once from the shapes is refilled from the Jacobians.
-template <class Emit>
-void forEachUpperEntry(const Eigen::Index* offs, const Eigen::Index* cols, std::size_t count, Emit&& emit) {
+template <class Cols, class Emit>
+void forEachUpperEntry(const Eigen::Index* offs, std::size_t count, Cols&& cols, Emit&& emit) {
   for (std::size_t a = 0; a < count; ++a)
     for (std::size_t b = 0; b < count; ++b) {
       if (offs[a] > offs[b]) continue;
-      for (Eigen::Index j = 0; j < cols[b]; ++j)
-        for (Eigen::Index i = 0; i < cols[a]; ++i) {
+      for (Eigen::Index j = 0; j < cols(b); ++j)
+        for (Eigen::Index i = 0; i < cols(a); ++i) {
           const Eigen::Index gi = offs[a] + i, gj = offs[b] + j;
           if (gi > gj) continue;  // diagonal block: keep its upper half
           emit(gi, gj, a, i, b, j);
@@ -32,24 +32,16 @@ void forEachUpperEntry(const Eigen::Index* offs, const Eigen::Index* cols, std::
 /// row: a residual has a few rows, too few for a vectorized dot to pay).
 template <class Emit>
 void forEachUpperJtJ(const Eigen::Index* offs, const std::vector<Eigen::MatrixXd>& J, Emit&& emit) {
-  const std::size_t count = J.size();
-  if (count == 0) return;
+  if (J.empty()) return;
   const Eigen::Index m = J[0].rows();
-  for (std::size_t a = 0; a < count; ++a)
-    for (std::size_t b = 0; b < count; ++b) {
-      if (offs[a] > offs[b]) continue;
-      for (Eigen::Index j = 0; j < J[b].cols(); ++j) {
-        const double* cb = J[b].data() + j * m;
-        for (Eigen::Index i = 0; i < J[a].cols(); ++i) {
-          const Eigen::Index gi = offs[a] + i, gj = offs[b] + j;
-          if (gi > gj) continue;  // diagonal block: keep its upper half
-          const double* ca = J[a].data() + i * m;
-          double v = 0;
-          for (Eigen::Index r = 0; r < m; ++r) v += ca[r] * cb[r];
-          emit(gi, gj, v, a, i, b, j);
-        }
-      }
-    }
+  forEachUpperEntry(offs, J.size(), [&](std::size_t a) { return J[a].cols(); },
+                    [&](Eigen::Index gi, Eigen::Index gj, std::size_t a, Eigen::Index i, std::size_t b, Eigen::Index j) {
+                      const double* ca = J[a].data() + i * m;
+                      const double* cb = J[b].data() + j * m;
+                      double v = 0;
+                      for (Eigen::Index r = 0; r < m; ++r) v += ca[r] * cb[r];
+                      emit(gi, gj, v, a, i, b, j);
+                    });
 }
 
 }  // namespace gssm::internal

@@ -67,14 +67,12 @@ void SparseCholesky::assemble() {
   if (matrix_) return;
   const int* Ti = static_cast<const int*>(triplet_->i);
   const int* Tj = static_cast<const int*>(triplet_->j);
-  std::vector<std::size_t> start(static_cast<std::size_t>(n_) + 1, 0);
-  for (std::size_t e = 0; e < count_; ++e) ++start[static_cast<std::size_t>(Tj[e]) + 1];
-  for (std::size_t j = 0; j < static_cast<std::size_t>(n_); ++j) start[j + 1] += start[j];
-  std::vector<std::uint32_t> by_column(count_);
-  std::vector<std::size_t> next(start.begin(), start.end() - 1);
-  for (std::size_t e = 0; e < count_; ++e) by_column[next[static_cast<std::size_t>(Tj[e])]++] = static_cast<std::uint32_t>(e);
-  slot_.resize(count_);
-  assembleColumns(start, by_column, Ti, static_cast<const double*>(triplet_->x), slot_.data());
+  const std::size_t count = count_;
+  assembleEntries(
+      [&](auto&& emit) {
+        for (std::size_t e = 0; e < count; ++e) emit(Ti[e], Tj[e]);
+      },
+      static_cast<const double*>(triplet_->x));
   cholmod_free_triplet(&triplet_, &common_);
 }
 

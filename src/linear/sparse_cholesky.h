@@ -71,6 +71,8 @@ class SparseCholesky {
 
  private:
   void freeAll();
+  template <class ForEachEntry>
+  void assembleEntries(ForEachEntry&& each, const double* value);
   void assembleColumns(const std::vector<std::size_t>& start, std::vector<std::uint32_t>& by_column, const int* row,
                        const double* value, int* slot);
   cholmod_common common_;
@@ -93,9 +95,17 @@ class SparseCholesky {
 template <class ForEachEntry>
 void SparseCholesky::assemblePattern(Eigen::Index n, ForEachEntry&& each) {
   reset(n, 0);
-  std::vector<std::size_t> start(static_cast<std::size_t>(n) + 1, 0);
+  assembleEntries(each, nullptr);
+  if (triplet_) cholmod_free_triplet(&triplet_, &common_);
+}
+
+// Counts the entries per column, lists them column by column with their
+// rows, and hands them to assembleColumns, whose slots overwrite the rows.
+template <class ForEachEntry>
+void SparseCholesky::assembleEntries(ForEachEntry&& each, const double* value) {
+  std::vector<std::size_t> start(static_cast<std::size_t>(n_) + 1, 0);
   each([&](Eigen::Index, Eigen::Index j) { ++start[static_cast<std::size_t>(j) + 1]; });
-  for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) start[j + 1] += start[j];
+  for (std::size_t j = 0; j < static_cast<std::size_t>(n_); ++j) start[j + 1] += start[j];
   count_ = start.back();
   std::vector<int> row(count_);
   std::vector<std::uint32_t> by_column(count_);
@@ -105,9 +115,8 @@ void SparseCholesky::assemblePattern(Eigen::Index n, ForEachEntry&& each) {
     row[e] = static_cast<int>(i);
     by_column[next[static_cast<std::size_t>(j)]++] = e++;
   });
-  assembleColumns(start, by_column, row.data(), nullptr, row.data());  // each entry's row becomes its slot
+  assembleColumns(start, by_column, row.data(), value, row.data());  // each entry's row becomes its slot
   slot_ = std::move(row);
-  if (triplet_) cholmod_free_triplet(&triplet_, &common_);
 }
 
 }  // namespace gssm::internal

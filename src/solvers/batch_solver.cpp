@@ -134,7 +134,7 @@ struct BatchSolver::Impl {
     chol.assemblePattern(n, [&](auto&& emit) {
       entries = 0;
       for (std::size_t fi = 0; fi < graph.size(); ++fi)
-        internal::forEachUpperEntry(factor_offs.data(), factor_dims.data(), columnsOf(fi),
+        internal::forEachUpperEntry(factor_offs.data(), columnsOf(fi), [&](std::size_t a) { return factor_dims[a]; },
                                     [&](Eigen::Index gi, Eigen::Index gj, auto...) {
                                       emit(gi, gj);
                                       ++entries;
@@ -252,25 +252,14 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   // 64 MB of fresh memory and a million small allocations); a flat copy of
   // the start puts it back if the solve throws (strong guarantee).
   Values& x = values;
-  Eigen::VectorXd start_flat(s.n);
-  {
-    Eigen::Index off = 0;
-    for (const auto& kv : values) {
-      start_flat.segment(off, kv.second.size()) = kv.second;
-      off += kv.second.size();
-    }
-  }
+  Eigen::VectorXd start_flat;
+  internal::flatten(values, start_flat);
   struct RestoreOnThrow {
     Values& v;
     const Eigen::VectorXd& flat;
     bool armed = true;
     ~RestoreOnThrow() {
-      if (!armed) return;
-      Eigen::Index off = 0;
-      for (auto& kv : v) {  // same keys and sizes: no allocation
-        kv.second = flat.segment(off, kv.second.size());
-        off += kv.second.size();
-      }
+      if (armed) internal::unflatten(flat, v);  // same keys and sizes: no allocation
     }
   } restore{values, start_flat};
   Eigen::VectorXd g, diag, g_new, diag_new;
@@ -278,19 +267,13 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   sum.initial_cost = cost;
   const bool lm = options_.method == BatchSolverOptions::Method::LevenbergMarquardt;
   internal::LevenbergMarquardtPolicy policy(options_.initial_lambda, options_.max_lambda, lm);
-  Eigen::VectorXd delta, xflat;  // reused across iterations (8 MB each at 10⁶ steps)
+  Eigen::VectorXd delta;  // reused across iterations (8 MB at 10⁶ steps)
 
-  // candidate = from + d, written in place (both hold the same keys in the
-  // same order): copying a million-node map per LM step cost 12% of a solve.
+  // candidate = x ⊕ δ, written in place (addStep into the same keys and
+  // sizes): copying a million-node map per LM step cost 12% of a solve.
   Values candidate = values;
-  auto applyStep = [&](const Values& from, const Eigen::VectorXd& d, Values& out) {
-    auto it = out.begin();
-    Eigen::Index off = 0;
-    for (const auto& kv : from) {
-      it->second = kv.second + d.segment(off, kv.second.size());
-      off += kv.second.size();
-      ++it;
-    }
+  auto stepConverged = [&](const Eigen::VectorXd& d, const Values& at) {
+    return d.norm() <= options_.step_tolerance * (internal::norm(at) + options_.step_tolerance);
   };
 
   auto converge = [&](T reason) {
@@ -322,21 +305,16 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     }
     delta = -g;
     s.chol.solveInPlace(delta);  // −H⁻¹g, exactly the negated solution
-    xflat.resize(s.n);
-    {
-      std::size_t i = 0;
-      for (const auto& kv : x) xflat.segment(s.offset[i++], kv.second.size()) = kv.second;
-    }
-    if (delta.norm() <= options_.step_tolerance * (xflat.norm() + options_.step_tolerance)) {
+    if (stepConverged(delta, x)) {
       if (policy.undamped()) {  // a tiny undamped step is still the exact correction: take it
-        applyStep(x, delta, candidate);
+        internal::addStep(x, delta, candidate);
         std::swap(x, candidate);
         cost = s.linearize(graph, x, g, diag);
       }
       if (converge(T::StepConverged)) break;
       continue;
     }
-    applyStep(x, delta, candidate);
+    internal::addStep(x, delta, candidate);
     // Linearize at the candidate right away (its cost comes with it): one
     // pass over the factors per accepted step instead of two; a rejected
     // step refills H at x.
@@ -391,11 +369,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
         [&](bool keep) {
           if (keep) x = std::move(trial_x);
         },
-        [&](const Values&, const Values& next, const Eigen::VectorXd& d) {
-          double xnorm = 0;
-          for (const auto& kv : next) xnorm += kv.second.squaredNorm();
-          return d.norm() <= options_.step_tolerance * (std::sqrt(xnorm) + options_.step_tolerance);
-        });
+        [&](const Values&, const Values& next, const Eigen::VectorXd& d) { return stepConverged(d, next); });
     sum.newton_steps = polish.steps;
     cost = polish.cost;
     if (sum.newton_steps > 0) cost = s.linearize(graph, x, g, diag);  // JᵀJ at the solution

@@ -492,12 +492,12 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   for (auto& kv : p.relinearized) {
     LinearFactor& linear = slots_[static_cast<std::size_t>(kv.first)].linear;
     std::swap(linear, kv.second);
-    if (pool_.spare_linear.size() < CliquePool::kMax) pool_.spare_linear.push_back(std::move(kv.second));
+    pool_.keep(std::move(kv.second));
     ++counts.factors_relinearized;
   }
   for (int c : p.removed_order) {
     clique_alive_[static_cast<std::size_t>(c)] = false;
-    if (pool_.spare.size() < CliquePool::kMax) pool_.spare.push_back(std::move(cliques_[static_cast<std::size_t>(c)]));
+    pool_.keep(std::move(cliques_[static_cast<std::size_t>(c)]));
     cliques_[static_cast<std::size_t>(c)] = Clique{};
     free_cliques_.push_back(c);
     --cliques_alive_;
@@ -817,7 +817,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
       auto& v = it->second;
       v.erase(std::remove(v.begin(), v.end(), s), v.end());
     }
-    if (pool_.spare_linear.size() < CliquePool::kMax) pool_.spare_linear.push_back(std::move(slot.linear));
+    pool_.keep(std::move(slot.linear));
     slot = Slot{};
     free_slots_.push_back(s);
     --slots_alive_;
@@ -838,7 +838,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   } else {
     root_ = -1;
   }
-  if (pool_.spare.size() < CliquePool::kMax) pool_.spare.push_back(std::move(cliques_[static_cast<std::size_t>(c)]));
+  pool_.keep(std::move(cliques_[static_cast<std::size_t>(c)]));
   cliques_[static_cast<std::size_t>(c)] = Clique{};
   clique_alive_[static_cast<std::size_t>(c)] = false;
   free_cliques_.push_back(c);

@@ -54,9 +54,19 @@ struct InputSource {
   int index;  // slot, or index into the new factors / new linear factors; unused for Orphan
 };
 
+// A member that belongs to one engine object — buffers and pools, not
+// state: a copy of the engine (a snapshot) gets a fresh, empty one.
+template <class T>
+struct NotCopied : T {
+  NotCopied() = default;
+  NotCopied(const NotCopied&) : T() {}
+  NotCopied& operator=(const NotCopied&) { return *this; }
+  NotCopied(NotCopied&&) noexcept = default;
+  NotCopied& operator=(NotCopied&&) noexcept = default;
+};
+
 // The lists one engine update fills (bayes_tree.cpp's UpdatePlan), kept by
-// the engine so their capacity carries over; a copy of the engine starts
-// with empty ones.
+// the engine so their capacity carries over.
 struct UpdateLists {
   std::vector<LinearFactor> linearized_new;         // of the new factors, same order
   std::vector<int> removed_order;                   // cliques of the top, leaf to root
@@ -68,11 +78,6 @@ struct UpdateLists {
   // clique order (one list per update, not one per clique).
   std::vector<std::pair<std::size_t, InputSource>> fresh_owned;
   std::vector<int> fresh_id;
-  UpdateLists() = default;
-  UpdateLists(const UpdateLists&) {}
-  UpdateLists& operator=(const UpdateLists&) { return *this; }
-  UpdateLists(UpdateLists&&) noexcept = default;
-  UpdateLists& operator=(UpdateLists&&) noexcept = default;
   /// Empties every list; one that a large update (a relinearization of the
   /// whole history) grew past kKeep entries gives its memory back.
   void clear() {
@@ -250,24 +255,25 @@ class BayesTreeEngine {
     std::vector<int> path;                             // solvePath's cliques, leaf to root
     std::vector<char> in_top;                          // detachTop's marks, by clique id (all 0 between calls)
   };
-  mutable Scratch scratch_;
+  mutable NotCopied<Scratch> scratch_;
   // Cliques replaced by an update and linearizations of dropped factors,
   // kept so the next elimination and linearization refill their matrices
   // and lists in place instead of allocating new ones (a fixed-lag update
-  // replaces the same few cliques and factors every step). Bounded; a copy
-  // of the engine starts with none.
+  // replaces the same few cliques and factors every step).
   struct CliquePool {
     static constexpr std::size_t kMax = 64;
     std::vector<Clique> spare;
     std::vector<LinearFactor> spare_linear;  // linearizations of dropped factors, refilled by linearize()
-    CliquePool() = default;
-    CliquePool(const CliquePool&) {}
-    CliquePool& operator=(const CliquePool&) { return *this; }
-    CliquePool(CliquePool&&) noexcept = default;
-    CliquePool& operator=(CliquePool&&) noexcept = default;
+    /// Keeps what an update discards, up to kMax of each.
+    void keep(Clique&& c) {
+      if (spare.size() < kMax) spare.push_back(std::move(c));
+    }
+    void keep(LinearFactor&& f) {
+      if (spare_linear.size() < kMax) spare_linear.push_back(std::move(f));
+    }
   };
-  mutable CliquePool pool_;
-  UpdateLists lists_;
+  mutable NotCopied<CliquePool> pool_;
+  NotCopied<UpdateLists> lists_;
 };
 
 }  // namespace gssm::internal

@@ -71,12 +71,41 @@ bool NewtonSystem::solve(Eigen::VectorXd& delta) {
 
 Values addStep(const Values& x, const Eigen::VectorXd& delta) {
   Values out = x;
+  addStep(x, delta, out);
+  return out;
+}
+
+void addStep(const Values& x, const Eigen::VectorXd& delta, Values& out) {
+  auto it = out.begin();
   Eigen::Index off = 0;
-  for (auto& kv : out) {
-    kv.second += delta.segment(off, kv.second.size());
+  for (const auto& kv : x) {
+    it->second = kv.second + delta.segment(off, kv.second.size());
+    off += kv.second.size();
+    ++it;
+  }
+}
+
+void flatten(const Values& x, Eigen::VectorXd& flat) {
+  flat.resize(x.dim());
+  Eigen::Index off = 0;
+  for (const auto& kv : x) {
+    flat.segment(off, kv.second.size()) = kv.second;
     off += kv.second.size();
   }
-  return out;
+}
+
+void unflatten(const Eigen::VectorXd& flat, Values& x) {
+  Eigen::Index off = 0;
+  for (auto& kv : x) {
+    kv.second = flat.segment(off, kv.second.size());
+    off += kv.second.size();
+  }
+}
+
+double norm(const Values& x) {
+  double sq = 0;
+  for (const auto& kv : x) sq += kv.second.squaredNorm();
+  return std::sqrt(sq);
 }
 
 }  // namespace gssm::internal

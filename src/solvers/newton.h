@@ -39,5 +39,13 @@ class NewtonSystem {
 
 /// x ⊕ δ for δ stacked in x's order.
 Values addStep(const Values& x, const Eigen::VectorXd& delta);
+/// out = x ⊕ δ in place; out holds x's keys and sizes (no allocation).
+void addStep(const Values& x, const Eigen::VectorXd& delta, Values& out);
+/// x's vectors stacked in its order into `flat` (resized to x.dim()).
+void flatten(const Values& x, Eigen::VectorXd& flat);
+/// The inverse: x's vectors overwritten from `flat` (same sizes: no allocation).
+void unflatten(const Eigen::VectorXd& flat, Values& x);
+/// ‖x‖ over every stacked component (the LM step test's scale).
+double norm(const Values& x);
 
 }  // namespace gssm::internal
