@@ -26,14 +26,15 @@ void forEachUpper(const Eigen::MatrixXd& H, F&& f) {
 
 // A banded SPD matrix with a dense border (the GSSM's shape), given to the
 // factorization as upper-triangle triplets with every entry split in two
-// (duplicates must be summed).
-Eigen::MatrixXd fill(SparseCholesky& c, Eigen::Index n, unsigned seed, Eigen::Index indefinite_at = -1) {
+// (duplicates must be summed). A wide band makes CHOLMOD go supernodal.
+Eigen::MatrixXd fill(SparseCholesky& c, Eigen::Index n, unsigned seed, Eigen::Index indefinite_at = -1,
+                     Eigen::Index band = 2) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
   for (Eigen::Index j = 0; j < n; ++j)
     for (Eigen::Index i = 0; i <= j; ++i)
-      if (j - i <= 2 || j >= n - 2) H(i, j) = H(j, i) = (i == j ? 8.0 : u(rng));
+      if (j - i <= band || j >= n - 2) H(i, j) = H(j, i) = (i == j ? 8.0 * std::max<Eigen::Index>(1, band / 2) : u(rng));
   if (indefinite_at >= 0) H(indefinite_at, indefinite_at) = -1.0;
   std::size_t nnz = 0;
   for (Eigen::Index j = 0; j < n; ++j)
@@ -48,10 +49,12 @@ Eigen::MatrixXd fill(SparseCholesky& c, Eigen::Index n, unsigned seed, Eigen::In
 }  // namespace
 
 TEST(SparseCholesky, DenseAndSparsePathsEqualADenseReference) {
-  for (const Eigen::Index n : {Eigen::Index(12), SparseCholesky::kDenseMax, SparseCholesky::kDenseMax + 1,
-                               Eigen::Index(150)}) {
+  // Dense, simplicial (band 2) and supernodal (band 24: ≥ 16 entries per column of L).
+  const std::pair<Eigen::Index, Eigen::Index> cases[] = {
+      {12, 2}, {SparseCholesky::kDenseMax, 2}, {SparseCholesky::kDenseMax + 1, 2}, {150, 2}, {150, 24}};
+  for (const auto& [n, band] : cases) {
     SparseCholesky c;
-    const Eigen::MatrixXd H = fill(c, n, 3 + static_cast<unsigned>(n));
+    const Eigen::MatrixXd H = fill(c, n, 3 + static_cast<unsigned>(n + band), -1, band);
     ASSERT_EQ(c.factorize(), -1) << n;
     const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 3);
     const Eigen::MatrixXd X = c.solve(B);
@@ -64,7 +67,7 @@ TEST(SparseCholesky, DenseAndSparsePathsEqualADenseReference) {
         if (S.lookup(i, j, v)) {
           EXPECT_NEAR(v, Hinv(i, j), 1e-12) << n << " (" << i << ", " << j << ")";
         }
-        if (i == j || i - j <= 2 || i >= n - 2) {
+        if (i == j || i - j <= band || i >= n - 2) {
           EXPECT_TRUE(S.lookup(i, j, v)) << "pattern entry missing";
         }
       }

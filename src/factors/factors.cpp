@@ -12,14 +12,41 @@ std::vector<Key> withConstants(const Model& m, std::vector<Key> keys) {
   if (m.dims().nb > 0) keys.push_back(Key::constants());
   return keys;
 }
-const Eigen::VectorXd& constantsOrEmpty(const Model& m, const Values& x) {
+// x_b of a model factor whose keys end with the constants (at `index`), or
+// an empty vector for a model without constants.
+const Eigen::VectorXd& constantsOrEmpty(const Factor& f, const Eigen::VectorXd* const* x, std::size_t index) {
   static const Eigen::VectorXd kEmpty;
-  return m.dims().nb > 0 ? x.at(Key::constants()) : kEmpty;
+  return f.keys().size() > index ? *x[index] : kEmpty;
 }
 }  // namespace
 
+void Factor::linearize(const Values& x, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const {
+  // The variables' addresses in key order: on the stack for the few keys of
+  // a model factor, on the heap for a wide marginal prior.
+  constexpr std::size_t kInline = 8;
+  const Eigen::VectorXd* on_stack[kInline];
+  std::vector<const Eigen::VectorXd*> on_heap;
+  const Eigen::VectorXd** vars = on_stack;
+  if (keys_.size() > kInline) {
+    on_heap.resize(keys_.size());
+    vars = on_heap.data();
+  }
+  for (std::size_t i = 0; i < keys_.size(); ++i) vars[i] = &x.at(keys_[i]);
+  linearizeAt(vars, r, J);
+}
+
 double Factor::linearizeRobust(const Values& x, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const {
   linearize(x, r, J);
+  return robustify(r, J);
+}
+
+double Factor::linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                                 std::vector<Eigen::MatrixXd>* J) const {
+  linearizeAt(x, r, J);
+  return robustify(r, J);
+}
+
+double Factor::robustify(Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const {
   const double s = r.squaredNorm();
   if (!loss_.robust()) return 0.5 * s;
   const double w = std::sqrt(loss_.weight(s));
@@ -61,9 +88,9 @@ PriorFactor::PriorFactor(Key key, const Gaussian& prior, std::vector<int> angles
   requireVector(prior.mean, noise_.dim(), "prior mean of " + key.toString());
 }
 
-void PriorFactor::linearize(const Values& x, Eigen::VectorXd& r,
-                            std::vector<Eigen::MatrixXd>* J) const {
-  r = x.at(keys()[0]) - mean_;
+void PriorFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                              std::vector<Eigen::MatrixXd>* J) const {
+  r = *x[0] - mean_;
   wrapAngles(r, angles_);
   noise_.whitenInPlace(r);
   if (J) {
@@ -92,11 +119,11 @@ ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::Ve
   requireVector(u, model.dims().nu, "input u at step " + std::to_string(k));
 }
 
-void ProcessFactor::linearize(const Values& x, Eigen::VectorXd& r,
-                              std::vector<Eigen::MatrixXd>* J) const {
-  const Eigen::VectorXd& xk = x.at(keys()[0]);
-  const Eigen::VectorXd& xk1 = x.at(keys()[1]);
-  const Eigen::VectorXd& xb = constantsOrEmpty(*model_, x);
+void ProcessFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                                std::vector<Eigen::MatrixXd>* J) const {
+  const Eigen::VectorXd& xk = *x[0];
+  const Eigen::VectorXd& xk1 = *x[1];
+  const Eigen::VectorXd& xb = constantsOrEmpty(*this, x, 2);
   // The model writes its Jacobians straight into the caller's blocks (which a
   // solver reuses from factor to factor): no allocation per linearization.
   Eigen::MatrixXd no_constants;  // J_f_xb of a model without constants (n_b = 0: empty)
@@ -150,11 +177,11 @@ MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const E
                           std::to_string(noise.dim()) + ", the channel has " + std::to_string(ch.dim()) + " components");
 }
 
-void MeasurementFactor::linearize(const Values& x, Eigen::VectorXd& r,
-                                  std::vector<Eigen::MatrixXd>* J) const {
-  const Eigen::VectorXd& xc = x.at(keys()[0]);
-  const Eigen::VectorXd& xb = constantsOrEmpty(*model_, x);
-  Eigen::MatrixXd no_constants;  // as in ProcessFactor::linearize
+void MeasurementFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                                    std::vector<Eigen::MatrixXd>* J) const {
+  const Eigen::VectorXd& xc = *x[0];
+  const Eigen::VectorXd& xb = constantsOrEmpty(*this, x, 1);
+  Eigen::MatrixXd no_constants;  // as in ProcessFactor::linearizeAt
   if (J) J->resize(keys().size());
   Eigen::MatrixXd* J_h_xc = J ? &(*J)[0] : nullptr;
   Eigen::MatrixXd* J_h_xb = J ? (keys().size() == 2 ? &(*J)[1] : &no_constants) : nullptr;
@@ -185,11 +212,11 @@ LinearGaussianFactor::LinearGaussianFactor(std::vector<Key> keys, std::vector<Ei
                             " has the wrong size");
 }
 
-void LinearGaussianFactor::linearize(const Values& x, Eigen::VectorXd& r,
-                                     std::vector<Eigen::MatrixXd>* J) const {
+void LinearGaussianFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                                       std::vector<Eigen::MatrixXd>* J) const {
   r = -b_;
   for (std::size_t i = 0; i < keys().size(); ++i)
-    r += A_[i] * (x.at(keys()[i]) - x0_.at(keys()[i]));
+    r += A_[i] * (*x[i] - x0_.at(keys()[i]));
   if (J) *J = A_;
 }
 

@@ -7,41 +7,91 @@
 
 namespace gssm::internal {
 
-/// Calls emit(row, col, a, i, b, j) for every upper-triangle entry
-/// (row ≤ col) of the blocks of `count` variables, variable a occupying
-/// columns offs[a] … offs[a] + cols(a) − 1. Same order on every call for the
-/// same shapes, so callers may address entries by their running index: a
-/// pattern laid out once from the shapes is refilled from the Jacobians.
-template <class Cols, class Emit>
-void forEachUpperEntry(const Eigen::Index* offs, std::size_t count, Cols&& cols, Emit&& emit) {
-  for (std::size_t a = 0; a < count; ++a)
-    for (std::size_t b = 0; b < count; ++b) {
-      if (offs[a] > offs[b]) continue;
-      for (Eigen::Index j = 0; j < cols(b); ++j)
-        for (Eigen::Index i = 0; i < cols(a); ++i) {
-          const Eigen::Index gi = offs[a] + i, gj = offs[b] + j;
-          if (gi > gj) continue;  // diagonal block: keep its upper half
-          emit(gi, gj, a, i, b, j);
-        }
+/// A factor's Jacobian columns flattened in key order (variable a's
+/// component i after all of variable a−1's): each one's column of H and,
+/// once gathered from the Jacobian blocks, its entries, side by side. Kept
+/// by the caller from factor to factor, so it allocates only for the widest.
+struct FactorColumns {
+  std::vector<Eigen::Index> global;  ///< column of H
+  std::vector<double> entries;       ///< the Jacobian, rows × size() column-major
+  Eigen::Index rows = 0;
+  bool ascending = true;  ///< global columns increase (a factor's keys in Key order)
+  std::size_t size() const { return size_; }
+
+  /// The columns of `count` variables, variable a at columns offs[a] …
+  /// offs[a] + dim(a) − 1 (no entries: a pattern's layout).
+  template <class Dim>
+  void place(const Eigen::Index* offs, std::size_t count, Dim&& dim) {
+    start();
+    for (std::size_t a = 0; a < count; ++a)
+      for (Eigen::Index i = 0, d = dim(a); i < d; ++i) push(offs[a] + i);
+  }
+  /// The columns of J's blocks, block a at offs[a], with their entries.
+  void gather(const Eigen::Index* offs, const std::vector<Eigen::MatrixXd>& J) {
+    start();
+    rows = J.empty() ? 0 : J[0].rows();
+    Eigen::Index total = 0;
+    for (const auto& block : J) total += block.cols();
+    if (entries.size() < static_cast<std::size_t>(rows * total)) entries.resize(static_cast<std::size_t>(rows * total));
+    double* out = entries.data();
+    for (std::size_t a = 0; a < J.size(); ++a) {
+      for (Eigen::Index i = 0; i < J[a].cols(); ++i) push(offs[a] + i);
+      const double* in = J[a].data();
+      for (Eigen::Index e = 0, size = J[a].size(); e < size; ++e) *out++ = in[e];  // a few: no memmove call
     }
+  }
+  /// Column p's entries.
+  const double* column(std::size_t p) const { return entries.data() + static_cast<Eigen::Index>(p) * rows; }
+  /// Column p dotted with a `rows`-vector.
+  double dot(std::size_t p, const double* other) const {
+    const double* a = column(p);
+    if (rows == 1) return a[0] * other[0];  // a scalar residual: most factors of a 1-D sensor
+    double v = 0;
+    for (Eigen::Index r = 0; r < rows; ++r) v += a[r] * other[r];
+    return v;
+  }
+
+ private:
+  void start() {
+    size_ = 0;
+    ascending = true;
+  }
+  void push(Eigen::Index column) {
+    if (size_ > 0 && column < global[size_ - 1]) ascending = false;
+    if (size_ == global.size()) global.push_back(column);
+    else global[size_] = column;
+    ++size_;
+  }
+  std::size_t size_ = 0;
+};
+
+/// Calls emit(p, q) for every pair of the factor's columns whose entry
+/// (global[p], global[q]) lies in the upper triangle: JᵀJ's entries. Same
+/// order on every call for the same columns, so callers may address entries
+/// by their running index: a pattern laid out once from the shapes is
+/// refilled from the Jacobians.
+template <class Emit>
+void forEachUpperPair(const FactorColumns& c, Emit&& emit) {
+  const std::size_t n = c.size();
+  if (c.ascending) {  // the common case, without a comparison per pair
+    for (std::size_t q = 0; q < n; ++q)
+      for (std::size_t p = 0; p <= q; ++p) emit(p, q);
+    return;
+  }
+  const Eigen::Index* g = c.global.data();
+  for (std::size_t q = 0; q < n; ++q)
+    for (std::size_t p = 0; p < n; ++p)
+      if (g[p] <= g[q]) emit(p, q);
 }
 
-/// Calls emit(row, col, v, a, i, b, j) for every upper-triangle entry of
-/// JᵀJ, where block J[a] occupies columns offs[a]… and
-/// v = J[a].col(i)·J[b].col(j) (forEachUpperEntry's order; summed row by
-/// row: a residual has a few rows, too few for a vectorized dot to pay).
+/// Calls emit(row, col, v, p, q) for every upper-triangle entry of JᵀJ,
+/// v = column p · column q (forEachUpperPair's order; summed row by row: a
+/// residual has a few rows, too few for a vectorized dot to pay).
 template <class Emit>
-void forEachUpperJtJ(const Eigen::Index* offs, const std::vector<Eigen::MatrixXd>& J, Emit&& emit) {
-  if (J.empty()) return;
-  const Eigen::Index m = J[0].rows();
-  forEachUpperEntry(offs, J.size(), [&](std::size_t a) { return J[a].cols(); },
-                    [&](Eigen::Index gi, Eigen::Index gj, std::size_t a, Eigen::Index i, std::size_t b, Eigen::Index j) {
-                      const double* ca = J[a].data() + i * m;
-                      const double* cb = J[b].data() + j * m;
-                      double v = 0;
-                      for (Eigen::Index r = 0; r < m; ++r) v += ca[r] * cb[r];
-                      emit(gi, gj, v, a, i, b, j);
-                    });
+void forEachUpperJtJ(const FactorColumns& c, Emit&& emit) {
+  forEachUpperPair(c, [&](std::size_t p, std::size_t q) {
+    emit(c.global[p], c.global[q], c.dot(p, c.column(q)), p, q);
+  });
 }
 
 }  // namespace gssm::internal

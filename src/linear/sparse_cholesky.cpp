@@ -255,59 +255,75 @@ SparseCholesky::SelectedInverse SparseCholesky::selectedInverse() const {
   }
   if (!factor_) throw NumericalError("selectedInverse: nothing factored");
   cholmod_common& c = const_cast<cholmod_common&>(common_);
-  // A simplicial LDLᵀ copy (unit L, D) of the factor, with sorted rows.
-  cholmod_factor* F = cholmod_copy_factor(factor_, &c);
-  if (!F || !cholmod_change_factor(CHOLMOD_REAL, false, false, true, true, F, &c)) {
-    if (F) cholmod_free_factor(&F, &c);
-    throw NumericalError("selectedInverse: CHOLMOD could not convert the factor");
+  // A simplicial LLᵀ factor: the one factorize() made (read in place), or a
+  // simplicial LLᵀ copy of a supernodal one.
+  cholmod_factor* copy = nullptr;
+  const cholmod_factor* F = factor_;
+  if (factor_->is_super || !factor_->is_ll) {
+    copy = cholmod_copy_factor(factor_, &c);
+    if (!copy || !cholmod_change_factor(CHOLMOD_REAL, true, false, true, true, copy, &c)) {
+      if (copy) cholmod_free_factor(&copy, &c);
+      throw NumericalError("selectedInverse: CHOLMOD could not convert the factor");
+    }
+    F = copy;
   }
+  struct FreeCopy {
+    cholmod_factor*& f;
+    cholmod_common& c;
+    ~FreeCopy() {
+      if (f) cholmod_free_factor(&f, &c);
+    }
+  } free_copy{copy, c};
   const int* perm = static_cast<const int*>(F->Perm);
   for (Eigen::Index k = 0; k < n_; ++k)
-    if (perm && perm[k] != k) {
-      cholmod_free_factor(&F, &c);
-      throw NumericalError("selectedInverse: expected the natural ordering");
-    }
+    if (perm && perm[k] != k) throw NumericalError("selectedInverse: expected the natural ordering");
   const int* Lp = static_cast<const int*>(F->p);
   const int* Li = static_cast<const int*>(F->i);
   const int* Lnz = static_cast<const int*>(F->nz);
   const double* Lx = static_cast<const double*>(F->x);
+  // S on L's pattern, each column's rows sorted with the diagonal first; l
+  // holds L's entries in the same places (l_jj at the diagonal's).
   SelectedInverse S;
   S.colptr.assign(static_cast<std::size_t>(n_) + 1, 0);
   for (Eigen::Index j = 0; j < n_; ++j) S.colptr[j + 1] = S.colptr[j] + Lnz[j];
   S.rows.resize(static_cast<std::size_t>(S.colptr.back()));
   S.values.assign(S.rows.size(), 0.0);
-  std::vector<double> d(static_cast<std::size_t>(n_));
-  std::vector<std::vector<std::pair<int, double>>> below(static_cast<std::size_t>(n_));
+  std::vector<double> l(S.rows.size());
   for (Eigen::Index j = 0; j < n_; ++j) {
-    auto& col = below[static_cast<std::size_t>(j)];
-    for (int p = Lp[j]; p < Lp[j] + Lnz[j]; ++p) {
-      if (Li[p] == j) d[static_cast<std::size_t>(j)] = Lx[p];
-      else col.emplace_back(Li[p], Lx[p]);
+    const int q0 = S.colptr[j];
+    for (int p = Lp[j], q = q0; p < Lp[j] + Lnz[j]; ++p, ++q) {
+      S.rows[static_cast<std::size_t>(q)] = Li[p];
+      l[static_cast<std::size_t>(q)] = Lx[p];
     }
-    std::sort(col.begin(), col.end());
-    int q = S.colptr[j];
-    S.rows[static_cast<std::size_t>(q++)] = static_cast<int>(j);
-    for (const auto& e : col) S.rows[static_cast<std::size_t>(q++)] = e.first;
-  }
-  cholmod_free_factor(&F, &c);
-  // Backward sweep: Σ_ij = −Σ_k Σ_ik l_kj (i > j), Σ_jj = 1/d_j − Σ_k l_kj Σ_kj.
-  for (Eigen::Index j = n_ - 1; j >= 0; --j) {
-    const auto& col = below[static_cast<std::size_t>(j)];
-    const int base = S.colptr[j];
-    for (std::size_t a = 0; a < col.size(); ++a) {
-      double sum = 0;
-      for (const auto& [k, lkj] : col) {
-        double sik;
-        if (!S.lookup(col[a].first, k, sik))
-          throw NumericalError("selectedInverse: pattern is not closed (internal error)");
-        sum += sik * lkj;
+    // CHOLMOD keeps the diagonal first and the rows increasing; sort anyway
+    // (insertion: a column has a few entries) so nothing rests on that.
+    auto rank = [&](int q) { return S.rows[q] == j ? -1 : S.rows[q]; };
+    for (int q = q0 + 1; q < S.colptr[j + 1]; ++q)
+      for (int t = q; t > q0 && rank(t - 1) > rank(t); --t) {
+        std::swap(S.rows[t], S.rows[t - 1]);
+        std::swap(l[t], l[t - 1]);
       }
-      S.values[static_cast<std::size_t>(base) + 1 + a] = -sum;
+    if (S.rows[q0] != j) throw NumericalError("selectedInverse: the factor has no diagonal entry (internal error)");
+  }
+  // Backward sweep with L = LLᵀ's factor (Takahashi):
+  //   Σ_ij = −(1/l_jj) Σ_k Σ_ik l_kj  (i > j),   Σ_jj = (1/l_jj − Σ_k l_kj Σ_kj) / l_jj,
+  // k over column j's rows below the diagonal.
+  for (Eigen::Index j = n_ - 1; j >= 0; --j) {
+    const int base = S.colptr[j], end = S.colptr[j + 1];
+    const double ljj = l[static_cast<std::size_t>(base)];
+    for (int a = base + 1; a < end; ++a) {
+      double sum = 0;
+      for (int b = base + 1; b < end; ++b) {
+        double sik;
+        if (!S.lookup(S.rows[a], S.rows[b], sik))
+          throw NumericalError("selectedInverse: pattern is not closed (internal error)");
+        sum += sik * l[static_cast<std::size_t>(b)];
+      }
+      S.values[static_cast<std::size_t>(a)] = -sum / ljj;
     }
-    double diag = 1.0 / d[static_cast<std::size_t>(j)];
-    for (std::size_t a = 0; a < col.size(); ++a)
-      diag -= col[a].second * S.values[static_cast<std::size_t>(base) + 1 + a];
-    S.values[static_cast<std::size_t>(base)] = diag;
+    double diag = 1.0 / ljj;
+    for (int a = base + 1; a < end; ++a) diag -= l[static_cast<std::size_t>(a)] * S.values[static_cast<std::size_t>(a)];
+    S.values[static_cast<std::size_t>(base)] = diag / ljj;
   }
   return S;
 }

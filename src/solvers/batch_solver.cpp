@@ -127,18 +127,23 @@ struct BatchSolver::Impl {
     }
     jacobians.resize(shapes.size());
     factor_offs.resize(max_keys);
-    factor_dims.resize(max_keys);
+    factor_x.resize(max_keys);
     // The pattern: every factor's upper JᵀJ entries, then the diagonal
     // (which the damping needs even where no factor reaches).
     std::size_t entries = 0;
     chol.assemblePattern(n, [&](auto&& emit) {
       entries = 0;
-      for (std::size_t fi = 0; fi < graph.size(); ++fi)
-        internal::forEachUpperEntry(factor_offs.data(), columnsOf(fi), [&](std::size_t a) { return factor_dims[a]; },
-                                    [&](Eigen::Index gi, Eigen::Index gj, auto...) {
-                                      emit(gi, gj);
-                                      ++entries;
-                                    });
+      for (std::size_t fi = 0; fi < graph.size(); ++fi) {
+        const std::size_t count = offsetsOf(fi);
+        columns.place(factor_offs.data(), count, [&](std::size_t a) {
+          const std::size_t v = factor_vars[factor_begin[fi] + a];
+          return offset[v + 1] - offset[v];
+        });
+        internal::forEachUpperPair(columns, [&](std::size_t p, std::size_t q) {
+          emit(columns.global[p], columns.global[q]);
+          ++entries;
+        });
+      }
       for (Eigen::Index i = 0; i < n; ++i) emit(i, i);
     });
     entry_slot = chol.slots();
@@ -158,18 +163,15 @@ struct BatchSolver::Impl {
     return it != layout.end() && *it == k ? static_cast<std::size_t>(it - layout.begin()) : npos;
   }
 
-  // Factor fi's variables' first columns and sizes into factor_offs and
-  // factor_dims; returns how many.
-  std::size_t columnsOf(std::size_t fi) {
+  // Factor fi's variables' first columns into factor_offs; returns how many.
+  std::size_t offsetsOf(std::size_t fi) {
     const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
-    for (std::size_t a = 0; a < count; ++a) {
-      const std::size_t v = factor_vars[b + a];
-      factor_offs[a] = offset[v];
-      factor_dims[a] = offset[v + 1] - offset[v];
-    }
+    for (std::size_t a = 0; a < count; ++a) factor_offs[a] = offset[factor_vars[b + a]];
     return count;
   }
-  std::vector<Eigen::Index> factor_offs, factor_dims;
+  std::vector<Eigen::Index> factor_offs;
+  std::vector<const Eigen::VectorXd*> factor_x;  // factor fi's variables' values, in its key order
+  internal::FactorColumns columns;
 
   // Linearizes every factor at x: writes H = JᵀJ into the factorization's
   // values (undamped; `diag` gets its diagonal), the gradient g = Jᵀr, and
@@ -184,19 +186,22 @@ struct BatchSolver::Impl {
     const int* slot = entry_slot;
     Eigen::VectorXd r;
     std::size_t fi = 0;
+    const auto first = x.begin();  // positions are the layout's (x has values' keys)
     for (const auto& f : graph) {
       std::vector<Eigen::MatrixXd>& J = jacobians[factor_shape[fi]];
-      const double c = f->linearizeRobust(x, r, &J);  // reweighted at every linearization
+      const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
+      for (std::size_t a = 0; a < count; ++a) factor_x[a] = &(first + factor_vars[b + a])->second;
+      const double c = f->linearizeRobustAt(factor_x.data(), r, &J);  // reweighted at every linearization
       if (!r.allFinite()) {
         if (trial) return std::numeric_limits<double>::infinity();
         throw NumericalError("BatchSolver: factor '" + f->describe() +
                              "' has a non-finite residual at the current estimate");
       }
       cost += c;
-      columnsOf(fi);
-      const Eigen::Index* offs = factor_offs.data();
-      for (std::size_t a = 0; a < J.size(); ++a) g.segment(offs[a], J[a].cols()).noalias() += J[a].transpose() * r;
-      internal::forEachUpperJtJ(offs, J, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
+      offsetsOf(fi);
+      columns.gather(factor_offs.data(), J);
+      for (std::size_t p = 0; p < columns.size(); ++p) g[columns.global[p]] += columns.dot(p, r.data());
+      internal::forEachUpperJtJ(columns, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
       ++fi;
     }
     diag.resize(n);

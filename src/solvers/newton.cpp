@@ -50,15 +50,16 @@ NewtonSystem::NewtonSystem(const Values& layout) : layout_(layout) {
 
 void NewtonSystem::add(const std::vector<Key>& keys, const Eigen::VectorXd& r,
                        const std::vector<Eigen::MatrixXd>& J, const Eigen::MatrixXd* curvature) {
-  std::vector<Eigen::Index> col(keys.size()), local(keys.size() + 1, 0);
+  std::vector<Eigen::Index> offs(keys.size());
   for (std::size_t a = 0; a < keys.size(); ++a) {
-    col[a] = offset_[layout_.indexOf(keys[a])];
-    local[a + 1] = local[a] + J[a].cols();
-    g_.segment(col[a], J[a].cols()) += J[a].transpose() * r;
+    offs[a] = offset_[layout_.indexOf(keys[a])];
+    g_.segment(offs[a], J[a].cols()) += J[a].transpose() * r;
   }
-  forEachUpperJtJ(col.data(), J, [&](Eigen::Index gi, Eigen::Index gj, double v, std::size_t a, Eigen::Index i,
-                              std::size_t b, Eigen::Index j) {
-    if (curvature) v += (*curvature)(local[a] + i, local[b] + j);
+  FactorColumns columns;
+  columns.gather(offs.data(), J);
+  // The curvature is over the factor's stacked variables: column p's row and column.
+  forEachUpperJtJ(columns, [&](Eigen::Index gi, Eigen::Index gj, double v, std::size_t p, std::size_t q) {
+    if (curvature) v += (*curvature)(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(q));
     chol_.add(gi, gj, v);  // duplicates are summed
   });
 }

@@ -23,13 +23,20 @@ class Factor {
   int dim() const { return dim_; }
 
   /// Whitened residual at `x`; when J is non-null it receives one block per
-  /// key, J[i] of size dim() × dim(keys()[i]).
-  virtual void linearize(const Values& x, Eigen::VectorXd& r,
-                         std::vector<Eigen::MatrixXd>* J) const = 0;
+  /// key, J[i] of size dim() × dim(keys()[i]). Throws InvalidArgument naming
+  /// a key that `x` lacks.
+  void linearize(const Values& x, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const;
+  /// The same with the variables' values given in keys() order (*x[i] is
+  /// keys()[i]'s), for a solver that holds them by position: no lookups.
+  virtual void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                           std::vector<Eigen::MatrixXd>* J) const = 0;
   /// What the solvers minimize: linearize() with r and J scaled by √ρ'(s),
   /// s = ‖r‖², for a factor with a robust loss (iteratively reweighted least
   /// squares, core/robust_loss.h); returns the cost ½ρ(s).
   double linearizeRobust(const Values& x, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const;
+  /// linearizeRobust() with the variables in keys() order, as linearizeAt().
+  double linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                           std::vector<Eigen::MatrixXd>* J) const;
   /// ½ρ(‖r(x)‖²) (½‖r(x)‖² without a robust loss).
   double cost(const Values& x) const;
   /// ρ'(‖r(x)‖²) at x: 1 without a loss; below 1 where a loss down-weights.
@@ -43,6 +50,7 @@ class Factor {
       : keys_(std::move(keys)), dim_(dim), loss_(loss) {}
 
  private:
+  double robustify(Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const;
   std::vector<Key> keys_;
   int dim_;
   RobustLoss loss_;
@@ -55,8 +63,8 @@ using FactorPtr = std::shared_ptr<const Factor>;
 class PriorFactor final : public Factor {
  public:
   PriorFactor(Key key, const Gaussian& prior, std::vector<int> angles = {});
-  void linearize(const Values& x, Eigen::VectorXd& r,
-                 std::vector<Eigen::MatrixXd>* J) const override;
+  void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                   std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   const Eigen::VectorXd& mean() const { return mean_; }
   const GaussianNoise& noise() const { return noise_; }
@@ -73,8 +81,8 @@ class PriorFactor final : public Factor {
 class ProcessFactor final : public Factor {
  public:
   ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt);
-  void linearize(const Values& x, Eigen::VectorXd& r,
-                 std::vector<Eigen::MatrixXd>* J) const override;
+  void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                   std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   double dt() const { return dt_; }
   const Eigen::VectorXd& input() const { return u_; }
@@ -97,8 +105,8 @@ class MeasurementFactor final : public Factor {
   /// On `channel` with an explicit noise model (checkpoints).
   MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y, int channel,
                     const GaussianNoise& noise);
-  void linearize(const Values& x, Eigen::VectorXd& r,
-                 std::vector<Eigen::MatrixXd>* J) const override;
+  void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                   std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   const Eigen::VectorXd& measurement() const { return y_; }
   int channel() const { return channel_; }
@@ -118,8 +126,8 @@ class LinearGaussianFactor final : public Factor {
  public:
   LinearGaussianFactor(std::vector<Key> keys, std::vector<Eigen::MatrixXd> A, Eigen::VectorXd b,
                        Values linearization_point);
-  void linearize(const Values& x, Eigen::VectorXd& r,
-                 std::vector<Eigen::MatrixXd>* J) const override;
+  void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                   std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   const std::vector<Eigen::MatrixXd>& A() const { return A_; }
   const Eigen::VectorXd& b() const { return b_; }
