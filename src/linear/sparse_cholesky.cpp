@@ -229,11 +229,12 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& B) {
 
 bool SparseCholesky::SelectedInverse::lookup(Eigen::Index i, Eigen::Index j, double& out) const {
   if (i < j) std::swap(i, j);
-  const auto b = rows.begin() + colptr[static_cast<std::size_t>(j)];
-  const auto e = rows.begin() + colptr[static_cast<std::size_t>(j) + 1];
-  const auto it = std::lower_bound(b, e, static_cast<int>(i));
-  if (it == e || *it != i) return false;
-  out = values[static_cast<std::size_t>(it - rows.begin())];
+  const int* b = rows.data() + colptr[static_cast<std::size_t>(j)];
+  const int* e = rows.data() + colptr[static_cast<std::size_t>(j) + 1];
+  const int row = static_cast<int>(i);
+  const int* it = e - b <= 16 ? std::find(b, e, row) : std::lower_bound(b, e, row);  // a state's column is short
+  if (it == e || *it != row) return false;
+  out = values[static_cast<std::size_t>(it - rows.data())];
   return true;
 }
 

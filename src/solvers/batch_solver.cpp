@@ -414,26 +414,33 @@ Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& key
   Impl& s = *impl_;
   if (!s.has_solution)
     throw InvalidArgument("BatchSolver: no solution yet; call solve() before asking for covariances");
-  std::vector<Eigen::Index> offs, dims;
+  // Each key's first column (offs) and size (dims), in one buffer: a run
+  // asks this once per step.
+  std::vector<Eigen::Index> columns(2 * keys.size());
+  Eigen::Index* offs = columns.data();
+  Eigen::Index* dims = offs + keys.size();
   Eigen::Index m = 0;
-  for (const auto& k : keys) {
-    const std::size_t i = s.positionOf(k);
+  for (std::size_t a = 0; a < keys.size(); ++a) {
+    const std::size_t i = s.positionOf(keys[a]);
     if (i == Impl::npos)
-      throw InvalidArgument("BatchSolver: " + k.toString() + " is not a variable of the last solve");
-    offs.push_back(s.offset[i]);
-    dims.push_back(s.offset[i + 1] - s.offset[i]);
-    m += dims.back();
+      throw InvalidArgument("BatchSolver: " + keys[a].toString() + " is not a variable of the last solve");
+    offs[a] = s.offset[i];
+    dims[a] = s.offset[i + 1] - s.offset[i];
+    m += dims[a];
   }
   Eigen::MatrixXd out(m, m);
   // Fast path: every requested entry lies on the factor's pattern (true for
-  // any x_c(k) with x_b), so it is read from the selected inverse.
+  // any x_c(k) with x_b), so it is read from the selected inverse; the lower
+  // triangle mirrors the upper.
   if (!s.selected) s.selected = s.chol.selectedInverse();
   bool on_pattern = true;
   for (std::size_t a = 0, r = 0; a < keys.size() && on_pattern; r += dims[a], ++a)
-    for (std::size_t b = 0, c = 0; b < keys.size() && on_pattern; c += dims[b], ++b)
+    for (std::size_t b = a, c = r; b < keys.size() && on_pattern; c += dims[b], ++b)
       for (Eigen::Index i = 0; i < dims[a] && on_pattern; ++i)
-        for (Eigen::Index j = 0; j < dims[b] && on_pattern; ++j)
+        for (Eigen::Index j = b == a ? i : 0; j < dims[b] && on_pattern; ++j) {
           on_pattern = s.selected->lookup(offs[a] + i, offs[b] + j, out(r + i, c + j));
+          if (on_pattern) out(c + j, r + i) = out(r + i, c + j);
+        }
   if (on_pattern) return out;
   // Otherwise: the needed columns of H⁻¹ by solving H X = E.
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(s.n, m);
