@@ -51,6 +51,39 @@ void denseNormalEquations(const FactorGraph& graph, const Values& x, Eigen::Matr
 
 }  // namespace
 
+// r(x) = x³ − x on one variable: zero (a minimum of ½r²) at −1, 0 and 1.
+// From x = 0.55 the Gauss–Newton step lands at −3.6 (cost 900 against
+// 0.07), in −1's basin; LM must reject it, go back exactly where it was,
+// and descend to 0.
+class CubicMinusX final : public Factor {
+ public:
+  CubicMinusX() : Factor({Key::state(0)}, 1) {}
+  void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                   std::vector<Eigen::MatrixXd>* J) const override {
+    const double v = (*x[0])[0];
+    r = Eigen::VectorXd::Constant(1, v * v * v - v);
+    if (J) {
+      J->resize(1);
+      (*J)[0] = Eigen::MatrixXd::Constant(1, 1, 3 * v * v - 1);
+    }
+  }
+  std::string describe() const override { return "x³ − x"; }
+};
+
+TEST(BatchSolver, RejectedStepsGoBackToWhereTheyLeft) {
+  FactorGraph graph;
+  graph.add(std::make_shared<CubicMinusX>());
+  Values x;
+  x.insert(Key::state(0), Eigen::VectorXd::Constant(1, 0.55));
+  BatchSolver solver;
+  const BatchSolverSummary sum = solver.solve(graph, x);
+  ASSERT_TRUE(sum.converged) << sum.toString();
+  EXPECT_GT(sum.rejected_steps, 0) << sum.toString();
+  // Continuing from a rejected candidate instead would end at −1.
+  EXPECT_NEAR(x.at(Key::state(0))[0], 0.0, 1e-9) << sum.toString();
+  EXPECT_NEAR(solver.marginalCovariance(Key::state(0))(0, 0), 1.0, 1e-9);  // (J(0)ᵀJ(0))⁻¹ = 1
+}
+
 // The GSSM MAP over all steps is the RTS smoother of the stacked Kalman model.
 TEST(BatchSolver, LinearModelEqualsRtsSmootherAtEveryStep) {
   std::mt19937 rng(42);

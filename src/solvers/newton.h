@@ -39,7 +39,7 @@ class NewtonSystem {
 
 /// x ⊕ δ for δ stacked in x's order.
 Values addStep(const Values& x, const Eigen::VectorXd& delta);
-/// out = x ⊕ δ in place; out holds x's keys and sizes (no allocation).
+/// out = x ⊕ δ in place; out holds x's keys and sizes (no allocation) and may be x itself.
 void addStep(const Values& x, const Eigen::VectorXd& delta, Values& out);
 /// x's vectors stacked in its order into `flat` (resized to x.dim()).
 void flatten(const Values& x, Eigen::VectorXd& flat);
