@@ -152,17 +152,29 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
   }
   lf.keys.assign(f.keys().begin(), f.keys().end());
   Eigen::VectorXd& r = scratch_.r;
-  f.linearizeRobust(x, r, &lf.A);  // robust factors reweighted at each linearization
+  std::vector<Eigen::MatrixXd>& J = scratch_.J;
+  f.linearizeRobust(x, r, &J);  // robust factors reweighted at each linearization
   bool finite = r.allFinite();
-  for (const auto& a : lf.A) finite = finite && a.allFinite();
+  Eigen::Index width = 0;
+  for (const auto& a : J) {
+    finite = finite && a.allFinite();
+    width += a.cols();
+  }
   if (!finite)
     throw NumericalError("factor '" + f.describe() +
                          "' has a non-finite residual or Jacobian at the current estimate");
-  lf.b = -r;
+  lf.Ab.resize(r.size(), width + 1);
+  Eigen::Index col = 0;
+  for (const auto& a : J) {
+    lf.Ab.middleCols(col, a.cols()) = a;
+    col += a.cols();
+  }
+  auto b = lf.Ab.col(width);
+  b = -r;
   for (std::size_t i = 0; i < lf.keys.size(); ++i) {
     const auto it = vars_.find(lf.keys[i]);
     if (it == vars_.end()) continue;  // a new variable: δ̂ = 0
-    lf.b += lf.A[i] * it->second.delta;
+    b += J[i] * it->second.delta;
   }
   return lf;
 }
@@ -386,7 +398,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     auto& spare = pool_.spare;
     for (std::size_t i = spare.size(); i-- > 0;) {
       const Clique& c = spare[i];
-      if (c.R.rows() != dv || c.S.cols() != sep_cols || c.separator.size() != sep_count) continue;
+      if (c.conditional.rows() != dv || c.conditional.cols() != dv + sep_cols + 1 || c.separator.size() != sep_count)
+        continue;
       cl = std::move(spare[i]);
       spare[i] = std::move(spare.back());
       spare.pop_back();
@@ -405,7 +418,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     sep.clear();
     Eigen::Index rows = 0;
     for (std::size_t id : pending_of[vi]) {
-      rows += pend[id]->b.size();
+      rows += pend[id]->rows();
       for (const auto& k : pend[id]->keys)
         if (k != v && std::find(sep.begin(), sep.end(), k) == sep.end()) sep.push_back(k);
     }
@@ -426,10 +439,14 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     Eigen::Index r0 = 0;
     for (std::size_t id : pending_of[vi]) {
       const LinearFactor& f = *pend[id];
-      for (std::size_t i = 0; i < f.keys.size(); ++i)
-        M.block(r0, colOf.at(f.keys[i]), f.b.size(), f.A[i].cols()) = f.A[i];
-      M.block(r0, ncols, f.b.size(), 1) = f.b;
-      r0 += f.b.size();
+      Eigen::Index col = 0;
+      for (const auto& k : f.keys) {
+        const Eigen::Index w = dims.at(k);
+        M.block(r0, colOf.at(k), f.rows(), w) = f.Ab.middleCols(col, w);
+        col += w;
+      }
+      M.block(r0, ncols, f.rows(), 1) = f.b();
+      r0 += f.rows();
       if (pend_source[id]) p.fresh_owned.emplace_back(vi, *pend_source[id]);
     }
     if (damp_rows > 0) {
@@ -470,15 +487,12 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
               "observes); add a prior or check the model";
         throw NumericalError(os.str());
       }
-    cl.R = Rfull.topLeftCorner(dv, dv);
-    cl.S = Rfull.block(0, dv, dv, ncols - dv);
-    cl.d = Rfull.block(0, ncols, dv, 1);
-    // The remaining rows are the marginal factor on the separator.
+    cl.conditional = Rfull.topRows(dv);  // [R S d]
+    // The remaining rows are the marginal factor on the separator, whose
+    // columns follow v's in separator order: [A | b] as they stand.
     LinearFactor& m = cl.marginal;
     const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
-    m.b = Rfull.block(dv, ncols, mrows, 1);
-    m.A.resize(sep.size());
-    for (std::size_t i = 0; i < sep.size(); ++i) m.A[i] = Rfull.block(dv, colOf.at(sep[i]), mrows, dims.at(sep[i]));
+    m.Ab = Rfull.block(dv, dv, mrows, ncols - dv + 1);
     m.keys.assign(sep.begin(), sep.end());
     cl.separator.assign(sep.begin(), sep.end());
     if (!sep.empty() && mrows > 0) addPending(&m, std::nullopt);
@@ -601,15 +615,16 @@ void BayesTreeEngine::backSubstituteTop(const UpdatePlan& p, EngineCounts& count
 void BayesTreeEngine::backSubstitute(int c) {
   const Clique& cl = cliques_[static_cast<std::size_t>(c)];
   Eigen::VectorXd& rhs = scratch_.rhs;
-  rhs = cl.d;
+  rhs = cl.d();
+  const auto S = cl.S();
   Eigen::Index col = 0;
   for (const auto& k : cl.separator) {
     const Eigen::VectorXd& ds = vars_.at(k).delta;
-    scratch_.term.noalias() = cl.S.middleCols(col, ds.size()) * ds;  // the product, then the difference
+    scratch_.term.noalias() = S.middleCols(col, ds.size()) * ds;  // the product, then the difference
     rhs -= scratch_.term;
     col += ds.size();
   }
-  vars_.at(cl.frontal).delta = cl.R.triangularView<Eigen::Upper>().solve(rhs);
+  vars_.at(cl.frontal).delta = cl.R().triangularView<Eigen::Upper>().solve(rhs);
 }
 
 void BayesTreeEngine::setEstimates(const Values& x) {
@@ -667,7 +682,7 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
     // sparse system (8k instructions per fixed-lag update before).
     // Y = R⁻ᵀ by forward substitution, column by column; Σ = YᵀY is
     // symmetric as computed (entry (i, j) and (j, i) sum the same products).
-    const Eigen::MatrixXd& R = cliques_[static_cast<std::size_t>(path[0])].R;
+    const auto R = cliques_[static_cast<std::size_t>(path[0])].R();
     const Eigen::Index n = R.rows();
     Eigen::MatrixXd& Y = scratch_.stacked;
     Y.setIdentity(n, n);
@@ -701,14 +716,16 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   for (int c : path) {
     const Clique& cl = cliques_[static_cast<std::size_t>(c)];
     const Eigen::Index r0 = off.at(cl.frontal);
-    for (Eigen::Index i = 0; i < cl.R.rows(); ++i)
-      for (Eigen::Index j = i; j < cl.R.cols(); ++j) trip.emplace_back(r0 + i, r0 + j, cl.R(i, j));
+    const auto R = cl.R();
+    const auto S = cl.S();
+    for (Eigen::Index i = 0; i < R.rows(); ++i)
+      for (Eigen::Index j = i; j < R.cols(); ++j) trip.emplace_back(r0 + i, r0 + j, R(i, j));
     Eigen::Index col = 0;
     for (const auto& k : cl.separator) {
       const Eigen::Index dk = vars_.at(k).anchor.size();
       const Eigen::Index c0 = off.at(k);
-      for (Eigen::Index i = 0; i < cl.S.rows(); ++i)
-        for (Eigen::Index j = 0; j < dk; ++j) trip.emplace_back(r0 + i, c0 + j, cl.S(i, col + j));
+      for (Eigen::Index i = 0; i < S.rows(); ++i)
+        for (Eigen::Index j = 0; j < dk; ++j) trip.emplace_back(r0 + i, c0 + j, S(i, col + j));
       col += dk;
     }
   }
@@ -731,15 +748,15 @@ double BayesTreeEngine::linearizationError(int slot) const {
   if (!s.nonlinear) return 0.0;
   Scratch& e = scratch_;
   if (e.x.size() > 64) e.x = Values();
-  e.rlin = -s.linear.b;
-  for (std::size_t i = 0; i < s.linear.keys.size(); ++i) {
-    const Key& k = s.linear.keys[i];
-    const Var& v = vars_.at(k);
-    if (!e.x.contains(k)) e.x.insert(k, Eigen::VectorXd(v.anchor.size()));
-    e.x.at(k) = v.anchor + v.delta;
-    e.term.noalias() = s.linear.A[i] * v.delta;
-    e.rlin += e.term;
-  }
+  // r_lin(δ̂), filling the point x̂ = anchor + δ̂ on the way (one lookup per key).
+  s.linear.residual(
+      [&](const Key& k) -> const Eigen::VectorXd& {
+        const Var& v = vars_.at(k);
+        if (!e.x.contains(k)) e.x.insert(k, Eigen::VectorXd(v.anchor.size()));
+        e.x.at(k) = v.anchor + v.delta;
+        return v.delta;
+      },
+      e.rlin, e.term);
   s.nonlinear->linearizeRobust(e.x, e.r, nullptr);  // a moved weight is a linearization error too
   return (e.r - e.rlin).norm();
 }
@@ -766,6 +783,8 @@ std::vector<int> BayesTreeEngine::slotsOf(const Key& k) const {
 
 double BayesTreeEngine::cost() const {
   double c = 0;
+  Eigen::VectorXd r, term;
+  auto deltaOf = [&](const Key& k) -> const Eigen::VectorXd& { return vars_.at(k).delta; };
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
@@ -773,8 +792,7 @@ double BayesTreeEngine::cost() const {
       for (const auto& k : s.linear.keys) x.insert(k, vars_.at(k).anchor + vars_.at(k).delta);
       c += s.nonlinear->cost(x);
     } else {
-      Eigen::VectorXd r = -s.linear.b;
-      for (std::size_t i = 0; i < s.linear.keys.size(); ++i) r += s.linear.A[i] * vars_.at(s.linear.keys[i]).delta;
+      s.linear.residual(deltaOf, r, term);
       c += 0.5 * r.squaredNorm();
     }
   }
@@ -782,8 +800,10 @@ double BayesTreeEngine::cost() const {
 }
 
 void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
-  Eigen::VectorXd r;
+  Eigen::VectorXd r, term;
   std::vector<Eigen::MatrixXd> J;
+  auto deltaOf = [&](const Key& k) -> const Eigen::VectorXd& { return vars_.at(k).delta; };
+  auto dimOf = [&](const Key& k) { return vars_.at(k).delta.size(); };
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
@@ -791,9 +811,8 @@ void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
       const Eigen::MatrixXd C = residualCurvature(*s.nonlinear, x, r);
       sys.add(s.nonlinear->keys(), r, J, &C);
     } else {  // r = Σ A δ − b in δ coordinates: J = A, no curvature
-      r = -s.linear.b;
-      for (std::size_t i = 0; i < s.linear.keys.size(); ++i) r += s.linear.A[i] * vars_.at(s.linear.keys[i]).delta;
-      sys.add(s.linear.keys, r, s.linear.A, nullptr);
+      s.linear.residual(deltaOf, r, term);
+      sys.add(s.linear.keys, r, s.linear.blocks(dimOf), nullptr);
     }
   }
 }
@@ -825,7 +844,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   slots_by_key_.erase(key);
   // Its marginal on the separator becomes a fixed linear prior (first-estimate
   // Jacobians), owned by the parent, which consumed it when it was eliminated.
-  if (parent >= 0 && cl.marginal.b.size() > 0) {
+  if (parent >= 0 && cl.marginal.rows() > 0) {
     const int s = allocSlot();
     slots_[static_cast<std::size_t>(s)] = Slot{nullptr, std::move(cl.marginal), parent, true};
     for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys)

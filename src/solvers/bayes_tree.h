@@ -28,22 +28,55 @@ class ByteWriter;
 class ByteReader;
 class NewtonSystem;
 
-/// Whitened linear factor in δ coordinates: r(δ) = Σ_i A_i δ_{keys[i]} − b.
+/// Whitened linear factor in δ coordinates: r(δ) = Σ_i A_i δ_{keys[i]} − b,
+/// held as one matrix Ab = [A_1 … A_n | b], block i as wide as keys[i]'s
+/// variable. One heap block where separate ones took n + 2: a full-history
+/// run keeps one linear factor per factor and one per clique.
 struct LinearFactor {
   std::vector<Key> keys;
-  std::vector<Eigen::MatrixXd> A;
-  Eigen::VectorXd b;
+  Eigen::MatrixXd Ab;
+  Eigen::Index rows() const { return Ab.rows(); }
+  auto b() const { return Ab.col(Ab.cols() - 1); }
+  /// r = Σ_i A_i δ_i − b, with δ_i = delta(keys[i]) (whose sizes are the
+  /// blocks' widths); `term` is scratch.
+  template <class Delta>
+  void residual(Delta&& delta, Eigen::VectorXd& r, Eigen::VectorXd& term) const {
+    r = -b();
+    Eigen::Index col = 0;
+    for (const auto& k : keys) {
+      const Eigen::VectorXd& d = delta(k);
+      term.noalias() = Ab.middleCols(col, d.size()) * d;  // the product, then the sum
+      r += term;
+      col += d.size();
+    }
+  }
+  /// The blocks A_i as separate matrices, block i dim(keys[i]) wide.
+  template <class Dim>
+  std::vector<Eigen::MatrixXd> blocks(Dim&& dim) const {
+    std::vector<Eigen::MatrixXd> out;
+    Eigen::Index col = 0;
+    for (const auto& k : keys) {
+      const Eigen::Index w = dim(k);
+      out.emplace_back(Ab.middleCols(col, w));
+      col += w;
+    }
+    return out;
+  }
 };
 
 struct Clique {
   Key frontal;
   std::vector<Key> separator;
-  Eigen::MatrixXd R, S;  // R upper triangular (d_f × d_f), S (d_f × Σ d_sep)
-  Eigen::VectorXd d;
+  /// The conditional [R S d] in one matrix: R upper triangular (d_f × d_f),
+  /// S (d_f × Σ d_sep), d (d_f).
+  Eigen::MatrixXd conditional;
   LinearFactor marginal;  // what this subtree passes to its parent (on the separator)
   std::vector<int> owned;  // factor slots consumed by this clique's elimination
   int parent = -1;
   std::vector<int> children;
+  auto R() const { return conditional.leftCols(conditional.rows()); }
+  auto S() const { return conditional.middleCols(conditional.rows(), conditional.cols() - conditional.rows() - 1); }
+  auto d() const { return conditional.col(conditional.cols() - 1); }
 };
 
 // Where an input of the elimination comes from, so that commit() can give
@@ -249,6 +282,7 @@ class BayesTreeEngine {
   struct Scratch {
     Values x;
     Eigen::VectorXd r, rlin, term, rhs;
+    std::vector<Eigen::MatrixXd> J;  // a factor's Jacobian blocks, copied into its Ab
     Eigen::MatrixXd stacked;  // a clique's [A | b] while it is triangularized
     std::vector<Key> separator;
     std::vector<std::vector<std::size_t>> pending_of;  // eliminateTop's queue, per ordering entry

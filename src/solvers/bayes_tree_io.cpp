@@ -10,22 +10,42 @@
 
 namespace gssm::internal {
 
+// A linear factor as its keys, its blocks A_i one by one and b (the format
+// from before the blocks were held side by side: old checkpoints still load).
 namespace {
-void writeLinear(ByteWriter& out, const LinearFactor& f) {
+template <class Dim>
+void writeLinear(ByteWriter& out, const LinearFactor& f, Dim&& dim) {
   out.keys(f.keys);
-  out.u64(f.A.size());
-  for (const auto& a : f.A) out.mat(a);
-  out.vec(f.b);
+  const std::vector<Eigen::MatrixXd> blocks = f.blocks(dim);
+  out.u64(blocks.size());
+  for (const auto& a : blocks) out.mat(a);
+  out.vec(f.rows() > 0 || f.Ab.cols() > 0 ? Eigen::VectorXd(f.b()) : Eigen::VectorXd());
 }
-LinearFactor readLinear(ByteReader& in, const std::string& what) {
+LinearFactor readLinear(ByteReader& in, const Model& model, const std::string& what) {
   LinearFactor f;
   f.keys = in.keys(what + " keys");
   const std::size_t n = in.count(what + " blocks", 16);
   if (n != f.keys.size())
     in.fail(what + ": " + std::to_string(n) + " blocks for " + std::to_string(f.keys.size()) + " keys");
-  f.A.resize(n);
-  for (std::size_t i = 0; i < n; ++i) f.A[i] = in.mat(what + " block " + std::to_string(i));
-  f.b = in.vec(what + " b");
+  std::vector<Eigen::MatrixXd> blocks(n);
+  Eigen::Index width = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    blocks[i] = in.mat(what + " block " + std::to_string(i));
+    width += blocks[i].cols();
+  }
+  const Eigen::VectorXd b = in.vec(what + " b");
+  for (std::size_t i = 0; i < n; ++i)
+    if (blocks[i].rows() != b.size() || blocks[i].cols() != variableDim(model, f.keys[i]))
+      in.fail(what + ": block for " + f.keys[i].toString() + " is " + std::to_string(blocks[i].rows()) + " x " +
+              std::to_string(blocks[i].cols()) + ", expected " + std::to_string(b.size()) + " x " +
+              std::to_string(variableDim(model, f.keys[i])));
+  f.Ab.resize(b.size(), width + 1);
+  Eigen::Index col = 0;
+  for (const auto& a : blocks) {
+    f.Ab.middleCols(col, a.cols()) = a;
+    col += a.cols();
+  }
+  f.Ab.col(width) = b;
   return f;
 }
 }  // namespace
@@ -46,13 +66,14 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     out.i32(v.clique);
     out.i64(v.rank);
   }
+  auto dimOf = [&](const Key& k) { return vars_.at(k).anchor.size(); };
   out.u64(slots_.size());
   for (const auto& s : slots_) {
     out.boolean(s.alive);
     if (!s.alive) continue;
     out.boolean(s.nonlinear != nullptr);
     if (s.nonlinear) writeFactor(out, *s.nonlinear);
-    writeLinear(out, s.linear);
+    writeLinear(out, s.linear, dimOf);
     out.i32(s.owner);
   }
   out.ints(free_slots_);
@@ -63,10 +84,10 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     const Clique& cl = cliques_[c];
     out.key(cl.frontal);
     out.keys(cl.separator);
-    out.mat(cl.R);
-    out.mat(cl.S);
-    out.vec(cl.d);
-    writeLinear(out, cl.marginal);
+    out.mat(cl.R());
+    out.mat(cl.S());
+    out.vec(cl.d());
+    writeLinear(out, cl.marginal, dimOf);
     out.ints(cl.owned);
     out.i32(cl.parent);
     out.ints(cl.children);
@@ -114,7 +135,7 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     if (!slot.alive) continue;
     ++e.slots_alive_;
     if (in.boolean((name + " has a nonlinear factor").c_str())) slot.nonlinear = readFactor(in, model, name);
-    slot.linear = readLinear(in, name + " linearization");
+    slot.linear = readLinear(in, model, name + " linearization");
     slot.owner = in.i32((name + " owner").c_str());
   }
   e.free_slots_ = in.ints("engine free slots");
@@ -128,10 +149,14 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     Clique& cl = e.cliques_[c];
     cl.frontal = in.key(name + " frontal");
     cl.separator = in.keys(name + " separator");
-    cl.R = in.mat(name + " R");
-    cl.S = in.mat(name + " S");
-    cl.d = in.vec(name + " d");
-    cl.marginal = readLinear(in, name + " marginal");
+    const Eigen::MatrixXd R = in.mat(name + " R");
+    const Eigen::MatrixXd S = in.mat(name + " S");
+    const Eigen::VectorXd d = in.vec(name + " d");
+    if (R.rows() != R.cols() || S.rows() != R.rows() || d.size() != R.rows())
+      in.fail(name + ": its conditional's R, S and d do not fit together");
+    cl.conditional.resize(R.rows(), R.cols() + S.cols() + 1);
+    cl.conditional << R, S, d;
+    cl.marginal = readLinear(in, model, name + " marginal");
     cl.owned = in.ints(name + " owned slots");
     cl.parent = in.i32((name + " parent").c_str());
     cl.children = in.ints(name + " children");
@@ -159,12 +184,12 @@ std::string BayesTreeEngine::invariantViolation() const {
     return it == vars_.end() ? -1 : it->second.anchor.size();
   };
   auto linearOk = [&](const LinearFactor& f, const std::string& what) -> std::string {
-    if (f.A.size() != f.keys.size()) return what + ": blocks and keys differ in number";
-    for (std::size_t i = 0; i < f.keys.size(); ++i) {
-      if (dim(f.keys[i]) < 0) return what + " uses " + f.keys[i].toString() + ", which is not a variable";
-      if (f.A[i].rows() != f.b.size() || f.A[i].cols() != dim(f.keys[i]))
-        return what + ": block for " + f.keys[i].toString() + " has the wrong size";
+    Eigen::Index width = 0;
+    for (const auto& k : f.keys) {
+      if (dim(k) < 0) return what + " uses " + k.toString() + ", which is not a variable";
+      width += dim(k);
     }
+    if (f.Ab.cols() != width + 1) return what + ": its blocks are not as wide as its variables";
     return "";
   };
   if (clique_alive_.size() != cliques_.size()) return "clique flags and cliques differ in number";
@@ -185,7 +210,7 @@ std::string BayesTreeEngine::invariantViolation() const {
     const std::string lin = linearOk(slot.linear, what);
     if (!lin.empty()) return lin;
     if (slot.nonlinear && (slot.nonlinear->keys() != slot.linear.keys ||
-                           slot.nonlinear->dim() != slot.linear.b.size()))
+                           slot.nonlinear->dim() != slot.linear.rows()))
       return what + ": its linearization does not match its factor";
     if (!aliveClique(slot.owner)) return what + " is owned by no live clique";
     const auto& owned = cliques_[static_cast<std::size_t>(slot.owner)].owned;
@@ -211,7 +236,7 @@ std::string BayesTreeEngine::invariantViolation() const {
       if (dim(k) < 0 || k == cl.frontal) return what + ": separator variable " + k.toString() + " is invalid";
       dsep += dim(k);
     }
-    if (cl.R.rows() != df || cl.R.cols() != df || cl.S.rows() != df || cl.S.cols() != dsep || cl.d.size() != df)
+    if (cl.conditional.rows() != df || cl.conditional.cols() != df + dsep + 1)
       return what + ": conditional has the wrong size";
     if (cl.marginal.keys != cl.separator && !cl.marginal.keys.empty())
       return what + ": marginal is not on its separator";
