@@ -8,7 +8,12 @@
 namespace gssm {
 
 namespace {
-std::vector<Key> withConstants(const Model& m, std::vector<Key> keys) {
+// The keys, then the constants' if the model has any; allocated at their
+// exact size (a full-history run keeps every factor's keys).
+std::vector<Key> withConstants(const Model& m, std::initializer_list<Key> states) {
+  std::vector<Key> keys;
+  keys.reserve(states.size() + (m.dims().nb > 0 ? 1 : 0));
+  keys.insert(keys.end(), states);
   if (m.dims().nb > 0) keys.push_back(Key::constants());
   return keys;
 }

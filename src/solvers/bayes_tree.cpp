@@ -150,7 +150,7 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
     lf = std::move(pool_.spare_linear.back());
     pool_.spare_linear.pop_back();
   }
-  lf.keys.assign(f.keys().begin(), f.keys().end());
+  lf.shareKeys(f);
   Eigen::VectorXd& r = scratch_.r;
   std::vector<Eigen::MatrixXd>& J = scratch_.J;
   f.linearizeRobust(x, r, &J);  // robust factors reweighted at each linearization
@@ -171,8 +171,8 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
   }
   auto b = lf.Ab.col(width);
   b = -r;
-  for (std::size_t i = 0; i < lf.keys.size(); ++i) {
-    const auto it = vars_.find(lf.keys[i]);
+  for (std::size_t i = 0; i < lf.keys().size(); ++i) {
+    const auto it = vars_.find(lf.keys()[i]);
     if (it == vars_.end()) continue;  // a new variable: δ̂ = 0
     b += J[i] * it->second.delta;
   }
@@ -195,7 +195,7 @@ std::vector<Key> BayesTreeEngine::order(const std::vector<Key>& keys,
   int nrow = 0;
   for (const auto* f : factors) {
     bool any = false;
-    for (const auto& k : f->keys) {
+    for (const auto& k : f->keys()) {
       auto it = col.find(k);
       if (it != col.end()) {
         rows_of_col[static_cast<std::size_t>(it->second)].push_back(nrow);
@@ -294,7 +294,7 @@ void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
     p.linearized_new.push_back(linearize(*f, p.new_variables));
   }
   for (const auto& lf : p.new_linear)
-    for (const auto& k : lf.keys)
+    for (const auto& k : lf.keys())
       if (!known(k)) throw InvalidArgument("linear factor uses unknown variable " + k.toString());
   for (int s : p.update.relinearize) {
     const Slot& slot = slots_.at(static_cast<std::size_t>(s));
@@ -320,11 +320,11 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
     }
   };
   for (const auto& lf : p.linearized_new)
-    for (const auto& k : lf.keys) markUp(k);
+    for (const auto& k : lf.keys()) markUp(k);
   for (const auto& lf : p.new_linear)
-    for (const auto& k : lf.keys) markUp(k);
+    for (const auto& k : lf.keys()) markUp(k);
   for (const auto& kv : p.relinearized)
-    for (const auto& k : kv.second.keys) markUp(k);
+    for (const auto& k : kv.second.keys()) markUp(k);
 
   using Kind = InputSource::Kind;
   for (int c : p.removed_order) {
@@ -380,12 +380,12 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     pend.push_back(f);
     pend_source.push_back(source);
     std::size_t first = ordering.size();
-    for (const auto& k : f->keys) first = std::min(first, pos.at(k));
+    for (const auto& k : f->keys()) first = std::min(first, pos.at(k));
     if (first < ordering.size()) pending_of[first].push_back(id);
   };
   for (const auto& in : p.inputs) {
     bool empty = true;
-    for (const auto& k : in.first->keys) empty = empty && !pos.count(k);
+    for (const auto& k : in.first->keys()) empty = empty && !pos.count(k);
     if (empty) continue;  // cannot happen for a consistent tree
     addPending(in.first, in.second.kind == InputSource::Kind::Orphan ? std::nullopt
                                                                       : std::optional<InputSource>(in.second));
@@ -398,7 +398,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     auto& spare = pool_.spare;
     for (std::size_t i = spare.size(); i-- > 0;) {
       const Clique& c = spare[i];
-      if (c.conditional.rows() != dv || c.conditional.cols() != dv + sep_cols + 1 || c.separator.size() != sep_count)
+      if (c.conditional.rows() != dv || c.conditional.cols() != dv + sep_cols + 1 || c.separator().size() != sep_count)
         continue;
       cl = std::move(spare[i]);
       spare[i] = std::move(spare.back());
@@ -419,7 +419,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     Eigen::Index rows = 0;
     for (std::size_t id : pending_of[vi]) {
       rows += pend[id]->rows();
-      for (const auto& k : pend[id]->keys)
+      for (const auto& k : pend[id]->keys())
         if (k != v && std::find(sep.begin(), sep.end(), k) == sep.end()) sep.push_back(k);
     }
     std::sort(sep.begin(), sep.end(), [&](const Key& a, const Key& b) { return pos.at(a) < pos.at(b); });
@@ -440,7 +440,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     for (std::size_t id : pending_of[vi]) {
       const LinearFactor& f = *pend[id];
       Eigen::Index col = 0;
-      for (const auto& k : f.keys) {
+      for (const auto& k : f.keys()) {
         const Eigen::Index w = dims.at(k);
         M.block(r0, colOf.at(k), f.rows(), w) = f.Ab.middleCols(col, w);
         col += w;
@@ -493,8 +493,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     LinearFactor& m = cl.marginal;
     const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
     m.Ab = Rfull.block(dv, dv, mrows, ncols - dv + 1);
-    m.keys.assign(sep.begin(), sep.end());
-    cl.separator.assign(sep.begin(), sep.end());
+    if (m.factor_keys || m.own_keys.size() != sep.size()) m.setKeys(sep);
+    else std::copy(sep.begin(), sep.end(), m.own_keys.begin());  // a pooled clique's: same size, no allocation
     if (!sep.empty() && mrows > 0) addPending(&m, std::nullopt);
   }
 }
@@ -523,7 +523,7 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     vars_[kv.first] = std::move(v);
   }
   auto registerSlot = [&](int s) {
-    for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys)
+    for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys())
       if (!k.isConstants()) slots_by_key_[k].push_back(s);
   };
   std::vector<int> new_slot_of(p.linearized_new.size()), new_lin_slot_of(p.new_linear.size());
@@ -560,7 +560,7 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   }
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
     Clique& cl = p.fresh[vi];
-    cl.parent = cl.separator.empty() ? -1 : vars_.at(cl.separator.front()).clique;
+    cl.parent = cl.separator().empty() ? -1 : vars_.at(cl.separator().front()).clique;
     cliques_[static_cast<std::size_t>(p.fresh_id[vi])] = std::move(cl);
   }
   root_ = -1;
@@ -574,7 +574,7 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     Clique& oc = cliques_[static_cast<std::size_t>(o)];
     int best = -1;
     std::int64_t best_rank = 0;
-    for (const auto& k : oc.separator) {
+    for (const auto& k : oc.separator()) {
       const Var& v = vars_.at(k);
       if (best < 0 || v.rank < best_rank) {
         best = v.clique;
@@ -618,7 +618,7 @@ void BayesTreeEngine::backSubstitute(int c) {
   rhs = cl.d();
   const auto S = cl.S();
   Eigen::Index col = 0;
-  for (const auto& k : cl.separator) {
+  for (const auto& k : cl.separator()) {
     const Eigen::VectorXd& ds = vars_.at(k).delta;
     scratch_.term.noalias() = S.middleCols(col, ds.size()) * ds;  // the product, then the difference
     rhs -= scratch_.term;
@@ -721,7 +721,7 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
     for (Eigen::Index i = 0; i < R.rows(); ++i)
       for (Eigen::Index j = i; j < R.cols(); ++j) trip.emplace_back(r0 + i, r0 + j, R(i, j));
     Eigen::Index col = 0;
-    for (const auto& k : cl.separator) {
+    for (const auto& k : cl.separator()) {
       const Eigen::Index dk = vars_.at(k).anchor.size();
       const Eigen::Index c0 = off.at(k);
       for (Eigen::Index i = 0; i < S.rows(); ++i)
@@ -789,7 +789,7 @@ double BayesTreeEngine::cost() const {
     if (!s.alive) continue;
     if (s.nonlinear) {
       Values x;
-      for (const auto& k : s.linear.keys) x.insert(k, vars_.at(k).anchor + vars_.at(k).delta);
+      for (const auto& k : s.linear.keys()) x.insert(k, vars_.at(k).anchor + vars_.at(k).delta);
       c += s.nonlinear->cost(x);
     } else {
       s.linear.residual(deltaOf, r, term);
@@ -812,7 +812,7 @@ void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
       sys.add(s.nonlinear->keys(), r, J, &C);
     } else {  // r = Σ A δ − b in δ coordinates: J = A, no curvature
       s.linear.residual(deltaOf, r, term);
-      sys.add(s.linear.keys, r, s.linear.blocks(dimOf), nullptr);
+      sys.add(s.linear.keys(), r, s.linear.blocks(dimOf), nullptr);
     }
   }
 }
@@ -829,7 +829,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   // Drop the factors this clique consumed; they are summarized by its marginal.
   for (int s : cl.owned) {
     Slot& slot = slots_[static_cast<std::size_t>(s)];
-    for (const auto& k : slot.linear.keys) {
+    for (const auto& k : slot.linear.keys()) {
       if (k.isConstants()) continue;
       auto it = slots_by_key_.find(k);
       if (it == slots_by_key_.end()) continue;
@@ -847,7 +847,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   if (parent >= 0 && cl.marginal.rows() > 0) {
     const int s = allocSlot();
     slots_[static_cast<std::size_t>(s)] = Slot{nullptr, std::move(cl.marginal), parent, true};
-    for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys)
+    for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys())
       if (!k.isConstants()) slots_by_key_[k].push_back(s);
     cliques_[static_cast<std::size_t>(parent)].owned.push_back(s);
   }

@@ -33,7 +33,21 @@ class NewtonSystem;
 /// variable. One heap block where separate ones took n + 2: a full-history
 /// run keeps one linear factor per factor and one per clique.
 struct LinearFactor {
-  std::vector<Key> keys;
+  /// Its variables: the linearized factor's own keys (not copied: a
+  /// full-history run keeps one linear factor per factor), or its own.
+  const std::vector<Key>& keys() const { return factor_keys ? *factor_keys : own_keys; }
+  /// Keys of its own (a marginal, a fixed linear factor).
+  void setKeys(std::vector<Key> keys) {
+    own_keys = std::move(keys);
+    factor_keys = nullptr;
+  }
+  /// The keys of `f`, which must outlive this (the slot holding both keeps f).
+  void shareKeys(const Factor& f) {
+    own_keys.clear();
+    factor_keys = &f.keys();
+  }
+  std::vector<Key> own_keys;
+  const std::vector<Key>* factor_keys = nullptr;
   Eigen::MatrixXd Ab;
   Eigen::Index rows() const { return Ab.rows(); }
   auto b() const { return Ab.col(Ab.cols() - 1); }
@@ -43,7 +57,7 @@ struct LinearFactor {
   void residual(Delta&& delta, Eigen::VectorXd& r, Eigen::VectorXd& term) const {
     r = -b();
     Eigen::Index col = 0;
-    for (const auto& k : keys) {
+    for (const auto& k : keys()) {
       const Eigen::VectorXd& d = delta(k);
       term.noalias() = Ab.middleCols(col, d.size()) * d;  // the product, then the sum
       r += term;
@@ -55,7 +69,7 @@ struct LinearFactor {
   std::vector<Eigen::MatrixXd> blocks(Dim&& dim) const {
     std::vector<Eigen::MatrixXd> out;
     Eigen::Index col = 0;
-    for (const auto& k : keys) {
+    for (const auto& k : keys()) {
       const Eigen::Index w = dim(k);
       out.emplace_back(Ab.middleCols(col, w));
       col += w;
@@ -66,11 +80,13 @@ struct LinearFactor {
 
 struct Clique {
   Key frontal;
-  std::vector<Key> separator;
   /// The conditional [R S d] in one matrix: R upper triangular (d_f × d_f),
   /// S (d_f × Σ d_sep), d (d_f).
   Eigen::MatrixXd conditional;
-  LinearFactor marginal;  // what this subtree passes to its parent (on the separator)
+  /// What this subtree passes to its parent, on the separator; its keys are
+  /// the separator (held once).
+  LinearFactor marginal;
+  const std::vector<Key>& separator() const { return marginal.keys(); }
   std::vector<int> owned;  // factor slots consumed by this clique's elimination
   int parent = -1;
   std::vector<int> children;
@@ -303,6 +319,7 @@ class BayesTreeEngine {
       if (spare.size() < kMax) spare.push_back(std::move(c));
     }
     void keep(LinearFactor&& f) {
+      f.factor_keys = nullptr;  // its factor may go: nothing may point into it
       if (spare_linear.size() < kMax) spare_linear.push_back(std::move(f));
     }
   };

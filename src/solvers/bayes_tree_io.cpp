@@ -15,7 +15,7 @@ namespace gssm::internal {
 namespace {
 template <class Dim>
 void writeLinear(ByteWriter& out, const LinearFactor& f, Dim&& dim) {
-  out.keys(f.keys);
+  out.keys(f.keys());
   const std::vector<Eigen::MatrixXd> blocks = f.blocks(dim);
   out.u64(blocks.size());
   for (const auto& a : blocks) out.mat(a);
@@ -23,10 +23,11 @@ void writeLinear(ByteWriter& out, const LinearFactor& f, Dim&& dim) {
 }
 LinearFactor readLinear(ByteReader& in, const Model& model, const std::string& what) {
   LinearFactor f;
-  f.keys = in.keys(what + " keys");
+  f.setKeys(in.keys(what + " keys"));
+  const std::vector<Key>& keys = f.keys();
   const std::size_t n = in.count(what + " blocks", 16);
-  if (n != f.keys.size())
-    in.fail(what + ": " + std::to_string(n) + " blocks for " + std::to_string(f.keys.size()) + " keys");
+  if (n != keys.size())
+    in.fail(what + ": " + std::to_string(n) + " blocks for " + std::to_string(keys.size()) + " keys");
   std::vector<Eigen::MatrixXd> blocks(n);
   Eigen::Index width = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -35,10 +36,10 @@ LinearFactor readLinear(ByteReader& in, const Model& model, const std::string& w
   }
   const Eigen::VectorXd b = in.vec(what + " b");
   for (std::size_t i = 0; i < n; ++i)
-    if (blocks[i].rows() != b.size() || blocks[i].cols() != variableDim(model, f.keys[i]))
-      in.fail(what + ": block for " + f.keys[i].toString() + " is " + std::to_string(blocks[i].rows()) + " x " +
+    if (blocks[i].rows() != b.size() || blocks[i].cols() != variableDim(model, keys[i]))
+      in.fail(what + ": block for " + keys[i].toString() + " is " + std::to_string(blocks[i].rows()) + " x " +
               std::to_string(blocks[i].cols()) + ", expected " + std::to_string(b.size()) + " x " +
-              std::to_string(variableDim(model, f.keys[i])));
+              std::to_string(variableDim(model, keys[i])));
   f.Ab.resize(b.size(), width + 1);
   Eigen::Index col = 0;
   for (const auto& a : blocks) {
@@ -83,7 +84,7 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     if (!clique_alive_[c]) continue;
     const Clique& cl = cliques_[c];
     out.key(cl.frontal);
-    out.keys(cl.separator);
+    out.keys(cl.separator());
     out.mat(cl.R());
     out.mat(cl.S());
     out.vec(cl.d());
@@ -136,6 +137,10 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     ++e.slots_alive_;
     if (in.boolean((name + " has a nonlinear factor").c_str())) slot.nonlinear = readFactor(in, model, name);
     slot.linear = readLinear(in, model, name + " linearization");
+    if (slot.nonlinear) {  // the linearization shares its factor's keys, as in a running engine
+      if (slot.linear.keys() != slot.nonlinear->keys()) in.fail(name + ": its linearization does not match its factor");
+      slot.linear.shareKeys(*slot.nonlinear);
+    }
     slot.owner = in.i32((name + " owner").c_str());
   }
   e.free_slots_ = in.ints("engine free slots");
@@ -148,7 +153,7 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     ++e.cliques_alive_;
     Clique& cl = e.cliques_[c];
     cl.frontal = in.key(name + " frontal");
-    cl.separator = in.keys(name + " separator");
+    const std::vector<Key> separator = in.keys(name + " separator");
     const Eigen::MatrixXd R = in.mat(name + " R");
     const Eigen::MatrixXd S = in.mat(name + " S");
     const Eigen::VectorXd d = in.vec(name + " d");
@@ -157,6 +162,15 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     cl.conditional.resize(R.rows(), R.cols() + S.cols() + 1);
     cl.conditional << R, S, d;
     cl.marginal = readLinear(in, model, name + " marginal");
+    if (cl.marginal.keys() != separator) {
+      // The separator is held once, as the marginal's keys; an empty marginal
+      // (a checkpoint may hold one) is an empty factor on the separator.
+      if (!cl.marginal.keys().empty()) in.fail(name + ": its marginal is not on its separator");
+      Eigen::Index width = 0;
+      for (const auto& k : separator) width += variableDim(model, k);
+      cl.marginal.setKeys(separator);
+      cl.marginal.Ab.resize(0, width + 1);
+    }
     cl.owned = in.ints(name + " owned slots");
     cl.parent = in.i32((name + " parent").c_str());
     cl.children = in.ints(name + " children");
@@ -185,7 +199,7 @@ std::string BayesTreeEngine::invariantViolation() const {
   };
   auto linearOk = [&](const LinearFactor& f, const std::string& what) -> std::string {
     Eigen::Index width = 0;
-    for (const auto& k : f.keys) {
+    for (const auto& k : f.keys()) {
       if (dim(k) < 0) return what + " uses " + k.toString() + ", which is not a variable";
       width += dim(k);
     }
@@ -209,7 +223,7 @@ std::string BayesTreeEngine::invariantViolation() const {
     const std::string what = "factor slot " + std::to_string(s);
     const std::string lin = linearOk(slot.linear, what);
     if (!lin.empty()) return lin;
-    if (slot.nonlinear && (slot.nonlinear->keys() != slot.linear.keys ||
+    if (slot.nonlinear && (slot.nonlinear->keys() != slot.linear.keys() ||
                            slot.nonlinear->dim() != slot.linear.rows()))
       return what + ": its linearization does not match its factor";
     if (!aliveClique(slot.owner)) return what + " is owned by no live clique";
@@ -232,14 +246,12 @@ std::string BayesTreeEngine::invariantViolation() const {
     const Eigen::Index df = dim(cl.frontal);
     if (df < 0 || vars_.at(cl.frontal).clique != c) return what + ": its frontal variable does not point back to it";
     Eigen::Index dsep = 0;
-    for (const auto& k : cl.separator) {
+    for (const auto& k : cl.separator()) {
       if (dim(k) < 0 || k == cl.frontal) return what + ": separator variable " + k.toString() + " is invalid";
       dsep += dim(k);
     }
     if (cl.conditional.rows() != df || cl.conditional.cols() != df + dsep + 1)
       return what + ": conditional has the wrong size";
-    if (cl.marginal.keys != cl.separator && !cl.marginal.keys.empty())
-      return what + ": marginal is not on its separator";
     const std::string lin = linearOk(cl.marginal, what + " marginal");
     if (!lin.empty()) return lin;
     for (int s : cl.owned)
@@ -248,8 +260,8 @@ std::string BayesTreeEngine::invariantViolation() const {
       if (!aliveClique(cl.parent)) return what + ": parent is not a live clique";
       const auto& ch = cliques_[static_cast<std::size_t>(cl.parent)].children;
       if (std::count(ch.begin(), ch.end(), c) != 1) return what + ": its parent does not list it once";
-      if (cl.separator.empty()) return what + " has a parent but no separator";
-    } else if (!cl.separator.empty()) {
+      if (cl.separator().empty()) return what + " has a parent but no separator";
+    } else if (!cl.separator().empty()) {
       return what + " has a separator but no parent";
     }
     for (int ch : cl.children)
