@@ -600,32 +600,40 @@ void BayesTreeEngine::backSubstituteTop(const UpdatePlan& p, EngineCounts& count
     backSubstitute(p.fresh_id[vi]);
     ++counts.variables_backsubstituted;
   }
-  std::vector<int> stack(p.orphans.begin(), p.orphans.end());
+  std::vector<int>& stack = scratch_.path;
+  stack.assign(p.orphans.begin(), p.orphans.end());
+  std::vector<double> old;  // δ before, to see how far it moved
   while (!stack.empty()) {
     const int c = stack.back();
     stack.pop_back();
     Var& v = vars_.at(cliques_[static_cast<std::size_t>(c)].frontal);
-    const Eigen::VectorXd old = v.delta;
+    old.assign(v.delta.data(), v.delta.data() + v.delta.size());
     backSubstitute(c);
     ++counts.variables_backsubstituted;
-    if ((v.delta - old).lpNorm<Eigen::Infinity>() > wildfire_)
+    if ((v.delta - Eigen::Map<const Eigen::VectorXd>(old.data(), v.delta.size())).lpNorm<Eigen::Infinity>() > wildfire_)
       for (int ch : cliques_[static_cast<std::size_t>(c)].children) stack.push_back(ch);
   }
 }
 
 void BayesTreeEngine::backSubstitute(int c) {
   const Clique& cl = cliques_[static_cast<std::size_t>(c)];
-  Eigen::VectorXd& rhs = scratch_.rhs;
+  // Solved in the frontal's own δ (its size: no allocation), the products
+  // in a buffer that only grows (a scratch vector resized between a state's
+  // and the constants' sizes reallocated at every clique).
+  Eigen::VectorXd& rhs = vars_.at(cl.frontal).delta;
+  const Eigen::Index n = cl.conditional.rows();
   rhs = cl.d();
+  std::vector<double>& buffer = scratch_.product;
+  if (buffer.size() < static_cast<std::size_t>(n)) buffer.resize(static_cast<std::size_t>(n));
+  Eigen::Map<Eigen::VectorXd> term(buffer.data(), n);
   const auto S = cl.S();
   Eigen::Index col = 0;
   for (const auto& k : cl.separator()) {
     const Eigen::VectorXd& ds = vars_.at(k).delta;
-    scratch_.term.noalias() = S.middleCols(col, ds.size()) * ds;  // the product, then the difference
-    rhs -= scratch_.term;
+    term.noalias() = S.middleCols(col, ds.size()) * ds;  // the product, then the difference
+    rhs -= term;
     col += ds.size();
   }
-  const Eigen::Index n = rhs.size();
   if (n <= 8) {
     // R δ = rhs by columns, last first, as Eigen's solver does within its
     // 8-column panel (the same arithmetic), without its general-size
@@ -639,7 +647,6 @@ void BayesTreeEngine::backSubstitute(int c) {
   } else {
     cl.R().triangularView<Eigen::Upper>().solveInPlace(rhs);
   }
-  vars_.at(cl.frontal).delta = rhs;
 }
 
 void BayesTreeEngine::setEstimates(const Values& x) {

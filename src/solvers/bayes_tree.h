@@ -297,12 +297,13 @@ class BayesTreeEngine {
   // its own) and dropped when the set outgrows a window.
   struct Scratch {
     Values x;
-    Eigen::VectorXd r, rlin, term, rhs;
+    Eigen::VectorXd r, rlin, term;
+    std::vector<double> product;  // backSubstitute's S·δ_sep, as long as the widest frontal
     std::vector<Eigen::MatrixXd> J;  // a factor's Jacobian blocks, copied into its Ab
     Eigen::MatrixXd stacked;  // a clique's [A | b] while it is triangularized
     std::vector<Key> separator;
     std::vector<std::vector<std::size_t>> pending_of;  // eliminateTop's queue, per ordering entry
-    std::vector<int> path;                             // solvePath's cliques, leaf to root
+    std::vector<int> path;                             // solvePath's cliques, leaf to root; backSubstituteTop's stack
     std::vector<char> in_top;                          // detachTop's marks, by clique id (all 0 between calls)
   };
   mutable NotCopied<Scratch> scratch_;
