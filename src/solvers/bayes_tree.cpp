@@ -791,15 +791,13 @@ std::vector<int> BayesTreeEngine::nonlinearSlots() const {
 }
 
 std::vector<int> BayesTreeEngine::slotsOf(const Key& k) const {
-  std::vector<int> out;
-  const std::vector<int>* list = nullptr;
   if (k.isConstants()) return nonlinearSlots();
+  std::vector<int> out;
   auto it = slots_by_key_.find(k);
-  if (it != slots_by_key_.end()) list = &it->second;
-  if (list) out.reserve(list->size());
-  if (list)
-    for (int s : *list)
-      if (slots_[static_cast<std::size_t>(s)].alive && slots_[static_cast<std::size_t>(s)].nonlinear) out.push_back(s);
+  if (it == slots_by_key_.end()) return out;
+  out.reserve(it->second.size());
+  for (int s : it->second)
+    if (slots_[static_cast<std::size_t>(s)].alive && slots_[static_cast<std::size_t>(s)].nonlinear) out.push_back(s);
   return out;
 }
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "gssm/factors/factors.h"
+#include "solvers/small_int_list.h"
 
 namespace gssm {
 class Model;
@@ -87,9 +88,9 @@ struct Clique {
   /// the separator (held once).
   LinearFactor marginal;
   const std::vector<Key>& separator() const { return marginal.keys(); }
-  std::vector<int> owned;  // factor slots consumed by this clique's elimination
+  SmallIntList owned;  // factor slots consumed by this clique's elimination
   int parent = -1;
-  std::vector<int> children;
+  SmallIntList children;
   auto R() const { return conditional.leftCols(conditional.rows()); }
   auto S() const { return conditional.middleCols(conditional.rows(), conditional.cols() - conditional.rows() - 1); }
   auto d() const { return conditional.col(conditional.cols() - 1); }
@@ -285,7 +286,7 @@ class BayesTreeEngine {
   std::vector<int> free_cliques_;
   std::vector<Slot> slots_;
   std::vector<int> free_slots_;
-  std::unordered_map<Key, std::vector<int>, KeyHash> slots_by_key_;  // non-constant keys only
+  std::unordered_map<Key, SmallIntList, KeyHash> slots_by_key_;  // non-constant keys only
   std::size_t slots_alive_ = 0, cliques_alive_ = 0;
   std::int64_t next_rank_ = 0;
   int root_ = -1;

@@ -89,9 +89,9 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     out.mat(cl.S());
     out.vec(cl.d());
     writeLinear(out, cl.marginal, dimOf);
-    out.ints(cl.owned);
+    out.ints(cl.owned.toVector());
     out.i32(cl.parent);
-    out.ints(cl.children);
+    out.ints(cl.children.toVector());
   }
   out.ints(free_cliques_);
   std::vector<Key> indexed;
@@ -100,7 +100,7 @@ void BayesTreeEngine::save(ByteWriter& out) const {
   out.u64(indexed.size());
   for (const auto& k : indexed) {
     out.key(k);
-    out.ints(slots_by_key_.at(k));
+    out.ints(slots_by_key_.at(k).toVector());
   }
   out.i64(next_rank_);
   out.i32(root_);
@@ -171,16 +171,19 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
       cl.marginal.setKeys(separator);
       cl.marginal.Ab.resize(0, width + 1);
     }
-    cl.owned = in.ints(name + " owned slots");
+    const std::vector<int> owned = in.ints(name + " owned slots");
+    cl.owned.assign(owned.begin(), owned.end());
     cl.parent = in.i32((name + " parent").c_str());
-    cl.children = in.ints(name + " children");
+    const std::vector<int> children = in.ints(name + " children");
+    cl.children.assign(children.begin(), children.end());
   }
   e.free_cliques_ = in.ints("engine free cliques");
   const std::size_t nindexed = in.count("engine slot index", 9 + 8);
   for (std::size_t i = 0; i < nindexed; ++i) {
     const Key k = in.key("slot index key");
     if (k.isConstants() || e.slots_by_key_.count(k)) in.fail("slot index: " + k.toString() + " not allowed or twice");
-    e.slots_by_key_[k] = in.ints("slots of " + k.toString());
+    const std::vector<int> slots = in.ints("slots of " + k.toString());
+    e.slots_by_key_[k].assign(slots.begin(), slots.end());
   }
   e.next_rank_ = in.i64("engine next rank");
   e.root_ = in.i32("engine root");
