@@ -378,10 +378,10 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   std::vector<std::vector<std::size_t>>& pending_of = scratch_.pending_of;
   if (pending_of.size() < ordering.size()) pending_of.resize(ordering.size());
   for (std::size_t i = 0; i < ordering.size(); ++i) pending_of[i].clear();
-  std::vector<const LinearFactor*> pend;
-  std::vector<std::optional<InputSource>> pend_source;  // nullopt: a marginal made here
-  pend.reserve(p.inputs.size() + ordering.size());  // the inputs, then one marginal per clique at most
-  pend_source.reserve(pend.capacity());
+  std::vector<const LinearFactor*>& pend = scratch_.pend;
+  std::vector<std::optional<InputSource>>& pend_source = scratch_.pend_source;  // nullopt: a marginal made here
+  pend.clear();
+  pend_source.clear();
   auto addPending = [&](const LinearFactor* f, std::optional<InputSource> source) {
     const std::size_t id = pend.size();
     pend.push_back(f);
@@ -609,7 +609,7 @@ void BayesTreeEngine::backSubstituteTop(const UpdatePlan& p, EngineCounts& count
   }
   std::vector<int>& stack = scratch_.path;
   stack.assign(p.orphans.begin(), p.orphans.end());
-  std::vector<double> old;  // δ before, to see how far it moved
+  std::vector<double>& old = scratch_.before;  // δ before, to see how far it moved
   while (!stack.empty()) {
     const int c = stack.back();
     stack.pop_back();

@@ -12,6 +12,7 @@
 // relinearizing one factor changes only that factor's rows.
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -304,6 +305,9 @@ class BayesTreeEngine {
     Eigen::MatrixXd stacked;  // a clique's [A | b] while it is triangularized
     std::vector<Key> separator;
     std::vector<std::vector<std::size_t>> pending_of;  // eliminateTop's queue, per ordering entry
+    std::vector<const LinearFactor*> pend;             // eliminateTop's inputs, then the marginals it makes
+    std::vector<std::optional<InputSource>> pend_source;  // where each came from (nullopt: made there)
+    std::vector<double> before;                        // backSubstituteTop: an orphan's δ before
     std::vector<int> path;                             // solvePath's cliques, leaf to root; backSubstituteTop's stack
     std::vector<char> in_top;                          // detachTop's marks, by clique id (all 0 between calls)
   };
