@@ -2,6 +2,7 @@
 // Variable identifiers of a GSSM factor graph. A graph has exactly one node
 // for the constant block x_b (for the whole run) and one node x_c(k) per step.
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <string>
 
@@ -10,9 +11,14 @@ namespace gssm {
 enum class VariableKind : std::uint8_t { State = 0, Constants = 1 };
 
 /// Names a variable: the time-series state at step k, or the constants.
+/// Both fields in 8 bytes: a full-history run holds several keys per step
+/// (factors, separators, the variable index).
 struct Key {
-  VariableKind kind = VariableKind::State;
-  std::int64_t step = 0;  ///< step index for a State; 0 for Constants
+  VariableKind kind : 1;
+  std::int64_t step : 63;  ///< step index for a State; 0 for Constants
+
+  constexpr Key() : kind(VariableKind::State), step(0) {}
+  constexpr Key(VariableKind k, std::int64_t s) : kind(k), step(s) {}
 
   static Key state(std::int64_t k) { return {VariableKind::State, k}; }
   static Key constants() { return {VariableKind::Constants, 0}; }
@@ -23,10 +29,15 @@ struct Key {
     if (a.kind != b.kind) return a.kind < b.kind;
     return a.step < b.step;
   }
-  friend bool operator==(const Key& a, const Key& b) {
-    return a.kind == b.kind && a.step == b.step;
-  }
+  friend bool operator==(const Key& a, const Key& b) { return a.word() == b.word(); }
   friend bool operator!=(const Key& a, const Key& b) { return !(a == b); }
+
+  /// Both fields as one word (one load and compare instead of two masked ones).
+  std::uint64_t word() const {
+    std::uint64_t w;
+    std::memcpy(&w, this, sizeof w);
+    return w;
+  }
 
   /// "x_c(12)" or "x_b".
   std::string toString() const {
@@ -35,11 +46,10 @@ struct Key {
   }
 };
 
+static_assert(sizeof(Key) == 8, "Key packs its kind and step into one word");
+
 struct KeyHash {
-  std::size_t operator()(const Key& k) const noexcept {
-    return std::hash<std::uint64_t>()(static_cast<std::uint64_t>(k.step) * 2u +
-                                      static_cast<std::uint64_t>(k.kind));
-  }
+  std::size_t operator()(const Key& k) const noexcept { return std::hash<std::uint64_t>()(k.word()); }
 };
 
 }  // namespace gssm
