@@ -4,6 +4,7 @@
 #include <Eigen/QR>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -17,31 +18,31 @@
 namespace gssm::internal {
 
 namespace {
-// Key → value table for the variables of one update: a linear scan while
-// small (appending a step touches 3-4 variables; no hashing, one small
-// vector), a hash map once a relinearization pass re-eliminates many.
-// Hash maps built per update and per clique were a good part of the 26% of
-// fixed-lag update time spent in malloc/free.
+// Key → value table for the variables of one update: a linear scan over an
+// inline array while small (appending a step touches 3-4 variables; no
+// hashing, no allocation: three tables are built per clique), a hash map
+// once a relinearization pass re-eliminates many. Hash maps built per
+// update and per clique were a good part of the 26% of fixed-lag update
+// time spent in malloc/free.
 template <class T>
 class KeyTable {
  public:
-  KeyTable() { small_.reserve(kSmall); }  // one allocation, not one per doubling
   void set(const Key& k, T v) {
     if (!big_.empty()) {
       big_[k] = v;
       return;
     }
-    for (auto& e : small_)
-      if (e.first == k) {
-        e.second = v;
+    for (std::size_t i = 0; i < size_; ++i)
+      if (small_[i].first == k) {
+        small_[i].second = v;
         return;
       }
-    if (small_.size() < kSmall) {
-      small_.emplace_back(k, v);
+    if (size_ < kSmall) {
+      small_[size_++] = {k, v};
       return;
     }
-    for (const auto& e : small_) big_.emplace(e.first, e.second);
-    small_.clear();
+    for (std::size_t i = 0; i < size_; ++i) big_.emplace(small_[i].first, small_[i].second);
+    size_ = 0;
     big_[k] = v;
   }
   const T* find(const Key& k) const {
@@ -49,8 +50,8 @@ class KeyTable {
       auto it = big_.find(k);
       return it == big_.end() ? nullptr : &it->second;
     }
-    for (const auto& e : small_)
-      if (e.first == k) return &e.second;
+    for (std::size_t i = 0; i < size_; ++i)
+      if (small_[i].first == k) return &small_[i].second;
     return nullptr;
   }
   bool count(const Key& k) const { return find(k) != nullptr; }
@@ -62,7 +63,8 @@ class KeyTable {
 
  private:
   static constexpr std::size_t kSmall = 16;
-  std::vector<std::pair<Key, T>> small_;
+  std::array<std::pair<Key, T>, kSmall> small_;
+  std::size_t size_ = 0;
   std::unordered_map<Key, T, KeyHash> big_;
 };
 // Householder triangularization of a clique's stacked system [A | b] in
@@ -697,21 +699,17 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   // its conditionals form a Bayes net on its frontal variables (every
   // separator lies above): Σ = (RᵀR)⁻¹ with R block upper triangular in
   // elimination order.
-  std::unordered_set<int> on_path;
-  std::vector<int> path;
-  for (const auto& k : keys) {
+  for (const auto& k : keys)
     if (!vars_.count(k)) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
-    for (int c = vars_.at(k).clique; c >= 0 && on_path.insert(c).second;
-         c = cliques_[static_cast<std::size_t>(c)].parent)
-      path.push_back(c);
-  }
-  if (path.size() == 1 && keys.size() == 1) {
+  const int root_of_one = keys.size() == 1 ? vars_.at(keys[0]).clique : -1;
+  if (root_of_one >= 0 && cliques_[static_cast<std::size_t>(root_of_one)].parent < 0) {
     // One clique, the root (the constants, checked after every update):
     // Σ = R⁻¹R⁻ᵀ of its own conditional, densely, without assembling a
-    // sparse system (8k instructions per fixed-lag update before).
+    // sparse system (8k instructions per fixed-lag update before) or even
+    // listing the path.
     // Y = R⁻ᵀ by forward substitution, column by column; Σ = YᵀY is
     // symmetric as computed (entry (i, j) and (j, i) sum the same products).
-    const auto R = cliques_[static_cast<std::size_t>(path[0])].R();
+    const auto R = cliques_[static_cast<std::size_t>(root_of_one)].R();
     const Eigen::Index n = R.rows();
     Eigen::MatrixXd& Y = scratch_.stacked;
     Y.setIdentity(n, n);
@@ -730,6 +728,12 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
       }
     return S;
   }
+  std::unordered_set<int> on_path;
+  std::vector<int> path;
+  for (const auto& k : keys)
+    for (int c = vars_.at(k).clique; c >= 0 && on_path.insert(c).second;
+         c = cliques_[static_cast<std::size_t>(c)].parent)
+      path.push_back(c);
   std::sort(path.begin(), path.end(), [&](int a, int b) {
     return vars_.at(cliques_[static_cast<std::size_t>(a)].frontal).rank <
            vars_.at(cliques_[static_cast<std::size_t>(b)].frontal).rank;
