@@ -267,7 +267,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       if (armed) internal::unflatten(flat, v);  // same keys and sizes: no allocation
     }
   } restore{values, start_flat};
-  Eigen::VectorXd g, diag, g_new, diag_new;
+  Eigen::VectorXd g, diag;
   double cost = s.linearize(graph, x, g, diag);
   sum.initial_cost = cost;
   const bool lm = options_.method == BatchSolverOptions::Method::LevenbergMarquardt;
@@ -324,10 +324,11 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     internal::addStep(x, delta, x);
     // Linearize at the candidate right away (its cost comes with it): one
     // pass over the factors per accepted step instead of two; a rejected
-    // step refills H at the point it goes back to.
-    const double new_cost = s.linearize(graph, x, g_new, diag_new, true);
+    // step refills H, g and the diagonal at the point it goes back to (so
+    // no second gradient and diagonal are kept: 16 MB at 10⁶ steps).
+    const double new_cost = s.linearize(graph, x, g, diag, true);
     if (!std::isfinite(new_cost) && !lm)  // Gauss–Newton cannot back off: say which factor
-      s.linearize(graph, x, g_new, diag_new);
+      s.linearize(graph, x, g, diag);
     if (!policy.accept(new_cost, cost)) {
       ++sum.rejected_steps;
       internal::unflatten(x_before, x);
@@ -343,8 +344,6 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       continue;
     }
     ++sum.iterations;
-    std::swap(g, g_new);
-    std::swap(diag, diag_new);
     const double old_cost = cost;
     cost = new_cost;
     policy.accepted();
