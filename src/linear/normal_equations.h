@@ -15,7 +15,7 @@ struct FactorColumns {
   std::vector<Eigen::Index> global;  ///< column of H
   std::vector<double> entries;       ///< the Jacobian, rows × size() column-major
   Eigen::Index rows = 0;
-  bool ascending = true;  ///< global columns increase (a factor's keys in Key order)
+  bool ascending = true;  ///< global columns strictly increase (a factor's keys in Key order)
   std::size_t size() const { return size_; }
 
   /// The columns of `count` variables, variable a at columns offs[a] …
@@ -57,7 +57,7 @@ struct FactorColumns {
     ascending = true;
   }
   void push(Eigen::Index column) {
-    if (size_ > 0 && column < global[size_ - 1]) ascending = false;
+    if (size_ > 0 && column <= global[size_ - 1]) ascending = false;  // a repeated column takes the general loop
     if (size_ == global.size()) global.push_back(column);
     else global[size_] = column;
     ++size_;
