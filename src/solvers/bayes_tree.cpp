@@ -181,13 +181,12 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
   return lf;
 }
 
-std::vector<Key> BayesTreeEngine::order(const std::vector<Key>& keys,
-                                        const std::vector<const LinearFactor*>& factors,
-                                        const Values& new_vars) const {
-  std::vector<Key> out = keys;
+void BayesTreeEngine::order(const std::vector<Key>& keys, const std::vector<const LinearFactor*>& factors,
+                            const Values& new_vars, std::vector<Key>& out) const {
+  out.assign(keys.begin(), keys.end());
   if (mode_ == OrderingMode::TimeOrdered || keys.size() <= 2) {
     std::sort(out.begin(), out.end());  // Key order: states by step, constants last
-    return out;
+    return;
   }
   // CCOLAMD on the factor × variable incidence, with constraint groups:
   // 0 = older variables, 1 = the newest variables, 2 = constants (root).
@@ -199,7 +198,7 @@ std::vector<Key> BayesTreeEngine::order(const std::vector<Key>& keys,
   for (const auto& k : keys) ++per_group[group(k)];
   if (per_group[0] <= 1 && per_group[1] <= 1 && per_group[2] <= 1) {
     std::sort(out.begin(), out.end(), [&](const Key& a, const Key& b) { return group(a) < group(b); });
-    return out;
+    return;
   }
   std::unordered_map<Key, int, KeyHash> col;
   for (std::size_t i = 0; i < keys.size(); ++i) col[keys[i]] = static_cast<int>(i);
@@ -233,10 +232,9 @@ std::vector<Key> BayesTreeEngine::order(const std::vector<Key>& keys,
   if (!ccolamd(nrow, ncol, static_cast<int>(A.size()), A.data(), p.data(), knobs, stats,
                cmember.data())) {
     std::sort(out.begin(), out.end());  // CCOLAMD failed: fall back to time order
-    return out;
+    return;
   }
   for (int i = 0; i < ncol; ++i) out[static_cast<std::size_t>(i)] = keys[static_cast<std::size_t>(p[static_cast<std::size_t>(i)])];
-  return out;
 }
 
 struct BayesTreeEngine::UpdatePlan {
@@ -250,6 +248,9 @@ struct BayesTreeEngine::UpdatePlan {
         orphans(l.orphans),
         keys(l.keys),
         inputs(l.inputs),
+        ordering(l.ordering),
+        new_slot_of(l.new_slot_of),
+        new_lin_slot_of(l.new_lin_slot_of),
         fresh(l.fresh),
         fresh_owned(l.fresh_owned),
         fresh_id(l.fresh_id) {
@@ -270,7 +271,9 @@ struct BayesTreeEngine::UpdatePlan {
   std::vector<int>& orphans;
   std::vector<Key>& keys;
   std::vector<std::pair<const LinearFactor*, InputSource>>& inputs;
-  std::vector<Key> ordering;
+  std::vector<Key>& ordering;
+  std::vector<int>& new_slot_of;
+  std::vector<int>& new_lin_slot_of;
   std::vector<Clique>& fresh;
   std::vector<std::pair<std::size_t, InputSource>>& fresh_owned;
   std::vector<int>& fresh_id;
@@ -365,7 +368,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   std::vector<const LinearFactor*> fptrs;
   fptrs.reserve(p.inputs.size());
   for (const auto& in : p.inputs) fptrs.push_back(in.first);
-  p.ordering = order(p.keys, fptrs, p.new_variables);
+  order(p.keys, fptrs, p.new_variables, p.ordering);
   const std::vector<Key>& ordering = p.ordering;
   KeyTable<std::size_t> pos;
   for (std::size_t i = 0; i < ordering.size(); ++i) pos.set(ordering[i], i);
@@ -536,7 +539,10 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys())
       if (!k.isConstants()) slots_by_key_[k].push_back(s);
   };
-  std::vector<int> new_slot_of(p.linearized_new.size()), new_lin_slot_of(p.new_linear.size());
+  std::vector<int>& new_slot_of = p.new_slot_of;
+  std::vector<int>& new_lin_slot_of = p.new_lin_slot_of;
+  new_slot_of.assign(p.linearized_new.size(), -1);
+  new_lin_slot_of.assign(p.new_linear.size(), -1);
   for (std::size_t i = 0; i < p.linearized_new.size(); ++i) {
     const int s = allocSlot();
     slots_[static_cast<std::size_t>(s)] = Slot{p.new_factors[i], std::move(p.linearized_new[i]), -1, true};
@@ -598,7 +604,7 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     for (std::size_t c = 0; c < cliques_.size(); ++c)
       if (clique_alive_[c] && cliques_[c].parent < 0) root_ = static_cast<int>(c);
   counts.cliques_reeliminated += static_cast<int>(ordering.size());
-  counts.top = ordering;
+  counts.top.assign(ordering.begin(), ordering.end());
   counts.orphans += static_cast<int>(p.orphans.size());
 }
 
@@ -801,15 +807,16 @@ std::vector<int> BayesTreeEngine::nonlinearSlots() const {
   return out;
 }
 
-std::vector<int> BayesTreeEngine::slotsOf(const Key& k) const {
-  if (k.isConstants()) return nonlinearSlots();
-  std::vector<int> out;
+void BayesTreeEngine::appendSlotsOf(const Key& k, std::vector<int>& out) const {
+  if (k.isConstants()) {
+    const std::vector<int> all = nonlinearSlots();
+    out.insert(out.end(), all.begin(), all.end());
+    return;
+  }
   auto it = slots_by_key_.find(k);
-  if (it == slots_by_key_.end()) return out;
-  out.reserve(it->second.size());
+  if (it == slots_by_key_.end()) return;
   for (int s : it->second)
     if (slots_[static_cast<std::size_t>(s)].alive && slots_[static_cast<std::size_t>(s)].nonlinear) out.push_back(s);
-  return out;
 }
 
 double BayesTreeEngine::cost() const {

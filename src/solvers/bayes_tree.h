@@ -129,6 +129,8 @@ struct UpdateLists {
   // clique order (one list per update, not one per clique).
   std::vector<std::pair<std::size_t, InputSource>> fresh_owned;
   std::vector<int> fresh_id;
+  std::vector<Key> ordering;                        // elimination order of the keys
+  std::vector<int> new_slot_of, new_lin_slot_of;    // the slot each new factor got
   /// Empties every list; one that a large update (a relinearization of the
   /// whole history) grew past kKeep entries gives its memory back.
   void clear() {
@@ -140,6 +142,9 @@ struct UpdateLists {
     reset(fresh);
     reset(fresh_owned);
     reset(fresh_id);
+    reset(ordering);
+    reset(new_slot_of);
+    reset(new_lin_slot_of);
   }
 
  private:
@@ -162,6 +167,11 @@ struct EngineCounts {
   int orphans = 0;
   int factors_relinearized = 0;
   int variables_backsubstituted = 0;
+  /// Zeroes the counts, keeping top's storage (a smoother reuses one per update).
+  void clear() {
+    top.clear();
+    cliques_reeliminated = orphans = factors_relinearized = variables_backsubstituted = 0;
+  }
 };
 
 /// What one engine update adds and relinearizes; every part may be empty.
@@ -231,8 +241,8 @@ class BayesTreeEngine {
   double linearizationError(int slot) const;
   /// Slots of nonlinear factors (alive).
   std::vector<int> nonlinearSlots() const;
-  /// Alive nonlinear slots whose keys include k.
-  std::vector<int> slotsOf(const Key& k) const;
+  /// Appends the alive nonlinear slots whose keys include k to `out`.
+  void appendSlotsOf(const Key& k, std::vector<int>& out) const;
   const FactorPtr& factorOf(int slot) const { return slots_[static_cast<std::size_t>(slot)].nonlinear; }
   /// ½‖r‖² of every alive factor at the current estimate (nonlinear factors
   /// exactly, linear ones by their linear model).
@@ -273,8 +283,9 @@ class BayesTreeEngine {
   void backSubstituteTop(const UpdatePlan& plan, EngineCounts& counts);
 
   LinearFactor linearize(const Factor& f, const Values& extra) const;
-  std::vector<Key> order(const std::vector<Key>& keys, const std::vector<const LinearFactor*>& factors,
-                         const Values& new_vars) const;
+  /// The elimination order of `keys` into `out`.
+  void order(const std::vector<Key>& keys, const std::vector<const LinearFactor*>& factors,
+             const Values& new_vars, std::vector<Key>& out) const;
   void backSubstitute(int c);
   int allocClique();
   int allocSlot();

@@ -28,6 +28,9 @@ class SmootherCore {
                    internal::EngineCounts& counts);
   void iterateToConvergence(UpdateReport& rep, internal::EngineCounts& counts);
   Eigen::VectorXd constants_at_last_check_;
+  // Per-update buffers kept for their capacity (not state: not saved).
+  internal::EngineCounts counts_;
+  std::vector<int> local_slots_;
 };
 
 }  // namespace gssm

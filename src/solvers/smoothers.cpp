@@ -216,7 +216,8 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
   UpdateReport rep;
   rep.new_factors = static_cast<int>(new_factors.size());
   rep.new_variables = static_cast<int>(new_values.size());
-  internal::EngineCounts counts;
+  internal::EngineCounts& counts = counts_;
+  counts.clear();
   engine.update(internal::EngineUpdate::adding(new_factors, new_values), counts);  // may throw: nothing changed
   rep.iterations = 1;
 
@@ -229,11 +230,10 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
     // Start-up nonlinearity: relinearize the factors of the top, which is
     // being re-eliminated anyway.
     for (int it = 0; it < options.max_local_iterations; ++it) {
-      std::vector<int> local;
-      local.reserve(16);
+      std::vector<int>& local = local_slots_;
+      local.clear();
       for (const auto& k : counts.top)
-        if (!k.isConstants())
-          for (int s : engine.slotsOf(k)) local.push_back(s);
+        if (!k.isConstants()) engine.appendSlotsOf(k, local);
       std::sort(local.begin(), local.end());
       local.erase(std::unique(local.begin(), local.end()), local.end());
       const int before = rep.iterations;
