@@ -381,12 +381,13 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   // Each pending factor waits at the first of its variables in the ordering;
   // the marginal a clique leaves on its separator joins the queue.
   std::vector<std::vector<std::size_t>>& pending_of = scratch_.pending_of;
+  if (ordering.size() <= kKeepEntries && pending_of.size() > kKeepEntries) pending_of = {};  // after a whole-history update
   if (pending_of.size() < ordering.size()) pending_of.resize(ordering.size());
   for (std::size_t i = 0; i < ordering.size(); ++i) pending_of[i].clear();
   std::vector<const LinearFactor*>& pend = scratch_.pend;
   std::vector<std::optional<InputSource>>& pend_source = scratch_.pend_source;  // nullopt: a marginal made here
-  pend.clear();
-  pend_source.clear();
+  clearKeepingSmall(pend);
+  clearKeepingSmall(pend_source);
   auto addPending = [&](const LinearFactor* f, std::optional<InputSource> source) {
     const std::size_t id = pend.size();
     pend.push_back(f);

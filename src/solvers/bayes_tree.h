@@ -116,6 +116,16 @@ struct NotCopied : T {
   NotCopied& operator=(NotCopied&&) noexcept = default;
 };
 
+/// Per-update buffers keep their storage for the next update up to this
+/// many entries; beyond (a relinearization of the whole history grew them)
+/// they give their memory back.
+constexpr std::size_t kKeepEntries = 256;
+template <class V>
+void clearKeepingSmall(V& v) {
+  if (v.capacity() > kKeepEntries) V().swap(v);
+  else v.clear();
+}
+
 // The lists one engine update fills (bayes_tree.cpp's UpdatePlan), kept by
 // the engine so their capacity carries over.
 struct UpdateLists {
@@ -131,28 +141,19 @@ struct UpdateLists {
   std::vector<int> fresh_id;
   std::vector<Key> ordering;                        // elimination order of the keys
   std::vector<int> new_slot_of, new_lin_slot_of;    // the slot each new factor got
-  /// Empties every list; one that a large update (a relinearization of the
-  /// whole history) grew past kKeep entries gives its memory back.
+  /// Empties every list (clearKeepingSmall).
   void clear() {
-    reset(linearized_new);
-    reset(removed_order);
-    reset(orphans);
-    reset(keys);
-    reset(inputs);
-    reset(fresh);
-    reset(fresh_owned);
-    reset(fresh_id);
-    reset(ordering);
-    reset(new_slot_of);
-    reset(new_lin_slot_of);
-  }
-
- private:
-  static constexpr std::size_t kKeep = 256;
-  template <class V>
-  static void reset(V& v) {
-    if (v.capacity() > kKeep) V().swap(v);
-    else v.clear();
+    clearKeepingSmall(linearized_new);
+    clearKeepingSmall(removed_order);
+    clearKeepingSmall(orphans);
+    clearKeepingSmall(keys);
+    clearKeepingSmall(inputs);
+    clearKeepingSmall(fresh);
+    clearKeepingSmall(fresh_owned);
+    clearKeepingSmall(fresh_id);
+    clearKeepingSmall(ordering);
+    clearKeepingSmall(new_slot_of);
+    clearKeepingSmall(new_lin_slot_of);
   }
 };
 
