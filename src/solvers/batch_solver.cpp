@@ -190,7 +190,11 @@ struct BatchSolver::Impl {
     for (const auto& f : graph) {
       std::vector<Eigen::MatrixXd>& J = jacobians[factor_shape[fi]];
       const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
-      for (std::size_t a = 0; a < count; ++a) factor_x[a] = &(first + factor_vars[b + a])->second;
+      for (std::size_t a = 0; a < count; ++a) {  // its variables' values and first columns
+        const std::uint32_t v = factor_vars[b + a];
+        factor_x[a] = &(first + v)->second;
+        factor_offs[a] = offset[v];
+      }
       const double c = f->linearizeRobustAt(factor_x.data(), r, &J);  // reweighted at every linearization
       if (!r.allFinite()) {
         if (trial) return std::numeric_limits<double>::infinity();
@@ -198,7 +202,6 @@ struct BatchSolver::Impl {
                              "' has a non-finite residual at the current estimate");
       }
       cost += c;
-      offsetsOf(fi);
       columns.gather(factor_offs.data(), J);
       for (std::size_t p = 0; p < columns.size(); ++p) g[columns.global[p]] += columns.dot(p, r.data());
       internal::forEachUpperJtJ(columns, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });

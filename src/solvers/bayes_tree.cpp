@@ -67,6 +67,12 @@ class KeyTable {
   std::size_t size_ = 0;
   std::unordered_map<Key, T, KeyHash> big_;
 };
+// x's vector for k, added with n components if absent: the engine fills a
+// scratch point key by key, in place once its entries exist.
+Eigen::VectorXd& pointEntry(Values& x, const Key& k, Eigen::Index n) {
+  if (!x.contains(k)) x.insert(k, Eigen::VectorXd(n));
+  return x.at(k);
+}
 // Householder triangularization of a clique's stacked system [A | b] in
 // place: the strict lower triangle is left holding reflector data (the
 // caller zeroes it). Eigen's unblocked algorithm (same reflectors: β = ∓‖x‖,
@@ -118,6 +124,11 @@ int BayesTreeEngine::allocClique() {
   return static_cast<int>(cliques_.size()) - 1;
 }
 
+void BayesTreeEngine::indexSlot(int s) {
+  for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys())
+    if (!k.isConstants()) slots_by_key_[k].push_back(s);
+}
+
 int BayesTreeEngine::allocSlot() {
   ++slots_alive_;
   if (!free_slots_.empty()) {
@@ -140,12 +151,17 @@ Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {
 LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) const {
   Values& x = scratch_.x;  // see linearizationError
   if (x.size() > 64) x = Values();
+  std::vector<const Var*>& known = scratch_.factor_vars;  // null: a new variable (δ̂ = 0)
+  known.clear();
   for (const auto& k : f.keys()) {
     const auto it = vars_.find(k);
-    const Eigen::VectorXd& value = it != vars_.end() ? it->second.anchor : extra.at(k);
-    if (!x.contains(k)) x.insert(k, Eigen::VectorXd(value.size()));
-    if (it != vars_.end()) x.at(k) = it->second.anchor + it->second.delta;
-    else x.at(k) = value;
+    known.push_back(it != vars_.end() ? &it->second : nullptr);
+    if (known.back()) {
+      pointEntry(x, k, it->second.anchor.size()) = it->second.anchor + it->second.delta;
+    } else {
+      const Eigen::VectorXd& value = extra.at(k);
+      pointEntry(x, k, value.size()) = value;
+    }
   }
   LinearFactor lf;
   if (!pool_.spare_linear.empty()) {  // its vectors and matrices get overwritten (same shapes: no allocation)
@@ -157,27 +173,15 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
   std::vector<Eigen::MatrixXd>& J = scratch_.J;
   f.linearizeRobust(x, r, &J);  // robust factors reweighted at each linearization
   bool finite = r.allFinite();
-  Eigen::Index width = 0;
-  for (const auto& a : J) {
-    finite = finite && a.allFinite();
-    width += a.cols();
-  }
+  for (const auto& a : J) finite = finite && a.allFinite();
   if (!finite)
     throw NumericalError("factor '" + f.describe() +
                          "' has a non-finite residual or Jacobian at the current estimate");
-  lf.Ab.resize(r.size(), width + 1);
-  Eigen::Index col = 0;
-  for (const auto& a : J) {
-    lf.Ab.middleCols(col, a.cols()) = a;
-    col += a.cols();
-  }
-  auto b = lf.Ab.col(width);
+  lf.setBlocks(J, r.size());
+  auto b = lf.Ab.col(lf.Ab.cols() - 1);
   b = -r;
-  for (std::size_t i = 0; i < lf.keys().size(); ++i) {
-    const auto it = vars_.find(lf.keys()[i]);
-    if (it == vars_.end()) continue;  // a new variable: δ̂ = 0
-    b += J[i] * it->second.delta;
-  }
+  for (std::size_t i = 0; i < known.size(); ++i)
+    if (known[i]) b += J[i] * known[i]->delta;
   return lf;
 }
 
@@ -507,8 +511,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     LinearFactor& m = cl.marginal;
     const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
     m.Ab = Rfull.block(dv, dv, mrows, ncols - dv + 1);
-    if (m.factor_keys || m.own_keys.size() != sep.size()) m.setKeys(sep);
-    else std::copy(sep.begin(), sep.end(), m.own_keys.begin());  // a pooled clique's: same size, no allocation
+    m.setKeys(sep);
     if (!sep.empty() && mrows > 0) addPending(&m, std::nullopt);
   }
 }
@@ -536,10 +539,6 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     v.delta = Eigen::VectorXd::Zero(kv.second.size());
     vars_[kv.first] = std::move(v);
   }
-  auto registerSlot = [&](int s) {
-    for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys())
-      if (!k.isConstants()) slots_by_key_[k].push_back(s);
-  };
   std::vector<int>& new_slot_of = p.new_slot_of;
   std::vector<int>& new_lin_slot_of = p.new_lin_slot_of;
   new_slot_of.assign(p.linearized_new.size(), -1);
@@ -548,13 +547,13 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     const int s = allocSlot();
     slots_[static_cast<std::size_t>(s)] = Slot{p.new_factors[i], std::move(p.linearized_new[i]), -1, true};
     new_slot_of[i] = s;
-    registerSlot(s);
+    indexSlot(s);
   }
   for (std::size_t i = 0; i < p.new_linear.size(); ++i) {
     const int s = allocSlot();
     slots_[static_cast<std::size_t>(s)] = Slot{nullptr, p.new_linear[i], -1, true};
     new_lin_slot_of[i] = s;
-    registerSlot(s);
+    indexSlot(s);
   }
   const std::vector<Key>& ordering = p.ordering;
   p.fresh_id.resize(ordering.size());
@@ -792,8 +791,7 @@ double BayesTreeEngine::linearizationError(int slot) const {
   s.linear.residual(
       [&](const Key& k) -> const Eigen::VectorXd& {
         const Var& v = vars_.at(k);
-        if (!e.x.contains(k)) e.x.insert(k, Eigen::VectorXd(v.anchor.size()));
-        e.x.at(k) = v.anchor + v.delta;
+        pointEntry(e.x, k, v.anchor.size()) = v.anchor + v.delta;
         return v.delta;
       },
       e.rlin, e.term);
@@ -809,11 +807,6 @@ std::vector<int> BayesTreeEngine::nonlinearSlots() const {
 }
 
 void BayesTreeEngine::appendSlotsOf(const Key& k, std::vector<int>& out) const {
-  if (k.isConstants()) {
-    const std::vector<int> all = nonlinearSlots();
-    out.insert(out.end(), all.begin(), all.end());
-    return;
-  }
   auto it = slots_by_key_.find(k);
   if (it == slots_by_key_.end()) return;
   for (int s : it->second)
@@ -886,8 +879,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   if (parent >= 0 && cl.marginal.rows() > 0) {
     const int s = allocSlot();
     slots_[static_cast<std::size_t>(s)] = Slot{nullptr, std::move(cl.marginal), parent, true};
-    for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys())
-      if (!k.isConstants()) slots_by_key_[k].push_back(s);
+    indexSlot(s);
     cliques_[static_cast<std::size_t>(parent)].owned.push_back(s);
   }
   if (parent >= 0) {

@@ -38,9 +38,10 @@ struct LinearFactor {
   /// Its variables: the linearized factor's own keys (not copied: a
   /// full-history run keeps one linear factor per factor), or its own.
   const std::vector<Key>& keys() const { return factor_keys ? *factor_keys : own_keys; }
-  /// Keys of its own (a marginal, a fixed linear factor).
-  void setKeys(std::vector<Key> keys) {
-    own_keys = std::move(keys);
+  /// Keys of its own (a marginal, a fixed linear factor), copied into the
+  /// storage it has (a pooled factor's: no allocation).
+  void setKeys(const std::vector<Key>& keys) {
+    own_keys.assign(keys.begin(), keys.end());
     factor_keys = nullptr;
   }
   /// The keys of `f`, which must outlive this (the slot holding both keeps f).
@@ -53,6 +54,18 @@ struct LinearFactor {
   Eigen::MatrixXd Ab;
   Eigen::Index rows() const { return Ab.rows(); }
   auto b() const { return Ab.col(Ab.cols() - 1); }
+  /// Lays the blocks A_i side by side in Ab with room for b after them
+  /// (b's column is the caller's to fill); the inverse of blocks().
+  void setBlocks(const std::vector<Eigen::MatrixXd>& A, Eigen::Index rows) {
+    Eigen::Index width = 0;
+    for (const auto& a : A) width += a.cols();
+    Ab.resize(rows, width + 1);
+    Eigen::Index col = 0;
+    for (const auto& a : A) {
+      Ab.middleCols(col, a.cols()) = a;
+      col += a.cols();
+    }
+  }
   /// r = Σ_i A_i δ_i − b, with δ_i = delta(keys[i]) (whose sizes are the
   /// blocks' widths); `term` is scratch.
   template <class Delta>
@@ -242,7 +255,8 @@ class BayesTreeEngine {
   double linearizationError(int slot) const;
   /// Slots of nonlinear factors (alive).
   std::vector<int> nonlinearSlots() const;
-  /// Appends the alive nonlinear slots whose keys include k to `out`.
+  /// Appends the alive nonlinear slots whose keys include the state k to
+  /// `out` (every factor touches the constants: that is nonlinearSlots()).
   void appendSlotsOf(const Key& k, std::vector<int>& out) const;
   const FactorPtr& factorOf(int slot) const { return slots_[static_cast<std::size_t>(slot)].nonlinear; }
   /// ½‖r‖² of every alive factor at the current estimate (nonlinear factors
@@ -290,6 +304,8 @@ class BayesTreeEngine {
   void backSubstitute(int c);
   int allocClique();
   int allocSlot();
+  /// Lists slot s under each of its states' keys (slots_by_key_).
+  void indexSlot(int s);
 
   OrderingMode mode_;
   double wildfire_;
@@ -311,6 +327,7 @@ class BayesTreeEngine {
   // its own) and dropped when the set outgrows a window.
   struct Scratch {
     Values x;
+    std::vector<const Var*> factor_vars;  // linearize: a factor's variables, null if new
     Eigen::VectorXd r, rlin, term;
     std::vector<double> product;  // backSubstitute's S·δ_sep, as long as the widest frontal
     std::vector<Eigen::MatrixXd> J;  // a factor's Jacobian blocks, copied into its Ab

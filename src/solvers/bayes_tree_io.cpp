@@ -29,24 +29,15 @@ LinearFactor readLinear(ByteReader& in, const Model& model, const std::string& w
   if (n != keys.size())
     in.fail(what + ": " + std::to_string(n) + " blocks for " + std::to_string(keys.size()) + " keys");
   std::vector<Eigen::MatrixXd> blocks(n);
-  Eigen::Index width = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    blocks[i] = in.mat(what + " block " + std::to_string(i));
-    width += blocks[i].cols();
-  }
+  for (std::size_t i = 0; i < n; ++i) blocks[i] = in.mat(what + " block " + std::to_string(i));
   const Eigen::VectorXd b = in.vec(what + " b");
   for (std::size_t i = 0; i < n; ++i)
     if (blocks[i].rows() != b.size() || blocks[i].cols() != variableDim(model, keys[i]))
       in.fail(what + ": block for " + keys[i].toString() + " is " + std::to_string(blocks[i].rows()) + " x " +
               std::to_string(blocks[i].cols()) + ", expected " + std::to_string(b.size()) + " x " +
               std::to_string(variableDim(model, keys[i])));
-  f.Ab.resize(b.size(), width + 1);
-  Eigen::Index col = 0;
-  for (const auto& a : blocks) {
-    f.Ab.middleCols(col, a.cols()) = a;
-    col += a.cols();
-  }
-  f.Ab.col(width) = b;
+  f.setBlocks(blocks, b.size());
+  f.Ab.col(f.Ab.cols() - 1) = b;
   return f;
 }
 }  // namespace
