@@ -126,7 +126,7 @@ int BayesTreeEngine::allocClique() {
 
 void BayesTreeEngine::indexSlot(int s) {
   for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys())
-    if (!k.isConstants()) slots_by_key_[k].push_back(s);
+    if (!k.isConstants()) vars_.at(k).slots.push_back(s);
 }
 
 int BayesTreeEngine::allocSlot() {
@@ -141,9 +141,9 @@ int BayesTreeEngine::allocSlot() {
 }
 
 Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {
-  const auto it = vars_.find(k);
-  if (it == vars_.end()) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
-  return it->second.anchor + it->second.delta;
+  const Var* v = vars_.find(k);
+  if (!v) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
+  return v->estimate();
 }
 
 // Linearizes f at the current estimate: r(x) ≈ r(x̂) + J (δ − δ̂), i.e.
@@ -154,10 +154,10 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
   std::vector<const Var*>& known = scratch_.factor_vars;  // null: a new variable (δ̂ = 0)
   known.clear();
   for (const auto& k : f.keys()) {
-    const auto it = vars_.find(k);
-    known.push_back(it != vars_.end() ? &it->second : nullptr);
-    if (known.back()) {
-      pointEntry(x, k, it->second.anchor.size()) = it->second.anchor + it->second.delta;
+    const Var* v = vars_.find(k);
+    known.push_back(v);
+    if (v) {
+      pointEntry(x, k, v->dim()) = v->anchor() + v->delta();
     } else {
       const Eigen::VectorXd& value = extra.at(k);
       pointEntry(x, k, value.size()) = value;
@@ -181,7 +181,7 @@ LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) co
   auto b = lf.Ab.col(lf.Ab.cols() - 1);
   b = -r;
   for (std::size_t i = 0; i < known.size(); ++i)
-    if (known[i]) b += J[i] * known[i]->delta;
+    if (known[i]) b += J[i] * known[i]->delta();
   return lf;
 }
 
@@ -296,12 +296,13 @@ void BayesTreeEngine::update(const EngineUpdate& u, EngineCounts& counts) {
 // factors and the slots to relinearize at the current estimate.
 void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
   for (const auto& kv : p.new_variables) {
-    if (vars_.count(kv.first))
+    if (vars_.contains(kv.first))
       throw InvalidArgument("variable " + kv.first.toString() + " already exists");
     if (!kv.second.allFinite())
       throw InvalidArgument("initial value of " + kv.first.toString() + " is not finite");
+    if (kv.second.size() == 0) throw InvalidArgument("initial value of " + kv.first.toString() + " is empty");
   }
-  auto known = [&](const Key& k) { return vars_.count(k) || p.new_variables.contains(k); };
+  auto known = [&](const Key& k) { return vars_.contains(k) || p.new_variables.contains(k); };
   for (const auto& f : p.new_factors) {
     for (const auto& k : f->keys())
       if (!known(k))
@@ -327,9 +328,9 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
   std::vector<char>& removed = scratch_.in_top;
   if (removed.size() < cliques_.size()) removed.resize(cliques_.size(), 0);
   auto markUp = [&](const Key& k) {
-    auto it = vars_.find(k);
-    if (it == vars_.end()) return;
-    for (int c = it->second.clique; c >= 0 && !removed[static_cast<std::size_t>(c)];
+    const Var* v = vars_.find(k);
+    if (!v) return;
+    for (int c = v->clique; c >= 0 && !removed[static_cast<std::size_t>(c)];
          c = cliques_[static_cast<std::size_t>(c)].parent) {
       removed[static_cast<std::size_t>(c)] = 1;
       p.removed_order.push_back(c);
@@ -378,8 +379,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   for (std::size_t i = 0; i < ordering.size(); ++i) pos.set(ordering[i], i);
   KeyTable<Eigen::Index> dims;
   for (const auto& k : ordering) {
-    const auto it = vars_.find(k);
-    dims.set(k, it != vars_.end() ? it->second.anchor.size() : p.new_variables.at(k).size());
+    const Var* var = vars_.find(k);
+    dims.set(k, var ? var->dim() : p.new_variables.at(k).size());
   }
 
   // Each pending factor waits at the first of its variables in the ordering;
@@ -469,7 +470,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     }
     if (damp_rows > 0) {
       // Marquardt rows pull δ_v toward its current value: √λ·D (δ_v − δ̂_v) = 0.
-      const Eigen::VectorXd& dhat = vars_.count(v) ? vars_.at(v).delta : Eigen::VectorXd(Eigen::VectorXd::Zero(dv));
+      const Var* var = vars_.find(v);
+      const Eigen::VectorXd dhat = var ? Eigen::VectorXd(var->delta()) : Eigen::VectorXd(Eigen::VectorXd::Zero(dv));
       for (Eigen::Index i = 0; i < dv; ++i) {
         const double w = std::sqrt(damping) * std::max(M.col(i).head(rows).norm(), 1e-12);
         M(rows + i, i) = w;
@@ -534,10 +536,7 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     --cliques_alive_;
   }
   for (const auto& kv : p.new_variables) {
-    Var v;
-    v.anchor = kv.second;
-    v.delta = Eigen::VectorXd::Zero(kv.second.size());
-    vars_[kv.first] = std::move(v);
+    vars_.insert(kv.first, Var(kv.second));
   }
   std::vector<int>& new_slot_of = p.new_slot_of;
   std::vector<int>& new_lin_slot_of = p.new_lin_slot_of;
@@ -622,10 +621,10 @@ void BayesTreeEngine::backSubstituteTop(const UpdatePlan& p, EngineCounts& count
     const int c = stack.back();
     stack.pop_back();
     Var& v = vars_.at(cliques_[static_cast<std::size_t>(c)].frontal);
-    old.assign(v.delta.data(), v.delta.data() + v.delta.size());
+    old.assign(v.delta().data(), v.delta().data() + v.dim());
     backSubstitute(c);
     ++counts.variables_backsubstituted;
-    if ((v.delta - Eigen::Map<const Eigen::VectorXd>(old.data(), v.delta.size())).lpNorm<Eigen::Infinity>() > wildfire_)
+    if ((v.delta() - Eigen::Map<const Eigen::VectorXd>(old.data(), v.dim())).lpNorm<Eigen::Infinity>() > wildfire_)
       for (int ch : cliques_[static_cast<std::size_t>(c)].children) stack.push_back(ch);
   }
 }
@@ -635,7 +634,7 @@ void BayesTreeEngine::backSubstitute(int c) {
   // Solved in the frontal's own δ (its size: no allocation), the products
   // in a buffer that only grows (a scratch vector resized between a state's
   // and the constants' sizes reallocated at every clique).
-  Eigen::VectorXd& rhs = vars_.at(cl.frontal).delta;
+  Eigen::Map<Eigen::VectorXd> rhs = vars_.at(cl.frontal).delta();
   const Eigen::Index n = cl.conditional.rows();
   rhs = cl.d();
   std::vector<double>& buffer = scratch_.product;
@@ -644,7 +643,7 @@ void BayesTreeEngine::backSubstitute(int c) {
   const auto S = cl.S();
   Eigen::Index col = 0;
   for (const auto& k : cl.separator()) {
-    const Eigen::VectorXd& ds = vars_.at(k).delta;
+    const auto ds = vars_.at(k).delta();
     term.noalias() = S.middleCols(col, ds.size()) * ds;  // the product, then the difference
     rhs -= term;
     col += ds.size();
@@ -667,13 +666,14 @@ void BayesTreeEngine::backSubstitute(int c) {
 void BayesTreeEngine::setEstimates(const Values& x) {
   for (const auto& kv : x) {
     Var& v = vars_.at(kv.first);
-    v.delta = kv.second - v.anchor;
+    v.delta() = kv.second - v.anchor();
   }
 }
 
 Values BayesTreeEngine::allEstimates() const {
   Values out;
-  for (const auto& kv : vars_) out.insert(kv.first, kv.second.anchor + kv.second.delta);
+  out.reserve(vars_.size());
+  vars_.forEach([&](const Key& k, const Var& v) { out.insert(k, v.estimate()); });
   return out;
 }
 
@@ -706,7 +706,7 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   // separator lies above): Σ = (RᵀR)⁻¹ with R block upper triangular in
   // elimination order.
   for (const auto& k : keys)
-    if (!vars_.count(k)) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
+    if (!vars_.contains(k)) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
   const int root_of_one = keys.size() == 1 ? vars_.at(keys[0]).clique : -1;
   if (root_of_one >= 0 && cliques_[static_cast<std::size_t>(root_of_one)].parent < 0) {
     // One clique, the root (the constants, checked after every update):
@@ -749,7 +749,7 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   for (int c : path) {
     const Key& f = cliques_[static_cast<std::size_t>(c)].frontal;
     off[f] = n;
-    n += vars_.at(f).anchor.size();
+    n += vars_.at(f).dim();
   }
   std::vector<Eigen::Triplet<double>> trip;
   for (int c : path) {
@@ -761,7 +761,7 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
       for (Eigen::Index j = i; j < R.cols(); ++j) trip.emplace_back(r0 + i, r0 + j, R(i, j));
     Eigen::Index col = 0;
     for (const auto& k : cl.separator()) {
-      const Eigen::Index dk = vars_.at(k).anchor.size();
+      const Eigen::Index dk = vars_.at(k).dim();
       const Eigen::Index c0 = off.at(k);
       for (Eigen::Index i = 0; i < S.rows(); ++i)
         for (Eigen::Index j = 0; j < dk; ++j) trip.emplace_back(r0 + i, c0 + j, S(i, col + j));
@@ -771,11 +771,11 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   Eigen::SparseMatrix<double> R(n, n);
   R.setFromTriplets(trip.begin(), trip.end());
   Eigen::Index m = 0;
-  for (const auto& k : keys) m += vars_.at(k).anchor.size();
+  for (const auto& k : keys) m += vars_.at(k).dim();
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, m);
   Eigen::Index c = 0;
   for (const auto& k : keys)
-    for (Eigen::Index j = 0; j < vars_.at(k).anchor.size(); ++j) E(off.at(k) + j, c++) = 1.0;
+    for (Eigen::Index j = 0; j < vars_.at(k).dim(); ++j) E(off.at(k) + j, c++) = 1.0;
   // Σ = R⁻¹ R⁻ᵀ, so Σ_req = Yᵀ Y with Y = R⁻ᵀ E.
   const Eigen::MatrixXd Y = Eigen::SparseMatrix<double>(R.transpose()).triangularView<Eigen::Lower>().solve(E);
   const Eigen::MatrixXd S = Y.transpose() * Y;
@@ -789,10 +789,10 @@ double BayesTreeEngine::linearizationError(int slot) const {
   if (e.x.size() > 64) e.x = Values();
   // r_lin(δ̂), filling the point x̂ = anchor + δ̂ on the way (one lookup per key).
   s.linear.residual(
-      [&](const Key& k) -> const Eigen::VectorXd& {
+      [&](const Key& k) {
         const Var& v = vars_.at(k);
-        pointEntry(e.x, k, v.anchor.size()) = v.anchor + v.delta;
-        return v.delta;
+        pointEntry(e.x, k, v.dim()) = v.anchor() + v.delta();
+        return v.delta();
       },
       e.rlin, e.term);
   s.nonlinear->linearizeRobust(e.x, e.r, nullptr);  // a moved weight is a linearization error too
@@ -807,21 +807,21 @@ std::vector<int> BayesTreeEngine::nonlinearSlots() const {
 }
 
 void BayesTreeEngine::appendSlotsOf(const Key& k, std::vector<int>& out) const {
-  auto it = slots_by_key_.find(k);
-  if (it == slots_by_key_.end()) return;
-  for (int s : it->second)
+  const Var* v = vars_.find(k);
+  if (!v) return;
+  for (int s : v->slots)
     if (slots_[static_cast<std::size_t>(s)].alive && slots_[static_cast<std::size_t>(s)].nonlinear) out.push_back(s);
 }
 
 double BayesTreeEngine::cost() const {
   double c = 0;
   Eigen::VectorXd r, term;
-  auto deltaOf = [&](const Key& k) -> const Eigen::VectorXd& { return vars_.at(k).delta; };
+  auto deltaOf = [&](const Key& k) { return vars_.at(k).delta(); };
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
       Values x;
-      for (const auto& k : s.linear.keys()) x.insert(k, vars_.at(k).anchor + vars_.at(k).delta);
+      for (const auto& k : s.linear.keys()) x.insert(k, vars_.at(k).estimate());
       c += s.nonlinear->cost(x);
     } else {
       s.linear.residual(deltaOf, r, term);
@@ -834,8 +834,8 @@ double BayesTreeEngine::cost() const {
 void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
   Eigen::VectorXd r, term;
   std::vector<Eigen::MatrixXd> J;
-  auto deltaOf = [&](const Key& k) -> const Eigen::VectorXd& { return vars_.at(k).delta; };
-  auto dimOf = [&](const Key& k) { return vars_.at(k).delta.size(); };
+  auto deltaOf = [&](const Key& k) { return vars_.at(k).delta(); };
+  auto dimOf = [&](const Key& k) { return vars_.at(k).dim(); };
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
@@ -850,9 +850,9 @@ void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
 }
 
 void BayesTreeEngine::marginalizeLeaf(const Key& key) {
-  auto vit = vars_.find(key);
-  if (vit == vars_.end()) throw InvalidArgument("marginalize: no variable " + key.toString());
-  const int c = vit->second.clique;
+  const Var* var = vars_.find(key);
+  if (!var) throw InvalidArgument("marginalize: no variable " + key.toString());
+  const int c = var->clique;
   Clique& cl = cliques_[static_cast<std::size_t>(c)];
   if (!cl.children.empty())
     throw NumericalError("marginalize: " + key.toString() +
@@ -863,9 +863,9 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
     Slot& slot = slots_[static_cast<std::size_t>(s)];
     for (const auto& k : slot.linear.keys()) {
       if (k.isConstants()) continue;
-      auto it = slots_by_key_.find(k);
-      if (it == slots_by_key_.end()) continue;
-      auto& v = it->second;
+      Var* on = vars_.find(k);
+      if (!on) continue;
+      auto& v = on->slots;
       v.erase(std::remove(v.begin(), v.end(), s), v.end());
     }
     pool_.keep(std::move(slot.linear));
@@ -873,7 +873,6 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
     free_slots_.push_back(s);
     --slots_alive_;
   }
-  slots_by_key_.erase(key);
   // Its marginal on the separator becomes a fixed linear prior (first-estimate
   // Jacobians), owned by the parent, which consumed it when it was eliminated.
   if (parent >= 0 && cl.marginal.rows() > 0) {
@@ -893,7 +892,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   clique_alive_[static_cast<std::size_t>(c)] = false;
   free_cliques_.push_back(c);
   --cliques_alive_;
-  vars_.erase(vit);
+  vars_.erase(key);
 }
 
 }  // namespace gssm::internal

@@ -19,6 +19,7 @@
 
 #include "gssm/factors/factors.h"
 #include "solvers/small_int_list.h"
+#include "solvers/var_table.h"
 
 namespace gssm {
 class Model;
@@ -73,7 +74,7 @@ struct LinearFactor {
     r = -b();
     Eigen::Index col = 0;
     for (const auto& k : keys()) {
-      const Eigen::VectorXd& d = delta(k);
+      const auto& d = delta(k);  // a vector or a map of one
       term.noalias() = Ab.middleCols(col, d.size()) * d;  // the product, then the sum
       r += term;
       col += d.size();
@@ -228,7 +229,7 @@ class BayesTreeEngine {
   /// separator becomes a fixed linear factor (exact marginalization).
   void marginalizeLeaf(const Key& key);
 
-  bool hasVariable(const Key& k) const { return vars_.count(k) != 0; }
+  bool hasVariable(const Key& k) const { return vars_.contains(k); }
   std::size_t numVariables() const { return vars_.size(); }
   std::size_t numFactors() const { return slots_alive_; }
   std::size_t numCliques() const { return cliques_alive_; }
@@ -278,11 +279,7 @@ class BayesTreeEngine {
   std::string invariantViolation() const;
 
  private:
-  struct Var {
-    Eigen::VectorXd anchor, delta;
-    int clique = -1;
-    std::int64_t rank = 0;  // elimination rank: larger = closer to the root
-  };
+  using Var = EngineVar;
   struct Slot {
     FactorPtr nonlinear;  // null: a fixed linear factor
     LinearFactor linear;
@@ -304,18 +301,17 @@ class BayesTreeEngine {
   void backSubstitute(int c);
   int allocClique();
   int allocSlot();
-  /// Lists slot s under each of its states' keys (slots_by_key_).
+  /// Lists slot s under each of its states (Var::slots).
   void indexSlot(int s);
 
   OrderingMode mode_;
   double wildfire_;
-  std::unordered_map<Key, Var, KeyHash> vars_;
+  VarTable vars_;  // each state lists the factor slots on it
   std::vector<Clique> cliques_;
   std::vector<bool> clique_alive_;
   std::vector<int> free_cliques_;
   std::vector<Slot> slots_;
   std::vector<int> free_slots_;
-  std::unordered_map<Key, SmallIntList, KeyHash> slots_by_key_;  // non-constant keys only
   std::size_t slots_alive_ = 0, cliques_alive_ = 0;
   std::int64_t next_rank_ = 0;
   int root_ = -1;

@@ -48,17 +48,17 @@ void BayesTreeEngine::save(ByteWriter& out) const {
   out.u64(vars_.size());
   // In key order, so the same state always gives the same bytes.
   std::vector<Key> keys;
-  for (const auto& kv : vars_) keys.push_back(kv.first);
+  vars_.forEach([&](const Key& k, const Var&) { keys.push_back(k); });
   std::sort(keys.begin(), keys.end());
   for (const auto& k : keys) {
     const Var& v = vars_.at(k);
     out.key(k);
-    out.vec(v.anchor);
-    out.vec(v.delta);
+    out.vec(v.anchor());
+    out.vec(v.delta());
     out.i32(v.clique);
     out.i64(v.rank);
   }
-  auto dimOf = [&](const Key& k) { return vars_.at(k).anchor.size(); };
+  auto dimOf = [&](const Key& k) { return vars_.at(k).dim(); };
   out.u64(slots_.size());
   for (const auto& s : slots_) {
     out.boolean(s.alive);
@@ -85,13 +85,14 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     out.ints(cl.children.toVector());
   }
   out.ints(free_cliques_);
+  // The slot index: the states with factors on them, in key order.
   std::vector<Key> indexed;
-  for (const auto& kv : slots_by_key_) indexed.push_back(kv.first);
-  std::sort(indexed.begin(), indexed.end());
+  for (const auto& k : keys)
+    if (!k.isConstants() && !vars_.at(k).slots.empty()) indexed.push_back(k);
   out.u64(indexed.size());
   for (const auto& k : indexed) {
     out.key(k);
-    out.ints(slots_by_key_.at(k).toVector());
+    out.ints(vars_.at(k).slots.toVector());
   }
   out.i64(next_rank_);
   out.i32(root_);
@@ -108,16 +109,17 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
   for (std::size_t i = 0; i < nvars; ++i) {
     const Key k = in.key("engine variable key");
     const std::string name = "variable " + k.toString();
-    if (e.vars_.count(k)) in.fail(name + " appears twice");
-    Var v;
-    v.anchor = in.vec(name + " anchor");
-    v.delta = in.vec(name + " delta");
-    if (v.anchor.size() != variableDim(model, k) || v.delta.size() != v.anchor.size())
-      in.fail(name + " has size " + std::to_string(v.anchor.size()) + " but the model's is " +
+    if (e.vars_.contains(k)) in.fail(name + " appears twice");
+    const Eigen::VectorXd anchor = in.vec(name + " anchor");
+    const Eigen::VectorXd delta = in.vec(name + " delta");
+    if (anchor.size() != variableDim(model, k) || delta.size() != anchor.size())
+      in.fail(name + " has size " + std::to_string(anchor.size()) + " but the model's is " +
               std::to_string(variableDim(model, k)));
+    Var v(anchor);
+    v.delta() = delta;
     v.clique = in.i32((name + " clique").c_str());
     v.rank = in.i64((name + " rank").c_str());
-    e.vars_[k] = std::move(v);
+    e.vars_.insert(k, std::move(v));
   }
   e.slots_.resize(in.count("engine factor slots", 1));
   for (std::size_t s = 0; s < e.slots_.size(); ++s) {
@@ -170,11 +172,14 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
   }
   e.free_cliques_ = in.ints("engine free cliques");
   const std::size_t nindexed = in.count("engine slot index", 9 + 8);
+  std::unordered_set<Key, KeyHash> indexed;
   for (std::size_t i = 0; i < nindexed; ++i) {
     const Key k = in.key("slot index key");
-    if (k.isConstants() || e.slots_by_key_.count(k)) in.fail("slot index: " + k.toString() + " not allowed or twice");
+    Var* v = k.isConstants() ? nullptr : e.vars_.find(k);
+    if (!v || indexed.count(k)) in.fail("slot index: " + k.toString() + " is not a state variable or appears twice");
+    indexed.insert(k);
     const std::vector<int> slots = in.ints("slots of " + k.toString());
-    e.slots_by_key_[k].assign(slots.begin(), slots.end());
+    v->slots.assign(slots.begin(), slots.end());
   }
   e.next_rank_ = in.i64("engine next rank");
   e.root_ = in.i32("engine root");
@@ -188,8 +193,8 @@ std::string BayesTreeEngine::invariantViolation() const {
   auto aliveClique = [&](int c) { return c >= 0 && c < nc && clique_alive_[static_cast<std::size_t>(c)]; };
   auto aliveSlot = [&](int s) { return s >= 0 && s < ns && slots_[static_cast<std::size_t>(s)].alive; };
   auto dim = [&](const Key& k) -> Eigen::Index {
-    auto it = vars_.find(k);
-    return it == vars_.end() ? -1 : it->second.anchor.size();
+    const Var* v = vars_.find(k);
+    return v ? v->dim() : -1;
   };
   auto linearOk = [&](const LinearFactor& f, const std::string& what) -> std::string {
     Eigen::Index width = 0;
@@ -202,14 +207,18 @@ std::string BayesTreeEngine::invariantViolation() const {
   };
   if (clique_alive_.size() != cliques_.size()) return "clique flags and cliques differ in number";
   std::size_t alive_slots = 0, alive_cliques = 0;
-  for (const auto& kv : vars_) {
-    const Var& v = kv.second;
-    if (v.anchor.size() == 0 || v.delta.size() != v.anchor.size()) return kv.first.toString() + " has an empty or mismatched value";
-    if (!aliveClique(v.clique)) return kv.first.toString() + " points to no live clique";
-    if (cliques_[static_cast<std::size_t>(v.clique)].frontal != kv.first)
-      return kv.first.toString() + "'s clique has another frontal variable";
-    if (v.rank < 0 || v.rank >= next_rank_) return kv.first.toString() + " has an elimination rank out of range";
-  }
+  std::string var_problem;
+  vars_.forEach([&](const Key& k, const Var& v) {
+    if (!var_problem.empty()) return;
+    if (!aliveClique(v.clique)) var_problem = k.toString() + " points to no live clique";
+    else if (cliques_[static_cast<std::size_t>(v.clique)].frontal != k)
+      var_problem = k.toString() + "'s clique has another frontal variable";
+    else if (v.rank < 0 || v.rank >= next_rank_) var_problem = k.toString() + " has an elimination rank out of range";
+    else
+      for (int s : v.slots)
+        if (s < 0 || s >= ns) var_problem = "slot index of " + k.toString() + " is out of range";
+  });
+  if (!var_problem.empty()) return var_problem;
   for (int s = 0; s < ns; ++s) {
     const Slot& slot = slots_[static_cast<std::size_t>(s)];
     if (!slot.alive) continue;
@@ -229,9 +238,6 @@ std::string BayesTreeEngine::invariantViolation() const {
     if (s < 0 || s >= ns || slots_[static_cast<std::size_t>(s)].alive || !free_seen.insert(s).second)
       return "free slot " + std::to_string(s) + " is out of range, alive or listed twice";
   if (free_seen.size() + alive_slots != slots_.size()) return "a dead factor slot is not on the free list";
-  for (const auto& kv : slots_by_key_)
-    for (int s : kv.second)
-      if (s < 0 || s >= ns) return "slot index of " + kv.first.toString() + " is out of range";
   for (int c = 0; c < nc; ++c) {
     if (!clique_alive_[static_cast<std::size_t>(c)]) continue;
     ++alive_cliques;

@@ -1,0 +1,155 @@
+#pragma once
+// Internal: the variables of the Bayes tree engine, by key. A run adds the
+// states step after step and a fixed lag removes the oldest, so states live
+// in an array indexed by step (a hash map spent ~170 bytes a step on nodes,
+// buckets and an index map beside it: a tenth of a full-history run's
+// memory); the constants apart; a state far from the others (a user's graph
+// may skip steps) in a hash map, so no gap is ever filled.
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "gssm/core/key.h"
+#include "solvers/small_int_list.h"
+
+namespace gssm::internal {
+
+/// One variable: x = anchor + δ (anchor and δ in one heap block), the clique
+/// it is the frontal variable of, its elimination rank and, for a state,
+/// the factor slots on it.
+class EngineVar {
+ public:
+  EngineVar() = default;
+  /// anchor = x0, δ = 0.
+  explicit EngineVar(const Eigen::VectorXd& x0) : values_(new double[2 * x0.size()]), dim_(x0.size()) {
+    anchor() = x0;
+    delta().setZero();
+  }
+  EngineVar(const EngineVar& o)
+      : values_(o.dim_ ? new double[2 * o.dim_] : nullptr),
+        dim_(o.dim_),
+        clique(o.clique),
+        rank(o.rank),
+        slots(o.slots) {
+    std::copy(o.values_.get(), o.values_.get() + 2 * o.dim_, values_.get());
+  }
+  EngineVar& operator=(const EngineVar& o) {
+    if (this != &o) *this = EngineVar(o);
+    return *this;
+  }
+  EngineVar(EngineVar&& o) noexcept = default;
+  EngineVar& operator=(EngineVar&& o) noexcept = default;
+
+  /// 0 for an empty entry (no variable).
+  Eigen::Index dim() const { return dim_; }
+  Eigen::Map<Eigen::VectorXd> anchor() { return {values_.get(), dim_}; }
+  Eigen::Map<const Eigen::VectorXd> anchor() const { return {values_.get(), dim_}; }
+  Eigen::Map<Eigen::VectorXd> delta() { return {values_.get() + dim_, dim_}; }
+  Eigen::Map<const Eigen::VectorXd> delta() const { return {values_.get() + dim_, dim_}; }
+  /// anchor + δ.
+  Eigen::VectorXd estimate() const { return anchor() + delta(); }
+
+ private:
+  std::unique_ptr<double[]> values_;  // [anchor; δ]
+  Eigen::Index dim_ = 0;
+
+ public:
+  int clique = -1;
+  std::int64_t rank = 0;  // elimination rank: larger = closer to the root
+  SmallIntList slots;     // factor slots on this state (none kept for the constants)
+};
+
+class VarTable {
+ public:
+  EngineVar* find(const Key& k) { return const_cast<EngineVar*>(static_cast<const VarTable*>(this)->find(k)); }
+  const EngineVar* find(const Key& k) const {
+    if (k == Key::constants()) return constants_.dim() ? &constants_ : nullptr;
+    if (!k.isConstants() && k.step >= first_ && k.step - first_ < static_cast<std::int64_t>(states_.size())) {
+      const EngineVar& v = states_[static_cast<std::size_t>(k.step - first_)];
+      if (v.dim()) return &v;
+    }
+    if (far_.empty()) return nullptr;
+    const auto it = far_.find(k);
+    return it == far_.end() ? nullptr : &it->second;
+  }
+  bool contains(const Key& k) const { return find(k) != nullptr; }
+  EngineVar& at(const Key& k) { return const_cast<EngineVar&>(static_cast<const VarTable*>(this)->at(k)); }
+  const EngineVar& at(const Key& k) const {
+    const EngineVar* v = find(k);
+    if (!v) throw std::out_of_range("no engine variable " + k.toString());
+    return *v;
+  }
+  std::size_t size() const { return size_; }
+
+  /// Adds k, which must be absent, with a non-empty value.
+  EngineVar& insert(const Key& k, EngineVar v) {
+    if (contains(k) || v.dim() == 0) throw std::logic_error("VarTable: " + k.toString() + " present or empty");
+    ++size_;
+    if (k == Key::constants()) return constants_ = std::move(v);
+    if (!k.isConstants()) {
+      const auto n = static_cast<std::int64_t>(states_.size());
+      const std::int64_t reach = std::max<std::int64_t>(kGap, n);  // gaps up to this are filled
+      if (n == 0) {
+        first_ = k.step;
+        states_.emplace_back();
+      } else if (k.step >= first_ + n && k.step - (first_ + n) <= reach) {
+        states_.resize(static_cast<std::size_t>(k.step - first_ + 1));
+      } else if (k.step < first_ && first_ - k.step <= reach) {
+        for (std::int64_t s = first_; s > k.step; --s) states_.emplace_front();
+        first_ = k.step;
+      }
+      if (k.step >= first_ && k.step - first_ < static_cast<std::int64_t>(states_.size()))
+        return states_[static_cast<std::size_t>(k.step - first_)] = std::move(v);
+    }
+    return far_[k] = std::move(v);
+  }
+
+  /// Removes k if present (a state at either end of the array shrinks it).
+  void erase(const Key& k) {
+    EngineVar* v = find(k);
+    if (!v) return;
+    --size_;
+    if (v == &constants_) {
+      constants_ = EngineVar();
+      return;
+    }
+    if (!far_.empty() && far_.erase(k)) return;
+    *v = EngineVar();
+    while (!states_.empty() && !states_.front().dim()) {
+      states_.pop_front();
+      ++first_;
+    }
+    while (!states_.empty() && !states_.back().dim()) states_.pop_back();
+  }
+
+  /// f(key, var) for every variable: states of the array by step, then the
+  /// far ones, then the constants.
+  template <class F>
+  void forEach(F&& f) const {
+    for (std::size_t i = 0; i < states_.size(); ++i)
+      if (states_[i].dim()) f(Key::state(first_ + static_cast<std::int64_t>(i)), states_[i]);
+    for (const auto& kv : far_) f(kv.first, kv.second);
+    if (constants_.dim()) f(Key::constants(), constants_);
+  }
+  template <class F>
+  void forEach(F&& f) {
+    for (std::size_t i = 0; i < states_.size(); ++i)
+      if (states_[i].dim()) f(Key::state(first_ + static_cast<std::int64_t>(i)), states_[i]);
+    for (auto& kv : far_) f(kv.first, kv.second);
+    if (constants_.dim()) f(Key::constants(), constants_);
+  }
+
+ private:
+  static constexpr std::int64_t kGap = 1024;
+  std::deque<EngineVar> states_;  // step first_ + i; dim() == 0: no variable
+  std::int64_t first_ = 0;
+  std::unordered_map<Key, EngineVar, KeyHash> far_;
+  EngineVar constants_;
+  std::size_t size_ = 0;
+};
+
+}  // namespace gssm::internal
