@@ -4,6 +4,7 @@
 
 #include "gssm/core/angles.h"
 #include "gssm/core/error.h"
+#include "factors/model_factors.h"
 
 namespace gssm {
 
@@ -16,12 +17,6 @@ std::vector<Key> withConstants(const Model& m, std::initializer_list<Key> states
   keys.insert(keys.end(), states);
   if (m.dims().nb > 0) keys.push_back(Key::constants());
   return keys;
-}
-// x_b of a model factor whose keys end with the constants (at `index`), or
-// an empty vector for a model without constants.
-const Eigen::VectorXd& constantsOrEmpty(const Factor& f, const Eigen::VectorXd* const* x, std::size_t index) {
-  static const Eigen::VectorXd kEmpty;
-  return f.keys().size() > index ? *x[index] : kEmpty;
 }
 }  // namespace
 
@@ -51,14 +46,18 @@ double Factor::linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::VectorX
   return robustify(r, J);
 }
 
-double Factor::robustify(Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const {
+double internal::robustify(const RobustLoss& loss, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) {
   const double s = r.squaredNorm();
-  if (!loss_.robust()) return 0.5 * s;
-  const double w = std::sqrt(loss_.weight(s));
+  if (!loss.robust()) return 0.5 * s;
+  const double w = std::sqrt(loss.weight(s));
   r *= w;
   if (J)
     for (auto& block : *J) block *= w;
-  return 0.5 * loss_.rho(s);
+  return 0.5 * loss.rho(s);
+}
+
+double Factor::robustify(Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J) const {
+  return internal::robustify(loss_, r, J);
 }
 
 double Factor::cost(const Values& x) const {
@@ -110,41 +109,59 @@ std::string PriorFactor::describe() const { return "prior on " + keys()[0].toStr
 // ---- ProcessFactor -----------------------------------------------------------
 ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u,
                              double dt)
+    : ProcessFactor(model, k, u, dt,
+                    model.processNoiseDependsOnInput()
+                        ? GaussianNoise(model.processNoiseOf(dt, u), "process noise of step " + std::to_string(k))
+                        : model.processNoiseModel(dt, k)) {}
+
+ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt,
+                             const GaussianNoise& noise)
     : Factor(withConstants(model, {Key::state(k), Key::state(k + 1)}), model.dims().nc),
       model_(&model),
       u_(u),
       dt_(dt),
-      noise_(model.processNoiseDependsOnInput()
-                 ? GaussianNoise(model.processNoiseOf(dt, u), "process noise of step " + std::to_string(k))
-                 : model.processNoiseModel(dt, k)) {
+      noise_(noise) {
   if (!(dt > 0) || !std::isfinite(dt))
     throw InvalidArgument("process factor x_c(" + std::to_string(k) + ") -> x_c(" +
                           std::to_string(k + 1) + "): time step must be > 0, got " +
                           std::to_string(dt));
   requireVector(u, model.dims().nu, "input u at step " + std::to_string(k));
+  if (noise.dim() != model.dims().nc)
+    throw InvalidArgument("process factor x_c(" + std::to_string(k) + ") -> x_c(" + std::to_string(k + 1) +
+                          "): its noise covariance is " + std::to_string(noise.dim()) + " x " +
+                          std::to_string(noise.dim()) + ", the state has " + std::to_string(model.dims().nc) +
+                          " components");
+}
+
+void internal::processResidual(const Model& model, const Eigen::VectorXd& u, double dt, const GaussianNoise& noise,
+                               const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                               std::vector<Eigen::MatrixXd>* J) {
+  static const Eigen::VectorXd kNoConstants;
+  const bool has_constants = model.dims().nb > 0;
+  const Eigen::VectorXd& xk = *x[0];
+  const Eigen::VectorXd& xk1 = *x[1];
+  const Eigen::VectorXd& xb = has_constants ? *x[2] : kNoConstants;
+  // The model writes its Jacobians straight into the caller's blocks (which a
+  // solver reuses from factor to factor): no allocation per linearization.
+  Eigen::MatrixXd no_constants;  // J_f_xb of a model without constants (n_b = 0: empty)
+  if (J) J->resize(has_constants ? 3 : 2);
+  Eigen::MatrixXd* J_f_xc = J ? &(*J)[0] : nullptr;
+  Eigen::MatrixXd* J_f_xb = J ? (has_constants ? &(*J)[2] : &no_constants) : nullptr;
+  r = xk1 - model.f(xk, xb, u, dt, J_f_xc, J_f_xb);
+  wrapAngles(r, model.angleStates());  // stacked indices below n_c are x_c's
+  noise.whitenInPlace(r);
+  if (J) {
+    const int nc = model.dims().nc;
+    (*J)[0] *= -1.0;
+    (*J)[1].setIdentity(nc, nc);
+    if (has_constants) (*J)[2] *= -1.0;
+    for (auto& block : *J) noise.whitenInPlace(block);
+  }
 }
 
 void ProcessFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                                 std::vector<Eigen::MatrixXd>* J) const {
-  const Eigen::VectorXd& xk = *x[0];
-  const Eigen::VectorXd& xk1 = *x[1];
-  const Eigen::VectorXd& xb = constantsOrEmpty(*this, x, 2);
-  // The model writes its Jacobians straight into the caller's blocks (which a
-  // solver reuses from factor to factor): no allocation per linearization.
-  Eigen::MatrixXd no_constants;  // J_f_xb of a model without constants (n_b = 0: empty)
-  if (J) J->resize(keys().size());
-  Eigen::MatrixXd* J_f_xc = J ? &(*J)[0] : nullptr;
-  Eigen::MatrixXd* J_f_xb = J ? (keys().size() == 3 ? &(*J)[2] : &no_constants) : nullptr;
-  r = xk1 - model_->f(xk, xb, u_, dt_, J_f_xc, J_f_xb);
-  wrapAngles(r, model_->angleStates());  // stacked indices below n_c are x_c's
-  noise_.whitenInPlace(r);
-  if (J) {
-    const int nc = model_->dims().nc;
-    (*J)[0] *= -1.0;
-    (*J)[1].setIdentity(nc, nc);
-    if (keys().size() == 3) (*J)[2] *= -1.0;
-    for (auto& block : *J) noise_.whitenInPlace(block);
-  }
+  internal::processResidual(*model_, u_, dt_, noise_, x, r, J);
 }
 
 std::string ProcessFactor::describe() const {
@@ -182,19 +199,27 @@ MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const E
                           std::to_string(noise.dim()) + ", the channel has " + std::to_string(ch.dim()) + " components");
 }
 
+void internal::measurementResidual(const Model& model, int channel, const Eigen::Ref<const Eigen::VectorXd>& y,
+                                   const GaussianNoise& noise, const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                                   std::vector<Eigen::MatrixXd>* J) {
+  static const Eigen::VectorXd kNoConstants;
+  const bool has_constants = model.dims().nb > 0;
+  const Eigen::VectorXd& xc = *x[0];
+  const Eigen::VectorXd& xb = has_constants ? *x[1] : kNoConstants;
+  Eigen::MatrixXd no_constants;  // as in processResidual
+  if (J) J->resize(has_constants ? 2 : 1);
+  Eigen::MatrixXd* J_h_xc = J ? &(*J)[0] : nullptr;
+  Eigen::MatrixXd* J_h_xb = J ? (has_constants ? &(*J)[1] : &no_constants) : nullptr;
+  r = model.h(channel, xc, xb, J_h_xc, J_h_xb) - y;
+  wrapAngles(r, model.channel(channel).angles);
+  noise.whitenInPlace(r);
+  if (J)
+    for (auto& block : *J) noise.whitenInPlace(block);
+}
+
 void MeasurementFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                                     std::vector<Eigen::MatrixXd>* J) const {
-  const Eigen::VectorXd& xc = *x[0];
-  const Eigen::VectorXd& xb = constantsOrEmpty(*this, x, 1);
-  Eigen::MatrixXd no_constants;  // as in ProcessFactor::linearizeAt
-  if (J) J->resize(keys().size());
-  Eigen::MatrixXd* J_h_xc = J ? &(*J)[0] : nullptr;
-  Eigen::MatrixXd* J_h_xb = J ? (keys().size() == 2 ? &(*J)[1] : &no_constants) : nullptr;
-  r = model_->h(channel_, xc, xb, J_h_xc, J_h_xb) - y_;
-  wrapAngles(r, model_->channel(channel_).angles);
-  noise_.whitenInPlace(r);
-  if (J)
-    for (auto& block : *J) noise_.whitenInPlace(block);
+  internal::measurementResidual(*model_, channel_, y_, noise_, x, r, J);
 }
 
 std::string MeasurementFactor::describe() const {

@@ -146,36 +146,47 @@ Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {
   return v->estimate();
 }
 
-// Linearizes f at the current estimate: r(x) ≈ r(x̂) + J (δ − δ̂), i.e.
-// A = J, b = J δ̂ − r(x̂). `extra` holds initial values of variables being added.
-LinearFactor BayesTreeEngine::linearize(const Factor& f, const Values& extra) const {
-  Values& x = scratch_.x;  // see linearizationError
-  if (x.size() > 64) x = Values();
-  std::vector<const Var*>& known = scratch_.factor_vars;  // null: a new variable (δ̂ = 0)
+template <class Keys>
+void BayesTreeEngine::pointAt(const Keys& keys, const Values* extra) const {
+  std::vector<Eigen::VectorXd>& points = scratch_.points;
+  std::vector<const Eigen::VectorXd*>& x = scratch_.x;
+  std::vector<const Var*>& known = scratch_.factor_vars;
+  if (points.size() < keys.size()) points.resize(keys.size());  // before any address is taken
+  x.clear();
   known.clear();
-  for (const auto& k : f.keys()) {
+  std::size_t i = 0;
+  for (const auto& k : keys) {
     const Var* v = vars_.find(k);
     known.push_back(v);
     if (v) {
-      pointEntry(x, k, v->dim()) = v->anchor() + v->delta();
+      points[i] = v->anchor() + v->delta();
+      x.push_back(&points[i]);
     } else {
-      const Eigen::VectorXd& value = extra.at(k);
-      pointEntry(x, k, value.size()) = value;
+      x.push_back(&extra->at(k));
     }
+    ++i;
   }
+}
+
+// Linearizes f at the current estimate: r(x) ≈ r(x̂) + J (δ − δ̂), i.e.
+// A = J, b = J δ̂ − r(x̂). `extra` holds initial values of variables being added.
+template <class Keys>
+LinearFactor BayesTreeEngine::linearize(const SlotFactor& f, const Keys& keys, const Values& extra) const {
+  pointAt(keys, &extra);
+  const std::vector<const Var*>& known = scratch_.factor_vars;  // null: a new variable (δ̂ = 0)
   LinearFactor lf;
   if (!pool_.spare_linear.empty()) {  // its vectors and matrices get overwritten (same shapes: no allocation)
     lf = std::move(pool_.spare_linear.back());
     pool_.spare_linear.pop_back();
   }
-  lf.shareKeys(f);
+  lf.setKeys(keys);
   Eigen::VectorXd& r = scratch_.r;
   std::vector<Eigen::MatrixXd>& J = scratch_.J;
-  f.linearizeRobust(x, r, &J);  // robust factors reweighted at each linearization
+  f.linearizeRobustAt(scratch_.x.data(), r, &J);  // robust factors reweighted at each linearization
   bool finite = r.allFinite();
   for (const auto& a : J) finite = finite && a.allFinite();
   if (!finite)
-    throw NumericalError("factor '" + f.describe() +
+    throw NumericalError("factor '" + f.toFactor(keys)->describe() +
                          "' has a non-finite residual or Jacobian at the current estimate");
   lf.setBlocks(J, r.size());
   auto b = lf.Ab.col(lf.Ab.cols() - 1);
@@ -247,6 +258,7 @@ struct BayesTreeEngine::UpdatePlan {
         new_variables(u.new_variables ? *u.new_variables : none),
         new_factors(u.new_factors ? *u.new_factors : no_factors),
         new_linear(u.new_linear ? *u.new_linear : no_linear),
+        held_new(l.held_new),
         linearized_new(l.linearized_new),
         removed_order(l.removed_order),
         orphans(l.orphans),
@@ -270,6 +282,7 @@ struct BayesTreeEngine::UpdatePlan {
   std::unordered_map<int, LinearFactor> relinearized;  // by slot (linearizeInputs)
   // The rest lives in the engine's UpdateLists, emptied here, so that its
   // vectors keep their capacity from update to update.
+  std::vector<SlotFactor>& held_new;
   std::vector<LinearFactor>& linearized_new;
   std::vector<int>& removed_order;
   std::vector<int>& orphans;
@@ -308,14 +321,15 @@ void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
       if (!known(k))
         throw InvalidArgument("factor '" + f->describe() + "' uses " + k.toString() +
                               ", which is neither in the smoother nor added with it");
-    p.linearized_new.push_back(linearize(*f, p.new_variables));
+    p.held_new.emplace_back(f);
+    p.linearized_new.push_back(linearize(p.held_new.back(), f->keys(), p.new_variables));
   }
   for (const auto& lf : p.new_linear)
     for (const auto& k : lf.keys())
       if (!known(k)) throw InvalidArgument("linear factor uses unknown variable " + k.toString());
   for (int s : p.update.relinearize) {
     const Slot& slot = slots_.at(static_cast<std::size_t>(s));
-    if (slot.alive && slot.nonlinear) p.relinearized[s] = linearize(*slot.nonlinear, p.new_variables);
+    if (slot.alive && slot.nonlinear) p.relinearized[s] = linearize(slot.nonlinear, slot.linear.keys(), p.new_variables);
   }
 }
 
@@ -544,13 +558,13 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   new_lin_slot_of.assign(p.new_linear.size(), -1);
   for (std::size_t i = 0; i < p.linearized_new.size(); ++i) {
     const int s = allocSlot();
-    slots_[static_cast<std::size_t>(s)] = Slot{p.new_factors[i], std::move(p.linearized_new[i]), -1, true};
+    slots_[static_cast<std::size_t>(s)] = Slot{std::move(p.held_new[i]), std::move(p.linearized_new[i]), -1, true};
     new_slot_of[i] = s;
     indexSlot(s);
   }
   for (std::size_t i = 0; i < p.new_linear.size(); ++i) {
     const int s = allocSlot();
-    slots_[static_cast<std::size_t>(s)] = Slot{nullptr, p.new_linear[i], -1, true};
+    slots_[static_cast<std::size_t>(s)] = Slot{SlotFactor(), p.new_linear[i], -1, true};
     new_lin_slot_of[i] = s;
     indexSlot(s);
   }
@@ -786,16 +800,10 @@ double BayesTreeEngine::linearizationError(int slot) const {
   const Slot& s = slots_.at(static_cast<std::size_t>(slot));
   if (!s.nonlinear) return 0.0;
   Scratch& e = scratch_;
-  if (e.x.size() > 64) e.x = Values();
-  // r_lin(δ̂), filling the point x̂ = anchor + δ̂ on the way (one lookup per key).
-  s.linear.residual(
-      [&](const Key& k) {
-        const Var& v = vars_.at(k);
-        pointEntry(e.x, k, v.dim()) = v.anchor() + v.delta();
-        return v.delta();
-      },
-      e.rlin, e.term);
-  s.nonlinear->linearizeRobust(e.x, e.r, nullptr);  // a moved weight is a linearization error too
+  pointAt(s.linear.keys(), nullptr);  // x̂ = anchor + δ̂
+  std::size_t i = 0;
+  s.linear.residual([&](const Key&) { return e.factor_vars[i++]->delta(); }, e.rlin, e.term);  // r_lin(δ̂)
+  s.nonlinear.linearizeRobustAt(e.x.data(), e.r, nullptr);  // a moved weight is a linearization error too
   return (e.r - e.rlin).norm();
 }
 
@@ -820,9 +828,8 @@ double BayesTreeEngine::cost() const {
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
-      Values x;
-      for (const auto& k : s.linear.keys()) x.insert(k, vars_.at(k).estimate());
-      c += s.nonlinear->cost(x);
+      pointAt(s.linear.keys(), nullptr);
+      c += s.nonlinear.linearizeRobustAt(scratch_.x.data(), r, nullptr);  // ½ρ(‖r‖²)
     } else {
       s.linear.residual(deltaOf, r, term);
       c += 0.5 * r.squaredNorm();
@@ -839,12 +846,13 @@ void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
-      s.nonlinear->linearizeRobust(x, r, &J);
-      const Eigen::MatrixXd C = residualCurvature(*s.nonlinear, x, r);
-      sys.add(s.nonlinear->keys(), r, J, &C);
+      const FactorPtr f = s.nonlinear.toFactor(s.linear.keys());
+      f->linearizeRobust(x, r, &J);
+      const Eigen::MatrixXd C = residualCurvature(*f, x, r);
+      sys.add(f->keys(), r, J, &C);
     } else {  // r = Σ A δ − b in δ coordinates: J = A, no curvature
       s.linear.residual(deltaOf, r, term);
-      sys.add(s.linear.keys(), r, s.linear.blocks(dimOf), nullptr);
+      sys.add(s.linear.keys().toVector(), r, s.linear.blocks(dimOf), nullptr);
     }
   }
 }
@@ -877,7 +885,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   // Jacobians), owned by the parent, which consumed it when it was eliminated.
   if (parent >= 0 && cl.marginal.rows() > 0) {
     const int s = allocSlot();
-    slots_[static_cast<std::size_t>(s)] = Slot{nullptr, std::move(cl.marginal), parent, true};
+    slots_[static_cast<std::size_t>(s)] = Slot{SlotFactor(), std::move(cl.marginal), parent, true};
     indexSlot(s);
     cliques_[static_cast<std::size_t>(parent)].owned.push_back(s);
   }

@@ -18,7 +18,8 @@
 #include <vector>
 
 #include "gssm/factors/factors.h"
-#include "solvers/small_int_list.h"
+#include "solvers/slot_factor.h"
+#include "solvers/small_list.h"
 #include "solvers/var_table.h"
 
 namespace gssm {
@@ -26,6 +27,10 @@ class Model;
 }
 
 namespace gssm::internal {
+
+/// A linear factor's or a clique's separator's keys: a model factor has at
+/// most three (x_c(k), x_c(k+1), x_b), a chain's separator two, held inline.
+using KeyList = SmallList<Key, 3>;
 
 class ByteWriter;
 class ByteReader;
@@ -36,22 +41,13 @@ class NewtonSystem;
 /// variable. One heap block where separate ones took n + 2: a full-history
 /// run keeps one linear factor per factor and one per clique.
 struct LinearFactor {
-  /// Its variables: the linearized factor's own keys (not copied: a
-  /// full-history run keeps one linear factor per factor), or its own.
-  const std::vector<Key>& keys() const { return factor_keys ? *factor_keys : own_keys; }
-  /// Keys of its own (a marginal, a fixed linear factor), copied into the
-  /// storage it has (a pooled factor's: no allocation).
-  void setKeys(const std::vector<Key>& keys) {
-    own_keys.assign(keys.begin(), keys.end());
-    factor_keys = nullptr;
+  const KeyList& keys() const { return keys_; }
+  /// Sets its keys, in the storage it has (a pooled factor's: no allocation).
+  template <class Keys>
+  void setKeys(const Keys& keys) {
+    keys_.assign(keys.begin(), keys.end());
   }
-  /// The keys of `f`, which must outlive this (the slot holding both keeps f).
-  void shareKeys(const Factor& f) {
-    own_keys.clear();
-    factor_keys = &f.keys();
-  }
-  std::vector<Key> own_keys;
-  const std::vector<Key>* factor_keys = nullptr;
+  KeyList keys_;  // a model factor's three or fewer inline
   Eigen::MatrixXd Ab;
   Eigen::Index rows() const { return Ab.rows(); }
   auto b() const { return Ab.col(Ab.cols() - 1); }
@@ -102,7 +98,7 @@ struct Clique {
   /// What this subtree passes to its parent, on the separator; its keys are
   /// the separator (held once).
   LinearFactor marginal;
-  const std::vector<Key>& separator() const { return marginal.keys(); }
+  const KeyList& separator() const { return marginal.keys(); }
   SmallIntList owned;  // factor slots consumed by this clique's elimination
   int parent = -1;
   SmallIntList children;
@@ -143,6 +139,7 @@ void clearKeepingSmall(V& v) {
 // The lists one engine update fills (bayes_tree.cpp's UpdatePlan), kept by
 // the engine so their capacity carries over.
 struct UpdateLists {
+  std::vector<SlotFactor> held_new;                 // the new factors as their slots will hold them
   std::vector<LinearFactor> linearized_new;         // of the new factors, same order
   std::vector<int> removed_order;                   // cliques of the top, leaf to root
   std::vector<int> orphans;                         // subtrees hanging below the top
@@ -157,6 +154,7 @@ struct UpdateLists {
   std::vector<int> new_slot_of, new_lin_slot_of;    // the slot each new factor got
   /// Empties every list (clearKeepingSmall).
   void clear() {
+    clearKeepingSmall(held_new);
     clearKeepingSmall(linearized_new);
     clearKeepingSmall(removed_order);
     clearKeepingSmall(orphans);
@@ -259,7 +257,6 @@ class BayesTreeEngine {
   /// Appends the alive nonlinear slots whose keys include the state k to
   /// `out` (every factor touches the constants: that is nonlinearSlots()).
   void appendSlotsOf(const Key& k, std::vector<int>& out) const;
-  const FactorPtr& factorOf(int slot) const { return slots_[static_cast<std::size_t>(slot)].nonlinear; }
   /// ½‖r‖² of every alive factor at the current estimate (nonlinear factors
   /// exactly, linear ones by their linear model).
   double cost() const;
@@ -281,7 +278,7 @@ class BayesTreeEngine {
  private:
   using Var = EngineVar;
   struct Slot {
-    FactorPtr nonlinear;  // null: a fixed linear factor
+    SlotFactor nonlinear;  // none: a fixed linear factor
     LinearFactor linear;
     int owner = -1;
     bool alive = false;
@@ -294,7 +291,15 @@ class BayesTreeEngine {
   void commit(UpdatePlan& plan, EngineCounts& counts);
   void backSubstituteTop(const UpdatePlan& plan, EngineCounts& counts);
 
-  LinearFactor linearize(const Factor& f, const Values& extra) const;
+  /// f on `keys` linearized at the current estimate (`extra`: values of
+  /// variables being added).
+  template <class Keys>
+  LinearFactor linearize(const SlotFactor& f, const Keys& keys, const Values& extra) const;
+  /// Points scratch_.x at the estimate of each of `keys` (anchor + δ, or
+  /// extra's value of a variable being added); `known[i]` is keys[i]'s
+  /// variable, null if new.
+  template <class Keys>
+  void pointAt(const Keys& keys, const Values* extra) const;
   /// The elimination order of `keys` into `out`.
   void order(const std::vector<Key>& keys, const std::vector<const LinearFactor*>& factors,
              const Values& new_vars, std::vector<Key>& out) const;
@@ -319,11 +324,10 @@ class BayesTreeEngine {
   // linearizationError for every new or candidate factor, backSubstitute
   // for every touched clique, eliminateTop, solvePath), so
   // they allocate once, not per call. Not state: never saved or compared.
-  // x: variables at anchor + delta; stale keys are harmless (a factor reads
-  // its own) and dropped when the set outgrows a window.
   struct Scratch {
-    Values x;
-    std::vector<const Var*> factor_vars;  // linearize: a factor's variables, null if new
+    std::vector<Eigen::VectorXd> points;        // a factor's variables' estimates, by position
+    std::vector<const Eigen::VectorXd*> x;      // their addresses (or a new variable's initial value)
+    std::vector<const Var*> factor_vars;        // a factor's variables, null if new
     Eigen::VectorXd r, rlin, term;
     std::vector<double> product;  // backSubstitute's S·δ_sep, as long as the widest frontal
     std::vector<Eigen::MatrixXd> J;  // a factor's Jacobian blocks, copied into its Ab
@@ -350,7 +354,6 @@ class BayesTreeEngine {
       if (spare.size() < kMax) spare.push_back(std::move(c));
     }
     void keep(LinearFactor&& f) {
-      f.factor_keys = nullptr;  // its factor may go: nothing may point into it
       if (spare_linear.size() < kMax) spare_linear.push_back(std::move(f));
     }
   };

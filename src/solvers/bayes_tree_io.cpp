@@ -15,7 +15,7 @@ namespace gssm::internal {
 namespace {
 template <class Dim>
 void writeLinear(ByteWriter& out, const LinearFactor& f, Dim&& dim) {
-  out.keys(f.keys());
+  out.keys(f.keys().toVector());
   const std::vector<Eigen::MatrixXd> blocks = f.blocks(dim);
   out.u64(blocks.size());
   for (const auto& a : blocks) out.mat(a);
@@ -24,7 +24,7 @@ void writeLinear(ByteWriter& out, const LinearFactor& f, Dim&& dim) {
 LinearFactor readLinear(ByteReader& in, const Model& model, const std::string& what) {
   LinearFactor f;
   f.setKeys(in.keys(what + " keys"));
-  const std::vector<Key>& keys = f.keys();
+  const KeyList& keys = f.keys();
   const std::size_t n = in.count(what + " blocks", 16);
   if (n != keys.size())
     in.fail(what + ": " + std::to_string(n) + " blocks for " + std::to_string(keys.size()) + " keys");
@@ -63,8 +63,8 @@ void BayesTreeEngine::save(ByteWriter& out) const {
   for (const auto& s : slots_) {
     out.boolean(s.alive);
     if (!s.alive) continue;
-    out.boolean(s.nonlinear != nullptr);
-    if (s.nonlinear) writeFactor(out, *s.nonlinear);
+    out.boolean(static_cast<bool>(s.nonlinear));
+    if (s.nonlinear) writeFactor(out, *s.nonlinear.toFactor(s.linear.keys()));
     writeLinear(out, s.linear, dimOf);
     out.i32(s.owner);
   }
@@ -75,7 +75,7 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     if (!clique_alive_[c]) continue;
     const Clique& cl = cliques_[c];
     out.key(cl.frontal);
-    out.keys(cl.separator());
+    out.keys(cl.separator().toVector());
     out.mat(cl.R());
     out.mat(cl.S());
     out.vec(cl.d());
@@ -128,11 +128,12 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     slot.alive = in.boolean((name + " alive").c_str());
     if (!slot.alive) continue;
     ++e.slots_alive_;
-    if (in.boolean((name + " has a nonlinear factor").c_str())) slot.nonlinear = readFactor(in, model, name);
+    FactorPtr factor;
+    if (in.boolean((name + " has a nonlinear factor").c_str())) factor = readFactor(in, model, name);
     slot.linear = readLinear(in, model, name + " linearization");
-    if (slot.nonlinear) {  // the linearization shares its factor's keys, as in a running engine
-      if (slot.linear.keys() != slot.nonlinear->keys()) in.fail(name + ": its linearization does not match its factor");
-      slot.linear.shareKeys(*slot.nonlinear);
+    if (factor) {  // the slot holds it as a running engine does (a model's factor as its numbers)
+      if (slot.linear.keys() != factor->keys()) in.fail(name + ": its linearization does not match its factor");
+      slot.nonlinear = SlotFactor(factor);
     }
     slot.owner = in.i32((name + " owner").c_str());
   }
@@ -226,8 +227,7 @@ std::string BayesTreeEngine::invariantViolation() const {
     const std::string what = "factor slot " + std::to_string(s);
     const std::string lin = linearOk(slot.linear, what);
     if (!lin.empty()) return lin;
-    if (slot.nonlinear && (slot.nonlinear->keys() != slot.linear.keys() ||
-                           slot.nonlinear->dim() != slot.linear.rows()))
+    if (slot.nonlinear && slot.nonlinear.dim() != slot.linear.rows())
       return what + ": its linearization does not match its factor";
     if (!aliveClique(slot.owner)) return what + " is owned by no live clique";
     const auto& owned = cliques_[static_cast<std::size_t>(slot.owner)].owned;

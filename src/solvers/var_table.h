@@ -14,7 +14,7 @@
 #include <unordered_map>
 
 #include "gssm/core/key.h"
-#include "solvers/small_int_list.h"
+#include "solvers/small_list.h"
 
 namespace gssm::internal {
 
@@ -65,16 +65,14 @@ class EngineVar {
 
 class VarTable {
  public:
-  EngineVar* find(const Key& k) { return const_cast<EngineVar*>(static_cast<const VarTable*>(this)->find(k)); }
+  inline EngineVar* find(const Key& k) { return const_cast<EngineVar*>(static_cast<const VarTable*>(this)->find(k)); }
   const EngineVar* find(const Key& k) const {
     if (k == Key::constants()) return constants_.dim() ? &constants_ : nullptr;
     if (!k.isConstants() && k.step >= first_ && k.step - first_ < static_cast<std::int64_t>(states_.size())) {
       const EngineVar& v = states_[static_cast<std::size_t>(k.step - first_)];
       if (v.dim()) return &v;
     }
-    if (far_.empty()) return nullptr;
-    const auto it = far_.find(k);
-    return it == far_.end() ? nullptr : &it->second;
+    return far_.empty() ? nullptr : findFar(k);
   }
   bool contains(const Key& k) const { return find(k) != nullptr; }
   EngineVar& at(const Key& k) { return const_cast<EngineVar&>(static_cast<const VarTable*>(this)->at(k)); }
@@ -144,6 +142,11 @@ class VarTable {
   }
 
  private:
+  // Out of line: the inline lookup stays small enough to be inlined.
+  __attribute__((noinline)) const EngineVar* findFar(const Key& k) const {
+    const auto it = far_.find(k);
+    return it == far_.end() ? nullptr : &it->second;
+  }
   static constexpr std::int64_t kGap = 1024;
   std::deque<EngineVar> states_;  // step first_ + i; dim() == 0: no variable
   std::int64_t first_ = 0;

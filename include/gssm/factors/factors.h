@@ -81,11 +81,15 @@ class PriorFactor final : public Factor {
 class ProcessFactor final : public Factor {
  public:
   ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt);
+  /// With an explicit noise model (a solver that held the factor as its numbers).
+  ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt, const GaussianNoise& noise);
   void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                    std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   double dt() const { return dt_; }
   const Eigen::VectorXd& input() const { return u_; }
+  const GaussianNoise& noise() const { return noise_; }
+  const Model& model() const { return *model_; }
 
  private:
   const Model* model_;
@@ -111,6 +115,7 @@ class MeasurementFactor final : public Factor {
   const Eigen::VectorXd& measurement() const { return y_; }
   int channel() const { return channel_; }
   const GaussianNoise& noise() const { return noise_; }
+  const Model& model() const { return *model_; }
 
  private:
   const Model* model_;
