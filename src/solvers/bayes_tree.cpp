@@ -67,12 +67,6 @@ class KeyTable {
   std::size_t size_ = 0;
   std::unordered_map<Key, T, KeyHash> big_;
 };
-// x's vector for k, added with n components if absent: the engine fills a
-// scratch point key by key, in place once its entries exist.
-Eigen::VectorXd& pointEntry(Values& x, const Key& k, Eigen::Index n) {
-  if (!x.contains(k)) x.insert(k, Eigen::VectorXd(n));
-  return x.at(k);
-}
 // Householder triangularization of a clique's stacked system [A | b] in
 // place: the strict lower triangle is left holding reflector data (the
 // caller zeroes it). Eigen's unblocked algorithm (same reflectors: β = ∓‖x‖,

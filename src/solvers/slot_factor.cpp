@@ -1,29 +1,72 @@
 #include "solvers/slot_factor.h"
 
+#include <new>
+
 #include "factors/model_factors.h"
 
 namespace gssm::internal {
 
-SlotFactor::SlotFactor(const FactorPtr& f) {
+SlotFactor::SlotFactor(const FactorPtr& f) : SlotFactor() {
   if (!f) return;
   if (const auto* p = dynamic_cast<const ProcessFactor*>(f.get())) {
-    kind_ = Kind::Process;
     model_ = &p->model();
     noise_ = p->noise();
-    u_ = p->input();
-    const double dt = p->dt();
-    numbers_.assign(&dt, &dt + 1);
+    new (&step_) Step{p->dt(), p->input()};
+    kind_ = Kind::Process;
   } else if (const auto* m = dynamic_cast<const MeasurementFactor*>(f.get())) {
-    kind_ = Kind::Measurement;
     model_ = &m->model();
     noise_ = m->noise();
     channel_ = m->channel();
-    loss_ = m->loss();
-    numbers_.assign(m->measurement().data(), m->measurement().data() + m->measurement().size());
+    loss_kind_ = static_cast<std::uint8_t>(m->loss().kind);
+    loss_scale_ = m->loss().scale;
+    new (&y_) SmallList<double, 2>();
+    y_.assign(m->measurement().data(), m->measurement().data() + m->measurement().size());
+    kind_ = Kind::Measurement;
   } else {
+    new (&object_) FactorPtr(f);
     kind_ = Kind::Object;
-    object_ = f;
   }
+}
+
+void SlotFactor::reset() {
+  switch (kind_) {
+    case Kind::None: break;
+    case Kind::Object: object_.~FactorPtr(); break;
+    case Kind::Process: step_.~Step(); break;
+    case Kind::Measurement: y_.~SmallList(); break;
+  }
+  kind_ = Kind::None;
+}
+
+void SlotFactor::copyFrom(const SlotFactor& o) {
+  loss_kind_ = o.loss_kind_;
+  channel_ = o.channel_;
+  loss_scale_ = o.loss_scale_;
+  model_ = o.model_;
+  noise_ = o.noise_;
+  switch (o.kind_) {
+    case Kind::None: break;
+    case Kind::Object: new (&object_) FactorPtr(o.object_); break;
+    case Kind::Process: new (&step_) Step(o.step_); break;
+    case Kind::Measurement: new (&y_) SmallList<double, 2>(o.y_); break;
+  }
+  kind_ = o.kind_;
+}
+
+void SlotFactor::moveFrom(SlotFactor& o) {
+  loss_kind_ = o.loss_kind_;
+  channel_ = o.channel_;
+  loss_scale_ = o.loss_scale_;
+  model_ = o.model_;
+  noise_ = std::move(o.noise_);
+  switch (o.kind_) {
+    case Kind::None: break;
+    case Kind::Object: new (&object_) FactorPtr(std::move(o.object_)); break;
+    case Kind::Process: new (&step_) Step(std::move(o.step_)); break;
+    case Kind::Measurement: new (&y_) SmallList<double, 2>(std::move(o.y_)); break;
+  }
+  kind_ = o.kind_;
+  o.reset();
 }
 
 int SlotFactor::dim() const {
@@ -42,12 +85,12 @@ double SlotFactor::linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::Vec
     case Kind::None: break;
     case Kind::Object: return object_->linearizeRobustAt(x, r, J);
     case Kind::Process:
-      processResidual(*model_, u_, numbers_[0], noise_, x, r, J);
-      return robustify(loss_, r, J);
+      processResidual(*model_, step_.u, step_.dt, noise_, x, r, J);
+      return robustify(RobustLoss{}, r, J);  // a process factor has no loss
     case Kind::Measurement: {
-      const Eigen::Map<const Eigen::VectorXd> y(numbers_.begin(), static_cast<Eigen::Index>(numbers_.size()));
+      const Eigen::Map<const Eigen::VectorXd> y(y_.begin(), static_cast<Eigen::Index>(y_.size()));
       measurementResidual(*model_, channel_, y, noise_, x, r, J);
-      return robustify(loss_, r, J);
+      return robustify(loss(), r, J);
     }
   }
   r.resize(0);
@@ -58,9 +101,9 @@ FactorPtr SlotFactor::toFactor(const std::vector<Key>& keys) const {
   switch (kind_) {
     case Kind::None: break;
     case Kind::Object: return object_;
-    case Kind::Process: return std::make_shared<ProcessFactor>(*model_, keys.at(0).step, u_, numbers_[0], noise_);
+    case Kind::Process: return std::make_shared<ProcessFactor>(*model_, keys.at(0).step, step_.u, step_.dt, noise_);
     case Kind::Measurement: {
-      const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(numbers_.begin(), static_cast<Eigen::Index>(numbers_.size()));
+      const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(y_.begin(), static_cast<Eigen::Index>(y_.size()));
       return std::make_shared<MeasurementFactor>(*model_, keys.at(0).step, y, channel_, noise_);
     }
   }

@@ -1,12 +1,12 @@
 #pragma once
 // Internal: the nonlinear factor behind a factor slot of the Bayes tree
 // engine. A model's process and measurement factors — all but a handful of
-// a run's — are held as their numbers (model, noise, Δt and input, or
+// a run's — are held as their numbers (model, noise, loss, Δt and input, or
 // measurement and channel; the keys are the slot's linearization's) and
 // evaluated by the same code as ProcessFactor and MeasurementFactor
 // (factors/model_factors.h): a full-history run keeps two per step, and as
 // objects each took ~170 bytes (the object, its key vector, its
-// measurement vector). Any other factor is kept as it is.
+// measurement vector); held so, 64 bytes. Any other factor is kept as it is.
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
@@ -20,9 +20,26 @@ namespace gssm::internal {
 class SlotFactor {
  public:
   /// None: the slot holds a fixed linear factor.
-  SlotFactor() = default;
+  SlotFactor() {}
   /// A ProcessFactor or MeasurementFactor taken apart; any other factor kept.
   explicit SlotFactor(const FactorPtr& f);
+  SlotFactor(const SlotFactor& o) : SlotFactor() { copyFrom(o); }
+  SlotFactor(SlotFactor&& o) noexcept : SlotFactor() { moveFrom(o); }
+  SlotFactor& operator=(const SlotFactor& o) {
+    if (this != &o) {
+      reset();
+      copyFrom(o);
+    }
+    return *this;
+  }
+  SlotFactor& operator=(SlotFactor&& o) noexcept {
+    if (this != &o) {
+      reset();
+      moveFrom(o);
+    }
+    return *this;
+  }
+  ~SlotFactor() { reset(); }
 
   explicit operator bool() const { return kind_ != Kind::None; }
   /// Residual dimension.
@@ -41,14 +58,26 @@ class SlotFactor {
 
  private:
   enum class Kind : std::uint8_t { None, Object, Process, Measurement };
+  struct Step {
+    double dt;
+    Eigen::VectorXd u;  // empty without inputs: no heap block
+  };
+  void reset();
+  void copyFrom(const SlotFactor& o);
+  void moveFrom(SlotFactor& o);
+  RobustLoss loss() const { return {static_cast<RobustLoss::Kind>(loss_kind_), loss_scale_}; }
+
   Kind kind_ = Kind::None;
+  std::uint8_t loss_kind_ = 0;       // Measurement: the factor's loss
   std::int32_t channel_ = 0;         // Measurement
+  double loss_scale_ = 1.0;
   const Model* model_ = nullptr;     // Process, Measurement
-  FactorPtr object_;                 // Object
   GaussianNoise noise_;              // Process, Measurement
-  Eigen::VectorXd u_;                // Process (empty without inputs: no heap block)
-  SmallList<double, 2> numbers_;     // Process: Δt; Measurement: y
-  RobustLoss loss_;                  // as the factor had it (Process: none)
+  union {
+    FactorPtr object_;               // Object
+    Step step_;                      // Process
+    SmallList<double, 2> y_;         // Measurement
+  };
 };
 
 }  // namespace gssm::internal
