@@ -82,3 +82,17 @@ TEST(SmallList, KeysMatchAVectorThroughRandomPushEraseClearCopyAndMove) {
   randomOperations<SmallList<Key, 3>, Key>(
       [](unsigned v) { return v == 6 ? Key::constants() : Key::state(static_cast<std::int64_t>(v) - 3); });
 }
+
+TEST(SmallList, ResizeKeepsTheFirstEntriesAndFillsTheRest) {
+  SmallList<double, 2> list;
+  std::vector<double> ref;
+  for (std::size_t n : {2u, 1u, 6u, 3u, 9u, 0u, 2u}) {
+    list.resize(n, 7.5);
+    ref.resize(n, 7.5);
+    expectSame(list, ref, static_cast<int>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+      list[i] = static_cast<double>(i) + 0.25 * static_cast<double>(n);  // written in place
+      ref[i] = list[i];
+    }
+  }
+}

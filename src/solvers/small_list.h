@@ -42,6 +42,7 @@ class SmallList {
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
   const T& operator[](std::size_t i) const { return data()[i]; }
+  T& operator[](std::size_t i) { return data()[i]; }
   const T& front() const { return data()[0]; }
   const T& back() const { return data()[size_ - 1]; }
 
@@ -63,6 +64,12 @@ class SmallList {
     size_ = 0;
     reserve(static_cast<std::uint32_t>(std::distance(first, last)));
     for (; first != last; ++first) data()[size_++] = *first;
+  }
+  /// n entries: the first kept, new ones set to v.
+  void resize(std::size_t n, const T& v = T()) {
+    reserve(static_cast<std::uint32_t>(n));
+    for (std::size_t i = size_; i < n; ++i) data()[i] = v;
+    size_ = static_cast<std::uint32_t>(n);
   }
   std::vector<T> toVector() const { return std::vector<T>(begin(), end()); }
 

@@ -18,44 +18,29 @@
 
 namespace gssm::internal {
 
-/// One variable: x = anchor + δ (anchor and δ in one heap block), the clique
-/// it is the frontal variable of, its elimination rank and, for a state,
-/// the factor slots on it.
+/// One variable: x = anchor + δ (anchor and δ side by side, inline for a
+/// scalar state), the clique it is the frontal variable of, its elimination
+/// rank and, for a state, the factor slots on it.
 class EngineVar {
  public:
   EngineVar() = default;
   /// anchor = x0, δ = 0.
-  explicit EngineVar(const Eigen::VectorXd& x0) : values_(new double[2 * x0.size()]), dim_(x0.size()) {
+  explicit EngineVar(const Eigen::VectorXd& x0) {
+    values_.resize(2 * static_cast<std::size_t>(x0.size()), 0.0);
     anchor() = x0;
-    delta().setZero();
   }
-  EngineVar(const EngineVar& o)
-      : values_(o.dim_ ? new double[2 * o.dim_] : nullptr),
-        dim_(o.dim_),
-        clique(o.clique),
-        rank(o.rank),
-        slots(o.slots) {
-    std::copy(o.values_.get(), o.values_.get() + 2 * o.dim_, values_.get());
-  }
-  EngineVar& operator=(const EngineVar& o) {
-    if (this != &o) *this = EngineVar(o);
-    return *this;
-  }
-  EngineVar(EngineVar&& o) noexcept = default;
-  EngineVar& operator=(EngineVar&& o) noexcept = default;
 
   /// 0 for an empty entry (no variable).
-  Eigen::Index dim() const { return dim_; }
-  Eigen::Map<Eigen::VectorXd> anchor() { return {values_.get(), dim_}; }
-  Eigen::Map<const Eigen::VectorXd> anchor() const { return {values_.get(), dim_}; }
-  Eigen::Map<Eigen::VectorXd> delta() { return {values_.get() + dim_, dim_}; }
-  Eigen::Map<const Eigen::VectorXd> delta() const { return {values_.get() + dim_, dim_}; }
+  Eigen::Index dim() const { return static_cast<Eigen::Index>(values_.size() / 2); }
+  Eigen::Map<Eigen::VectorXd> anchor() { return {values_.begin(), dim()}; }
+  Eigen::Map<const Eigen::VectorXd> anchor() const { return {values_.begin(), dim()}; }
+  Eigen::Map<Eigen::VectorXd> delta() { return {values_.begin() + dim(), dim()}; }
+  Eigen::Map<const Eigen::VectorXd> delta() const { return {values_.begin() + dim(), dim()}; }
   /// anchor + δ.
   Eigen::VectorXd estimate() const { return anchor() + delta(); }
 
  private:
-  std::unique_ptr<double[]> values_;  // [anchor; δ]
-  Eigen::Index dim_ = 0;
+  SmallList<double, 2> values_;  // [anchor; δ]
 
  public:
   int clique = -1;
