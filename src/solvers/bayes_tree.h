@@ -99,9 +99,9 @@ struct Clique {
   /// the separator (held once).
   LinearFactor marginal;
   const KeyList& separator() const { return marginal.keys(); }
-  SmallIntList owned;  // factor slots consumed by this clique's elimination
+  SmallList<int, 2> owned;  // factor slots consumed by this clique's elimination
   int parent = -1;
-  SmallIntList children;
+  SmallList<int, 2> children;  // a chain's clique owns two factors and has one child: inline
   auto R() const { return conditional.leftCols(conditional.rows()); }
   auto S() const { return conditional.middleCols(conditional.rows(), conditional.cols() - conditional.rows() - 1); }
   auto d() const { return conditional.col(conditional.cols() - 1); }
