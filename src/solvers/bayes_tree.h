@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "gssm/factors/factors.h"
+#include "solvers/key_list.h"
 #include "solvers/slot_factor.h"
 #include "solvers/small_list.h"
 #include "solvers/var_table.h"
@@ -27,10 +28,6 @@ class Model;
 }
 
 namespace gssm::internal {
-
-/// A linear factor's or a clique's separator's keys: a model factor has at
-/// most three (x_c(k), x_c(k+1), x_b), a chain's separator two, held inline.
-using KeyList = SmallList<Key, 3>;
 
 class ByteWriter;
 class ByteReader;
@@ -47,7 +44,7 @@ struct LinearFactor {
   void setKeys(const Keys& keys) {
     keys_.assign(keys.begin(), keys.end());
   }
-  KeyList keys_;  // a model factor's three or fewer inline
+  KeyList keys_;
   Eigen::MatrixXd Ab;
   Eigen::Index rows() const { return Ab.rows(); }
   auto b() const { return Ab.col(Ab.cols() - 1); }
