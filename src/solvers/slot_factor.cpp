@@ -18,9 +18,8 @@ SlotFactor::SlotFactor(const FactorPtr& f) : SlotFactor() {
     noise_ = m->noise();
     channel_ = m->channel();
     loss_kind_ = static_cast<std::uint8_t>(m->loss().kind);
-    loss_scale_ = m->loss().scale;
-    new (&y_) SmallList<double, 2>();
-    y_.assign(m->measurement().data(), m->measurement().data() + m->measurement().size());
+    new (&observation_) Observation{{}, m->loss().scale};
+    observation_.y.assign(m->measurement().data(), m->measurement().data() + m->measurement().size());
     kind_ = Kind::Measurement;
   } else {
     new (&object_) FactorPtr(f);
@@ -33,7 +32,7 @@ void SlotFactor::reset() {
     case Kind::None: break;
     case Kind::Object: object_.~FactorPtr(); break;
     case Kind::Process: step_.~Step(); break;
-    case Kind::Measurement: y_.~SmallList(); break;
+    case Kind::Measurement: observation_.~Observation(); break;
   }
   kind_ = Kind::None;
 }
@@ -41,14 +40,13 @@ void SlotFactor::reset() {
 void SlotFactor::copyFrom(const SlotFactor& o) {
   loss_kind_ = o.loss_kind_;
   channel_ = o.channel_;
-  loss_scale_ = o.loss_scale_;
   model_ = o.model_;
   noise_ = o.noise_;
   switch (o.kind_) {
     case Kind::None: break;
     case Kind::Object: new (&object_) FactorPtr(o.object_); break;
     case Kind::Process: new (&step_) Step(o.step_); break;
-    case Kind::Measurement: new (&y_) SmallList<double, 2>(o.y_); break;
+    case Kind::Measurement: new (&observation_) Observation(o.observation_); break;
   }
   kind_ = o.kind_;
 }
@@ -56,14 +54,13 @@ void SlotFactor::copyFrom(const SlotFactor& o) {
 void SlotFactor::moveFrom(SlotFactor& o) {
   loss_kind_ = o.loss_kind_;
   channel_ = o.channel_;
-  loss_scale_ = o.loss_scale_;
   model_ = o.model_;
   noise_ = std::move(o.noise_);
   switch (o.kind_) {
     case Kind::None: break;
     case Kind::Object: new (&object_) FactorPtr(std::move(o.object_)); break;
     case Kind::Process: new (&step_) Step(std::move(o.step_)); break;
-    case Kind::Measurement: new (&y_) SmallList<double, 2>(std::move(o.y_)); break;
+    case Kind::Measurement: new (&observation_) Observation(std::move(o.observation_)); break;
   }
   kind_ = o.kind_;
   o.reset();
@@ -88,6 +85,7 @@ double SlotFactor::linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::Vec
       processResidual(*model_, step_.u, step_.dt, noise_, x, r, J);
       return robustify(RobustLoss{}, r, J);  // a process factor has no loss
     case Kind::Measurement: {
+      const auto& y_ = observation_.y;
       const Eigen::Map<const Eigen::VectorXd> y(y_.begin(), static_cast<Eigen::Index>(y_.size()));
       measurementResidual(*model_, channel_, y, noise_, x, r, J);
       return robustify(loss(), r, J);
@@ -103,6 +101,7 @@ FactorPtr SlotFactor::toFactor(const std::vector<Key>& keys) const {
     case Kind::Object: return object_;
     case Kind::Process: return std::make_shared<ProcessFactor>(*model_, keys.at(0).step, step_.u, step_.dt, noise_);
     case Kind::Measurement: {
+      const auto& y_ = observation_.y;
       const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(y_.begin(), static_cast<Eigen::Index>(y_.size()));
       return std::make_shared<MeasurementFactor>(*model_, keys.at(0).step, y, channel_, noise_);
     }

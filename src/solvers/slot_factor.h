@@ -6,7 +6,7 @@
 // evaluated by the same code as ProcessFactor and MeasurementFactor
 // (factors/model_factors.h): a full-history run keeps two per step, and as
 // objects each took ~170 bytes (the object, its key vector, its
-// measurement vector); held so, 64 bytes. Any other factor is kept as it is.
+// measurement vector); held so, 56 bytes. Any other factor is kept as it is.
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
@@ -62,21 +62,24 @@ class SlotFactor {
     double dt;
     Eigen::VectorXd u;  // empty without inputs: no heap block
   };
+  struct Observation {
+    SmallList<double, 1> y;  // a scalar measurement inline
+    double loss_scale;
+  };
   void reset();
   void copyFrom(const SlotFactor& o);
   void moveFrom(SlotFactor& o);
-  RobustLoss loss() const { return {static_cast<RobustLoss::Kind>(loss_kind_), loss_scale_}; }
+  RobustLoss loss() const { return {static_cast<RobustLoss::Kind>(loss_kind_), observation_.loss_scale}; }
 
   Kind kind_ = Kind::None;
-  std::uint8_t loss_kind_ = 0;       // Measurement: the factor's loss
+  std::uint8_t loss_kind_ = 0;       // Measurement: the factor's loss (its scale in observation_)
   std::int32_t channel_ = 0;         // Measurement
-  double loss_scale_ = 1.0;
   const Model* model_ = nullptr;     // Process, Measurement
   GaussianNoise noise_;              // Process, Measurement
   union {
     FactorPtr object_;               // Object
     Step step_;                      // Process
-    SmallList<double, 2> y_;         // Measurement
+    Observation observation_;        // Measurement
   };
 };
 
