@@ -1,6 +1,7 @@
 #include "gssm/core/gaussian.h"
 
 #include <Eigen/Cholesky>
+#include <memory>
 #include <sstream>
 
 #include "gssm/core/error.h"
@@ -43,18 +44,19 @@ void requireCovariance(const Eigen::MatrixXd& m, Eigen::Index n, const std::stri
 }
 
 GaussianNoise::GaussianNoise() {
-  static const std::shared_ptr<const Data> empty = std::make_shared<const Data>();
+  static const Data* const empty = new Data();  // never released: its count never reaches 0
+  empty->refs.fetch_add(1, std::memory_order_relaxed);
   data_ = empty;
 }
 
 GaussianNoise::GaussianNoise(const Eigen::MatrixXd& covariance, const std::string& what) {
   requireCovariance(covariance, covariance.rows(), what);
-  auto d = std::make_shared<Data>();
+  auto d = std::make_unique<Data>();
   d->covariance = covariance;
   d->L = Eigen::LLT<Eigen::MatrixXd>(covariance).matrixL();
   const Eigen::Index n = d->L.rows();
   d->diagonal = n <= 1 || (d->L - Eigen::MatrixXd(d->L.diagonal().asDiagonal())).cwiseAbs().maxCoeff() == 0.0;
-  data_ = std::move(d);
+  data_ = d.release();
 }
 
 // A diagonal L (independent noise, the common case) divides row by row: the

@@ -1,7 +1,7 @@
 #pragma once
 // Gaussian noise models: whitening by the Cholesky factor of a covariance.
 #include <Eigen/Core>
-#include <memory>
+#include <atomic>
 #include <string>
 
 namespace gssm {
@@ -19,10 +19,18 @@ inline bool validVector(const Eigen::VectorXd& v, Eigen::Index n) { return v.siz
 /// A zero-mean Gaussian N(0, Σ), Σ = L Lᵀ. whiten(v) = L⁻¹ v, so that
 /// ‖whiten(v)‖² is the squared Mahalanobis norm vᵀ Σ⁻¹ v.
 /// Immutable; copies share Σ and L (every measurement factor of a run holds
-/// the same R: one Cholesky factor, 16 bytes each instead of two matrices).
+/// the same R: one Cholesky factor, one word each instead of two matrices).
 class GaussianNoise {
  public:
   GaussianNoise();
+  GaussianNoise(const GaussianNoise& o) noexcept : data_(o.data_) { data_->refs.fetch_add(1, std::memory_order_relaxed); }
+  GaussianNoise(GaussianNoise&& o) noexcept : GaussianNoise(o) {}  // a moved-from noise stays valid
+  GaussianNoise& operator=(const GaussianNoise& o) noexcept {
+    GaussianNoise copy(o);
+    std::swap(data_, copy.data_);
+    return *this;
+  }
+  ~GaussianNoise() { release(data_); }
   /// Throws NumericalError (naming `what`) if Σ is not positive definite.
   explicit GaussianNoise(const Eigen::MatrixXd& covariance, const std::string& what = "covariance");
 
@@ -37,11 +45,17 @@ class GaussianNoise {
   Eigen::VectorXd whiten(const Eigen::VectorXd& v) const;
 
  private:
+  // Shared by reference count in the data itself: a full-history run holds
+  // a noise model per factor, and a shared_ptr took two words.
   struct Data {
     Eigen::MatrixXd covariance, L;
     bool diagonal = true;
+    mutable std::atomic<long> refs{1};
   };
-  std::shared_ptr<const Data> data_;
+  static void release(const Data* d) noexcept {
+    if (d->refs.fetch_sub(1, std::memory_order_acq_rel) == 1) delete d;
+  }
+  const Data* data_;
 };
 
 /// A Gaussian density N(mean, covariance) on one variable.
