@@ -46,6 +46,12 @@ void expectSameEvaluation(const Model& m, const FactorPtr& f, std::mt19937& rng)
   const SlotFactor held(f);
   ASSERT_TRUE(static_cast<bool>(held));
   EXPECT_EQ(held.dim(), f->dim());
+  EXPECT_TRUE(held.fitsKeys(f->keys()));
+  const std::vector<Key> reversed(f->keys().rbegin(), f->keys().rend());
+  if (reversed.size() > 1) {
+    EXPECT_FALSE(held.fitsKeys(reversed));  // (the step is the keys': any step fits)
+  }
+  EXPECT_FALSE(held.fitsKeys(std::vector<Key>(f->keys().begin(), f->keys().end() - 1)));
   const FactorPtr back = held.toFactor(f->keys());
   EXPECT_EQ(back->describe(), f->describe());
   EXPECT_EQ(back->keys(), f->keys());

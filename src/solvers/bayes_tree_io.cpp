@@ -227,7 +227,7 @@ std::string BayesTreeEngine::invariantViolation() const {
     const std::string what = "factor slot " + std::to_string(s);
     const std::string lin = linearOk(slot.linear, what);
     if (!lin.empty()) return lin;
-    if (slot.nonlinear && slot.nonlinear.dim() != slot.linear.rows())
+    if (slot.nonlinear && (!slot.nonlinear.fitsKeys(slot.linear.keys()) || slot.nonlinear.dim() != slot.linear.rows()))
       return what + ": its linearization does not match its factor";
     if (!aliveClique(slot.owner)) return what + " is owned by no live clique";
     const auto& owned = cliques_[static_cast<std::size_t>(slot.owner)].owned;

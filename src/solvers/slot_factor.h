@@ -8,6 +8,7 @@
 // objects each took ~170 bytes (the object, its key vector, its
 // measurement vector); held so, 56 bytes. Any other factor is kept as it is.
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -44,6 +45,21 @@ class SlotFactor {
   explicit operator bool() const { return kind_ != Kind::None; }
   /// Residual dimension.
   int dim() const;
+  /// Whether `keys` are the factor's: an object's own, a process factor's
+  /// x_c(k), x_c(k+1) (then x_b if the model has constants), a
+  /// measurement's x_c(k) (then x_b).
+  template <class Keys>
+  bool fitsKeys(const Keys& keys) const {
+    if (kind_ == Kind::Object) return object_->keys().size() == keys.size() &&
+                                      std::equal(keys.begin(), keys.end(), object_->keys().begin());
+    if (kind_ == Kind::None || keys.size() == 0) return false;
+    const Key first = *keys.begin();
+    std::vector<Key> expected{first};
+    if (kind_ == Kind::Process) expected.push_back(Key::state(first.step + 1));
+    if (model_->dims().nb > 0) expected.push_back(Key::constants());
+    return !first.isConstants() && expected.size() == keys.size() &&
+           std::equal(keys.begin(), keys.end(), expected.begin());
+  }
   /// What Factor::linearizeRobustAt returns for the factor it was made from,
   /// with its variables' values in key order.
   double linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
