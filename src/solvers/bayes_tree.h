@@ -44,7 +44,6 @@ struct LinearFactor {
   void setKeys(const Keys& keys) {
     keys_.assign(keys.begin(), keys.end());
   }
-  KeyList keys_;
   Eigen::MatrixXd Ab;
   Eigen::Index rows() const { return Ab.rows(); }
   auto b() const { return Ab.col(Ab.cols() - 1); }
@@ -85,6 +84,9 @@ struct LinearFactor {
     }
     return out;
   }
+
+ private:
+  KeyList keys_;
 };
 
 struct Clique {
@@ -293,8 +295,8 @@ class BayesTreeEngine {
   template <class Keys>
   LinearFactor linearize(const SlotFactor& f, const Keys& keys, const Values& extra) const;
   /// Points scratch_.x at the estimate of each of `keys` (anchor + δ, or
-  /// extra's value of a variable being added); `known[i]` is keys[i]'s
-  /// variable, null if new.
+  /// extra's value of a variable being added); scratch_.factor_vars[i] is
+  /// keys[i]'s variable, null if new.
   template <class Keys>
   void pointAt(const Keys& keys, const Values* extra) const;
   /// The elimination order of `keys` into `out`.

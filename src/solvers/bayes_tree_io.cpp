@@ -112,6 +112,7 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     if (e.vars_.contains(k)) in.fail(name + " appears twice");
     const Eigen::VectorXd anchor = in.vec(name + " anchor");
     const Eigen::VectorXd delta = in.vec(name + " delta");
+    if (anchor.size() == 0) in.fail(name + " is empty (the model has no such variable)");
     if (anchor.size() != variableDim(model, k) || delta.size() != anchor.size())
       in.fail(name + " has size " + std::to_string(anchor.size()) + " but the model's is " +
               std::to_string(variableDim(model, k)));
