@@ -1,5 +1,6 @@
 #pragma once
-// Internal: a list of trivially copyable values (slot and clique ids, keys)
+// Internal: a list of trivially copyable values (slot and clique ids, keys,
+// a variable's numbers)
 // held inline up to N entries and on the heap beyond. A Bayes tree over a
 // long chain keeps a few such lists per step (a clique's factors, children
 // and separator, a factor's keys, a variable's factors); as std::vectors
