@@ -6,7 +6,7 @@
 // evaluated by the same code as ProcessFactor and MeasurementFactor
 // (factors/model_factors.h): a full-history run keeps two per step, and as
 // objects each took ~170 bytes (the object, its key vector, its
-// measurement vector); held so, 56 bytes. Any other factor is kept as it is.
+// measurement vector); held so, 48 bytes. Any other factor is kept as it is.
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdint>

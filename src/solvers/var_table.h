@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <deque>
-#include <memory>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -50,7 +49,7 @@ class EngineVar {
 
 class VarTable {
  public:
-  inline EngineVar* find(const Key& k) { return const_cast<EngineVar*>(static_cast<const VarTable*>(this)->find(k)); }
+  EngineVar* find(const Key& k) { return const_cast<EngineVar*>(static_cast<const VarTable*>(this)->find(k)); }
   const EngineVar* find(const Key& k) const {
     if (k == Key::constants()) return constants_.dim() ? &constants_ : nullptr;
     if (!k.isConstants() && k.step >= first_ && k.step - first_ < static_cast<std::int64_t>(states_.size())) {
