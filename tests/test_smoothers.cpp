@@ -356,3 +356,47 @@ TEST(Nav2D, BatchEqualsIncrementalAfterEveryUpdateAndFixedLagEqualsIncremental) 
     EXPECT_LT(relativeError(fl->current().covariance, inc->current().covariance), 1e-6) << "every " << every;
   }
 }
+
+// A user's graph need not number its states consecutively: states far apart
+// (and before the first) live in the engine's table apart from the dense
+// run of steps. The estimates and marginals must still be the batch
+// solution's, after every update.
+TEST(IncrementalSmoother, StatesFarApartInStepEqualTheBatchSolve) {
+  const std::vector<std::int64_t> steps{0, 1, 2, 5000, 5001, -7000, 3, 40000, -6999, 4};
+  std::mt19937 rng(8);
+  std::normal_distribution<double> g;
+  IncrementalSmoother smoother(SmootherOptions{}, EliminationOrdering::ConstrainedColamd);
+  FactorGraph graph;
+  Values all;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const Key k = Key::state(steps[i]);
+    std::vector<FactorPtr> added;
+    Values initial;
+    const Eigen::Vector2d mean(g(rng), 10 + g(rng));
+    initial.insert(k, mean);
+    all.insert(k, mean);
+    added.push_back(std::make_shared<PriorFactor>(k, Gaussian{mean, Eigen::Matrix2d::Identity() * (4.0 + i)}));
+    if (i > 0) {  // a linear link to the previous state: x_k − x_prev = [1, 0] ± 0.5
+      const Key prev = Key::state(steps[i - 1]);
+      Values at;
+      at.insert(prev, Eigen::Vector2d::Zero());
+      at.insert(k, Eigen::Vector2d::Zero());
+      added.push_back(std::make_shared<LinearGaussianFactor>(
+          std::vector<Key>{prev, k}, std::vector<Eigen::MatrixXd>{-2.0 * Eigen::Matrix2d::Identity(), 2.0 * Eigen::Matrix2d::Identity()},
+          Eigen::Vector2d(2.0, 0.0), at));
+    }
+    smoother.update(added, initial);
+    for (const auto& f : added) graph.add(f);
+    Values x = all;
+    BatchSolver batch;
+    ASSERT_TRUE(batch.solve(graph, x).converged);
+    const Values inc = smoother.calculateEstimate();
+    ASSERT_EQ(inc.size(), x.size());
+    for (const auto& kv : x) {
+      EXPECT_LT(relativeError(inc.at(kv.first), kv.second), 1e-9) << kv.first.toString() << " after " << i + 1;
+      EXPECT_LT(relativeError(smoother.jointMarginalCovariance({kv.first}), batch.jointMarginalCovariance({kv.first})),
+                1e-9)
+          << kv.first.toString() << " after " << i + 1;
+    }
+  }
+}
