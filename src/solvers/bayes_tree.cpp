@@ -153,8 +153,12 @@ void BayesTreeEngine::pointAt(const Keys& keys, const Values* extra) const {
     const Var* v = vars_.find(k);
     known.push_back(v);
     if (v) {
-      points[i] = v->anchor() + v->delta();
-      x.push_back(&points[i]);
+      // The constants in a buffer of their own: a position holds a state in
+      // one factor and x_b in the next (process, then measurement), and one
+      // buffer resized between their sizes reallocated every time.
+      Eigen::VectorXd& p = k.isConstants() ? scratch_.constants_point : points[i];
+      p = v->anchor() + v->delta();
+      x.push_back(&p);
     } else {
       x.push_back(&extra->at(k));
     }

@@ -329,7 +329,8 @@ class BayesTreeEngine {
   // for every touched clique, eliminateTop, solvePath), so
   // they allocate once, not per call. Not state: never saved or compared.
   struct Scratch {
-    std::vector<Eigen::VectorXd> points;        // a factor's variables' estimates, by position
+    std::vector<Eigen::VectorXd> points;        // a factor's states' estimates, by position
+    Eigen::VectorXd constants_point;            // its constants' estimate
     std::vector<const Eigen::VectorXd*> x;      // their addresses (or a new variable's initial value)
     std::vector<const Var*> factor_vars;        // a factor's variables, null if new
     Eigen::VectorXd r, rlin, term;

@@ -95,15 +95,15 @@ double SlotFactor::linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::Vec
   return 0.0;
 }
 
-FactorPtr SlotFactor::toFactor(const std::vector<Key>& keys) const {
+FactorPtr SlotFactor::toFactorAt(std::int64_t step) const {
   switch (kind_) {
     case Kind::None: break;
     case Kind::Object: return object_;
-    case Kind::Process: return std::make_shared<ProcessFactor>(*model_, keys.at(0).step, step_.u, step_.dt, noise_);
+    case Kind::Process: return std::make_shared<ProcessFactor>(*model_, step, step_.u, step_.dt, noise_);
     case Kind::Measurement: {
       const auto& y_ = observation_.y;
       const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(y_.begin(), static_cast<Eigen::Index>(y_.size()));
-      return std::make_shared<MeasurementFactor>(*model_, keys.at(0).step, y, channel_, noise_);
+      return std::make_shared<MeasurementFactor>(*model_, step, y, channel_, noise_);
     }
   }
   return nullptr;

@@ -53,12 +53,17 @@ class SlotFactor {
     if (kind_ == Kind::Object) return object_->keys().size() == keys.size() &&
                                       std::equal(keys.begin(), keys.end(), object_->keys().begin());
     if (kind_ == Kind::None || keys.size() == 0) return false;
+    // x_c(k), then x_c(k+1) for a process factor, then x_b if there are constants.
+    const std::size_t states = kind_ == Kind::Process ? 2 : 1;
+    if (keys.size() != states + (model_->dims().nb > 0 ? 1 : 0)) return false;
     const Key first = *keys.begin();
-    std::vector<Key> expected{first};
-    if (kind_ == Kind::Process) expected.push_back(Key::state(first.step + 1));
-    if (model_->dims().nb > 0) expected.push_back(Key::constants());
-    return !first.isConstants() && expected.size() == keys.size() &&
-           std::equal(keys.begin(), keys.end(), expected.begin());
+    std::size_t i = 0;
+    for (const Key& k : keys) {
+      const Key expected = i < states ? Key::state(first.step + static_cast<std::int64_t>(i)) : Key::constants();
+      if (first.isConstants() || k != expected) return false;
+      ++i;
+    }
+    return true;
   }
   /// What Factor::linearizeRobustAt returns for the factor it was made from,
   /// with its variables' values in key order.
@@ -66,10 +71,9 @@ class SlotFactor {
                            std::vector<Eigen::MatrixXd>* J) const;
   /// The factor as an object again, on `keys` (its slot's), for what needs
   /// one: curvature terms, checkpoints, messages.
-  FactorPtr toFactor(const std::vector<Key>& keys) const;
   template <class Keys>
   FactorPtr toFactor(const Keys& keys) const {
-    return toFactor(std::vector<Key>(keys.begin(), keys.end()));
+    return toFactorAt(keys.size() > 0 ? keys.begin()->step : 0);
   }
 
  private:
@@ -82,6 +86,7 @@ class SlotFactor {
     SmallList<double, 1> y;  // a scalar measurement inline
     double loss_scale;
   };
+  FactorPtr toFactorAt(std::int64_t step) const;  // a model factor's at its first state's step
   void reset();
   void copyFrom(const SlotFactor& o);
   void moveFrom(SlotFactor& o);

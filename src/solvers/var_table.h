@@ -112,17 +112,11 @@ class VarTable {
   /// far ones, then the constants.
   template <class F>
   void forEach(F&& f) const {
-    for (std::size_t i = 0; i < states_.size(); ++i)
-      if (states_[i].dim()) f(Key::state(first_ + static_cast<std::int64_t>(i)), states_[i]);
-    for (const auto& kv : far_) f(kv.first, kv.second);
-    if (constants_.dim()) f(Key::constants(), constants_);
+    visit(*this, f);
   }
   template <class F>
   void forEach(F&& f) {
-    for (std::size_t i = 0; i < states_.size(); ++i)
-      if (states_[i].dim()) f(Key::state(first_ + static_cast<std::int64_t>(i)), states_[i]);
-    for (auto& kv : far_) f(kv.first, kv.second);
-    if (constants_.dim()) f(Key::constants(), constants_);
+    visit(*this, f);
   }
 
  private:
@@ -130,6 +124,14 @@ class VarTable {
   __attribute__((noinline)) const EngineVar* findFar(const Key& k) const {
     const auto it = far_.find(k);
     return it == far_.end() ? nullptr : &it->second;
+  }
+  // forEach's walk for a const and a mutable table alike.
+  template <class Table, class F>
+  static void visit(Table& t, F& f) {
+    for (std::size_t i = 0; i < t.states_.size(); ++i)
+      if (t.states_[i].dim()) f(Key::state(t.first_ + static_cast<std::int64_t>(i)), t.states_[i]);
+    for (auto& kv : t.far_) f(kv.first, kv.second);
+    if (t.constants_.dim()) f(Key::constants(), t.constants_);
   }
   static constexpr std::int64_t kGap = 1024;
   std::deque<EngineVar> states_;  // step first_ + i; dim() == 0: no variable
