@@ -119,8 +119,93 @@ int BayesTreeEngine::allocClique() {
 }
 
 void BayesTreeEngine::indexSlot(int s) {
-  for (const auto& k : slots_[static_cast<std::size_t>(s)].linear.keys())
+  for (const auto& k : slotKeys(slots_[static_cast<std::size_t>(s)]))
     if (!k.isConstants()) vars_.at(k).slots.push_back(s);
+}
+
+namespace {
+// A record's sizes are 16-bit: checked before an update commits.
+constexpr Eigen::Index kMaxRecordDim = std::numeric_limits<std::uint16_t>::max();
+std::uint16_t narrow16(Eigen::Index n) {
+  if (n < 0 || n > kMaxRecordDim) throw std::logic_error("engine record size out of range");
+  return static_cast<std::uint16_t>(n);
+}
+// Throws if f's keys or [A | b] are larger than a slot records; `what`
+// names it (called only then: a description costs more than an update).
+template <class What>
+void checkHoldable(const LinearFactor& f, What&& what) {
+  if (static_cast<Eigen::Index>(f.keys().size()) > kMaxRecordDim || f.Ab.rows() > kMaxRecordDim ||
+      f.Ab.cols() > kMaxRecordDim)
+    throw InvalidArgument(what() + " has " + std::to_string(f.keys().size()) + " variables and " +
+                          std::to_string(f.Ab.rows()) + " x " + std::to_string(f.Ab.cols()) +
+                          " [A | b]; the engine holds at most " + std::to_string(kMaxRecordDim) + " of each");
+}
+}  // namespace
+
+namespace {
+// n doubles from `from` to `to`, inline (std::copy_n calls memmove: a call
+// per column of a few entries, 1% of a fixed-lag update).
+inline double* copyDoubles(const double* from, Eigen::Index n, double* to) {
+  Eigen::Map<Eigen::VectorXd>(to, n) = Eigen::Map<const Eigen::VectorXd>(from, n);
+  return to + n;
+}
+template <class Keys>
+void copyKeys(const Keys& keys, Key* to) {
+  for (const Key& k : keys) *to++ = k;
+}
+}  // namespace
+
+void BayesTreeEngine::releaseRecord(Slot& s) {
+  records_.release(s.record, s.words());
+  s.nkeys = s.rows = s.cols = 0;
+  s.record = 0;
+}
+
+void BayesTreeEngine::storeLinearization(Slot& s, const LinearView& f) {
+  const std::size_t words = f.keys().size() + static_cast<std::size_t>(f.rows() * f.cols());
+  if (words != s.words()) {
+    releaseRecord(s);
+    s.record = records_.allocate(words);
+  }
+  s.nkeys = narrow16(static_cast<Eigen::Index>(f.keys().size()));
+  s.rows = narrow16(f.rows());
+  s.cols = narrow16(f.cols());
+  copyKeys(f.keys(), records_.keys(s.record));
+  double* ab = records_.doubles(s.record, s.nkeys);
+  if (!f.packed) {
+    copyDoubles(f.ab, f.rows() * f.cols(), ab);
+    return;
+  }
+  for (Eigen::Index j = 0; j < f.cols(); ++j) {  // a packed view's zeros written out
+    double* to = copyDoubles(f.col(j), f.colLength(j), ab + j * f.rows());
+    std::fill(to, ab + (j + 1) * f.rows(), 0.0);
+  }
+}
+
+Clique BayesTreeEngine::storeClique(const EliminatedClique& e) {
+  Clique c;
+  c.frontal = e.frontal;
+  const KeyList& sep = e.marginal.keys();
+  c.nsep = narrow16(static_cast<Eigen::Index>(sep.size()));
+  c.dv = narrow16(e.conditional.rows());
+  c.width = narrow16(e.conditional.cols() - e.conditional.rows() - 1);
+  c.mrows = narrow16(e.marginal.rows());
+  c.record = records_.allocate(c.words());
+  copyKeys(sep, records_.keys(c.record));
+  copyDoubles(e.conditional.data(), e.conditional.size(), records_.doubles(c.record, c.conditionalOffset()));
+  // The marginal [R_S | d_S] is upper trapezoidal: each column down to the diagonal.
+  double* m = records_.doubles(c.record, c.marginalOffset());
+  for (Eigen::Index j = 0; j <= c.width; ++j) {
+    const Eigen::Index n = std::min<Eigen::Index>(j + 1, c.mrows);
+    m = copyDoubles(e.marginal.Ab.data() + j * c.mrows, n, m);
+  }
+  c.owned = e.owned;
+  return c;
+}
+
+void BayesTreeEngine::releaseRecord(Clique& c) {
+  records_.release(c.record, c.words());
+  c = Clique{};
 }
 
 int BayesTreeEngine::allocSlot() {
@@ -194,7 +279,7 @@ LinearFactor BayesTreeEngine::linearize(const SlotFactor& f, const Keys& keys, c
   return lf;
 }
 
-void BayesTreeEngine::order(const std::vector<Key>& keys, const std::vector<const LinearFactor*>& factors,
+void BayesTreeEngine::order(const std::vector<Key>& keys, const std::vector<std::pair<LinearView, InputSource>>& factors,
                             const Values& new_vars, std::vector<Key>& out) const {
   out.assign(keys.begin(), keys.end());
   if (mode_ == OrderingMode::TimeOrdered || keys.size() <= 2) {
@@ -217,9 +302,9 @@ void BayesTreeEngine::order(const std::vector<Key>& keys, const std::vector<cons
   for (std::size_t i = 0; i < keys.size(); ++i) col[keys[i]] = static_cast<int>(i);
   std::vector<std::vector<int>> rows_of_col(keys.size());
   int nrow = 0;
-  for (const auto* f : factors) {
+  for (const auto& f : factors) {
     bool any = false;
-    for (const auto& k : f->keys()) {
+    for (const auto& k : f.first.keys()) {
       auto it = col.find(k);
       if (it != col.end()) {
         rows_of_col[static_cast<std::size_t>(it->second)].push_back(nrow);
@@ -285,11 +370,11 @@ struct BayesTreeEngine::UpdatePlan {
   std::vector<int>& removed_order;
   std::vector<int>& orphans;
   std::vector<Key>& keys;
-  std::vector<std::pair<const LinearFactor*, InputSource>>& inputs;
+  std::vector<std::pair<LinearView, InputSource>>& inputs;
   std::vector<Key>& ordering;
   std::vector<int>& new_slot_of;
   std::vector<int>& new_lin_slot_of;
-  std::vector<Clique>& fresh;
+  std::vector<EliminatedClique>& fresh;
   std::vector<std::pair<std::size_t, InputSource>>& fresh_owned;
   std::vector<int>& fresh_id;
 };
@@ -321,13 +406,16 @@ void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
                               ", which is neither in the smoother nor added with it");
     p.held_new.emplace_back(f);
     p.linearized_new.push_back(linearize(p.held_new.back(), f->keys(), p.new_variables));
+    checkHoldable(p.linearized_new.back(), [&] { return "factor '" + f->describe() + "'"; });
   }
-  for (const auto& lf : p.new_linear)
+  for (const auto& lf : p.new_linear) {
     for (const auto& k : lf.keys())
       if (!known(k)) throw InvalidArgument("linear factor uses unknown variable " + k.toString());
+    checkHoldable(lf, [] { return std::string("a linear factor"); });
+  }
   for (int s : p.update.relinearize) {
     const Slot& slot = slots_.at(static_cast<std::size_t>(s));
-    if (slot.alive && slot.nonlinear) p.relinearized[s] = linearize(slot.nonlinear, slot.linear.keys(), p.new_variables);
+    if (slot.alive && slot.nonlinear) p.relinearized[s] = linearize(slot.nonlinear, slotKeys(slot), p.new_variables);
   }
 }
 
@@ -361,7 +449,7 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
     p.keys.push_back(cl.frontal);
     for (int s : cl.owned) {
       auto it = p.relinearized.find(s);
-      p.inputs.push_back({it != p.relinearized.end() ? &it->second : &slots_[static_cast<std::size_t>(s)].linear,
+      p.inputs.push_back({it != p.relinearized.end() ? it->second.view() : slotView(slots_[static_cast<std::size_t>(s)]),
                           {Kind::Slot, s}});
     }
     for (int ch : cl.children)
@@ -369,10 +457,10 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
   }
   for (const auto& kv : p.new_variables) p.keys.push_back(kv.first);
   for (std::size_t i = 0; i < p.linearized_new.size(); ++i)
-    p.inputs.push_back({&p.linearized_new[i], {Kind::NewFactor, static_cast<int>(i)}});
+    p.inputs.push_back({p.linearized_new[i].view(), {Kind::NewFactor, static_cast<int>(i)}});
   for (std::size_t i = 0; i < p.new_linear.size(); ++i)
-    p.inputs.push_back({&p.new_linear[i], {Kind::NewLinear, static_cast<int>(i)}});
-  for (int o : p.orphans) p.inputs.push_back({&cliques_[static_cast<std::size_t>(o)].marginal, {Kind::Orphan, o}});
+    p.inputs.push_back({p.new_linear[i].view(), {Kind::NewLinear, static_cast<int>(i)}});
+  for (int o : p.orphans) p.inputs.push_back({marginalView(cliques_[static_cast<std::size_t>(o)]), {Kind::Orphan, o}});
   for (int c : p.removed_order) removed[static_cast<std::size_t>(c)] = 0;
 }
 
@@ -382,10 +470,7 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
 // clique): stack the factors [A | b] with v first, triangularize, split R
 // into the conditional on v and the marginal factor on its separator.
 void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
-  std::vector<const LinearFactor*> fptrs;
-  fptrs.reserve(p.inputs.size());
-  for (const auto& in : p.inputs) fptrs.push_back(in.first);
-  order(p.keys, fptrs, p.new_variables, p.ordering);
+  order(p.keys, p.inputs, p.new_variables, p.ordering);
   const std::vector<Key>& ordering = p.ordering;
   KeyTable<std::size_t> pos;
   for (std::size_t i = 0; i < ordering.size(); ++i) pos.set(ordering[i], i);
@@ -398,63 +483,67 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   // Each pending factor waits at the first of its variables in the ordering;
   // the marginal a clique leaves on its separator joins the queue.
   std::vector<std::vector<std::size_t>>& pending_of = scratch_.pending_of;
-  if (ordering.size() <= kKeepEntries && pending_of.size() > kKeepEntries) pending_of = {};  // after a whole-history update
+  // After a whole-history update, its storage goes (`= {}` would keep the
+  // capacity: the initializer-list assignment; 24 bytes a variable).
+  if (ordering.size() <= kKeepEntries && pending_of.size() > kKeepEntries)
+    std::vector<std::vector<std::size_t>>().swap(pending_of);
   if (pending_of.size() < ordering.size()) pending_of.resize(ordering.size());
   for (std::size_t i = 0; i < ordering.size(); ++i) pending_of[i].clear();
-  std::vector<const LinearFactor*>& pend = scratch_.pend;
+  std::vector<LinearView>& pend = scratch_.pend;
   std::vector<std::optional<InputSource>>& pend_source = scratch_.pend_source;  // nullopt: a marginal made here
   clearKeepingSmall(pend);
   clearKeepingSmall(pend_source);
-  auto addPending = [&](const LinearFactor* f, std::optional<InputSource> source) {
+  auto addPending = [&](const LinearView& f, std::optional<InputSource> source) {
     const std::size_t id = pend.size();
     pend.push_back(f);
     pend_source.push_back(source);
     std::size_t first = ordering.size();
-    for (const auto& k : f->keys()) first = std::min(first, pos.at(k));
+    for (const auto& k : f.keys()) first = std::min(first, pos.at(k));
     if (first < ordering.size()) pending_of[first].push_back(id);
   };
   for (const auto& in : p.inputs) {
     bool empty = true;
-    for (const auto& k : in.first->keys()) empty = empty && !pos.count(k);
+    for (const auto& k : in.first.keys()) empty = empty && !pos.count(k);
     if (empty) continue;  // cannot happen for a consistent tree
     addPending(in.first, in.second.kind == InputSource::Kind::Orphan ? std::nullopt
                                                                       : std::optional<InputSource>(in.second));
   }
-  p.fresh.assign(ordering.size(), Clique{});  // empty: no allocation
+  p.fresh.assign(ordering.size(), EliminatedClique{});  // empty: no allocation
   p.fresh_owned.clear();
   // A pooled clique of the same shape, if any, whose storage the new one
   // then overwrites without allocating.
   // (A marginalized clique gave its marginal away: matched by its
   // conditional alone, its lists' capacity is what is reused.)
-  auto reuse = [&](Clique& cl, Eigen::Index dv, Eigen::Index sep_cols) {
+  auto reuse = [&](EliminatedClique& cl, Eigen::Index dv, Eigen::Index sep_cols) {
     auto& spare = pool_.spare;
     for (std::size_t i = spare.size(); i-- > 0;) {
-      const Clique& c = spare[i];
+      const EliminatedClique& c = spare[i];
       if (c.conditional.rows() != dv || c.conditional.cols() != dv + sep_cols + 1) continue;
       cl = std::move(spare[i]);
       spare[i] = std::move(spare.back());
       spare.pop_back();
       cl.owned.clear();
-      cl.children.clear();
-      cl.parent = -1;
       return;
     }
   };
   const double damping = p.update.damping;
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
     const Key& v = ordering[vi];
-    Clique& cl = p.fresh[vi];
+    EliminatedClique& cl = p.fresh[vi];
     // Union of keys, v first then by position.
     std::vector<Key>& sep = scratch_.separator;
     sep.clear();
     Eigen::Index rows = 0;
     for (std::size_t id : pending_of[vi]) {
-      rows += pend[id]->rows();
-      for (const auto& k : pend[id]->keys())
+      rows += pend[id].rows();
+      for (const auto& k : pend[id].keys())
         if (k != v && std::find(sep.begin(), sep.end(), k) == sep.end()) sep.push_back(k);
     }
     std::sort(sep.begin(), sep.end(), [&](const Key& a, const Key& b) { return pos.at(a) < pos.at(b); });
     const Eigen::Index dv = dims.at(v);
+    if (static_cast<Eigen::Index>(sep.size()) > kMaxRecordDim || dv > kMaxRecordDim)
+      throw InvalidArgument("eliminating " + v.toString() + " makes a clique on " + std::to_string(sep.size()) +
+                            " variables; the engine holds at most " + std::to_string(kMaxRecordDim));
     KeyTable<Eigen::Index> colOf;
     Eigen::Index ncols = dv;
     colOf.set(v, 0);
@@ -462,6 +551,9 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
       colOf.set(k, ncols);
       ncols += dims.at(k);
     }
+    if (ncols - dv > kMaxRecordDim)
+      throw InvalidArgument("eliminating " + v.toString() + " makes a clique " + std::to_string(ncols) +
+                            " wide; the engine holds at most " + std::to_string(kMaxRecordDim));
     reuse(cl, dv, ncols - dv);
     cl.frontal = v;
     const Eigen::Index damp_rows = damping > 0 ? dv : 0;
@@ -469,14 +561,16 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     M.setZero(rows + damp_rows, ncols + 1);
     Eigen::Index r0 = 0;
     for (std::size_t id : pending_of[vi]) {
-      const LinearFactor& f = *pend[id];
+      const LinearView& f = pend[id];
+      // Column by column (a packed marginal holds none of its zeros; M's are set).
+      auto copyCol = [&](Eigen::Index from, Eigen::Index to) { copyDoubles(f.col(from), f.colLength(from), &M(r0, to)); };
       Eigen::Index col = 0;
       for (const auto& k : f.keys()) {
-        const Eigen::Index w = dims.at(k);
-        M.block(r0, colOf.at(k), f.rows(), w) = f.Ab.middleCols(col, w);
+        const Eigen::Index w = dims.at(k), to = colOf.at(k);
+        for (Eigen::Index j = 0; j < w; ++j) copyCol(col + j, to + j);
         col += w;
       }
-      M.block(r0, ncols, f.rows(), 1) = f.b();
+      copyCol(col, ncols);
       r0 += f.rows();
       if (pend_source[id]) p.fresh_owned.emplace_back(vi, *pend_source[id]);
     }
@@ -526,7 +620,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
     const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
     m.Ab = Rfull.block(dv, dv, mrows, ncols - dv + 1);
     m.setKeys(sep);
-    if (!sep.empty() && mrows > 0) addPending(&m, std::nullopt);
+    if (!sep.empty() && mrows > 0) addPending(m.view(), std::nullopt);
   }
 }
 
@@ -535,15 +629,13 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
 // cliques. Nothing here throws short of memory.
 void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   for (auto& kv : p.relinearized) {
-    LinearFactor& linear = slots_[static_cast<std::size_t>(kv.first)].linear;
-    std::swap(linear, kv.second);
+    storeLinearization(slots_[static_cast<std::size_t>(kv.first)], kv.second.view());  // same size: in place
     pool_.keep(std::move(kv.second));
     ++counts.factors_relinearized;
   }
   for (int c : p.removed_order) {
     clique_alive_[static_cast<std::size_t>(c)] = false;
-    pool_.keep(std::move(cliques_[static_cast<std::size_t>(c)]));
-    cliques_[static_cast<std::size_t>(c)] = Clique{};
+    releaseRecord(cliques_[static_cast<std::size_t>(c)]);
     free_cliques_.push_back(c);
     --cliques_alive_;
   }
@@ -554,18 +646,20 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   std::vector<int>& new_lin_slot_of = p.new_lin_slot_of;
   new_slot_of.assign(p.linearized_new.size(), -1);
   new_lin_slot_of.assign(p.new_linear.size(), -1);
+  auto addSlot = [&](SlotFactor&& f, const LinearFactor& lf) {
+    const int s = allocSlot();
+    Slot& slot = slots_[static_cast<std::size_t>(s)];
+    slot.nonlinear = std::move(f);
+    storeLinearization(slot, lf.view());
+    slot.alive = true;
+    indexSlot(s);
+    return s;
+  };
   for (std::size_t i = 0; i < p.linearized_new.size(); ++i) {
-    const int s = allocSlot();
-    slots_[static_cast<std::size_t>(s)] = Slot{std::move(p.held_new[i]), std::move(p.linearized_new[i]), -1, true};
-    new_slot_of[i] = s;
-    indexSlot(s);
+    new_slot_of[i] = addSlot(std::move(p.held_new[i]), p.linearized_new[i]);
+    pool_.keep(std::move(p.linearized_new[i]));
   }
-  for (std::size_t i = 0; i < p.new_linear.size(); ++i) {
-    const int s = allocSlot();
-    slots_[static_cast<std::size_t>(s)] = Slot{SlotFactor(), p.new_linear[i], -1, true};
-    new_lin_slot_of[i] = s;
-    indexSlot(s);
-  }
+  for (std::size_t i = 0; i < p.new_linear.size(); ++i) new_lin_slot_of[i] = addSlot(SlotFactor(), p.new_linear[i]);
   const std::vector<Key>& ordering = p.ordering;
   p.fresh_id.resize(ordering.size());
   auto owned = p.fresh_owned.begin();
@@ -586,9 +680,11 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     var.rank = next_rank_++;
   }
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
-    Clique& cl = p.fresh[vi];
-    cl.parent = cl.separator().empty() ? -1 : vars_.at(cl.separator().front()).clique;
+    EliminatedClique& fresh = p.fresh[vi];
+    Clique cl = storeClique(fresh);
+    cl.parent = fresh.marginal.keys().empty() ? -1 : vars_.at(fresh.marginal.keys().front()).clique;
     cliques_[static_cast<std::size_t>(p.fresh_id[vi])] = std::move(cl);
+    pool_.keep(std::move(fresh));
   }
   root_ = -1;
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
@@ -601,7 +697,7 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     Clique& oc = cliques_[static_cast<std::size_t>(o)];
     int best = -1;
     std::int64_t best_rank = 0;
-    for (const auto& k : oc.separator()) {
+    for (const auto& k : separator(oc)) {
       const Var& v = vars_.at(k);
       if (best < 0 || v.rank < best_rank) {
         best = v.clique;
@@ -639,22 +735,24 @@ void BayesTreeEngine::backSubstituteTop(const UpdatePlan& p, EngineCounts& count
     if ((v.delta() - Eigen::Map<const Eigen::VectorXd>(old.data(), v.dim())).lpNorm<Eigen::Infinity>() > wildfire_)
       for (int ch : cliques_[static_cast<std::size_t>(c)].children) stack.push_back(ch);
   }
+  clearKeepingSmall(stack);  // a wildfire through the whole history grew it
 }
 
 void BayesTreeEngine::backSubstitute(int c) {
   const Clique& cl = cliques_[static_cast<std::size_t>(c)];
+  const auto C = conditional(cl);  // [R S d]
   // Solved in the frontal's own δ (its size: no allocation), the products
   // in a buffer that only grows (a scratch vector resized between a state's
   // and the constants' sizes reallocated at every clique).
   Eigen::Map<Eigen::VectorXd> rhs = vars_.at(cl.frontal).delta();
-  const Eigen::Index n = cl.conditional.rows();
-  rhs = cl.d();
+  const Eigen::Index n = cl.dv;
+  rhs = C.col(C.cols() - 1);
   std::vector<double>& buffer = scratch_.product;
   if (buffer.size() < static_cast<std::size_t>(n)) buffer.resize(static_cast<std::size_t>(n));
   Eigen::Map<Eigen::VectorXd> term(buffer.data(), n);
-  const auto S = cl.S();
+  const auto S = C.middleCols(n, cl.width);
   Eigen::Index col = 0;
-  for (const auto& k : cl.separator()) {
+  for (const auto& k : separator(cl)) {
     const auto ds = vars_.at(k).delta();
     term.noalias() = S.middleCols(col, ds.size()) * ds;  // the product, then the difference
     rhs -= term;
@@ -664,14 +762,14 @@ void BayesTreeEngine::backSubstitute(int c) {
     // R δ = rhs by columns, last first, as Eigen's solver does within its
     // 8-column panel (the same arithmetic), without its general-size
     // dispatch on a block: a fixed-lag update back-substitutes ~11 cliques.
-    const double* R = cl.conditional.data();  // column-major, R(i, j) = R[i + j·n]
+    const double* R = C.data();  // column-major, R(i, j) = R[i + j·n]
     for (Eigen::Index j = n - 1; j >= 0; --j) {
       if (rhs[j] == 0) continue;  // as Eigen: 0 / R(j, j) stays +0
       rhs[j] /= R[j + j * n];
       for (Eigen::Index i = 0; i < j; ++i) rhs[i] -= rhs[j] * R[i + j * n];
     }
   } else {
-    cl.R().triangularView<Eigen::Upper>().solveInPlace(rhs);
+    C.leftCols(n).triangularView<Eigen::Upper>().solveInPlace(rhs);
   }
 }
 
@@ -710,6 +808,7 @@ void BayesTreeEngine::solvePath(const Key& k) {
   path.clear();
   for (int c = vars_.at(k).clique; c >= 0; c = cliques_[static_cast<std::size_t>(c)].parent) path.push_back(c);
   for (auto it = path.rbegin(); it != path.rend(); ++it) backSubstitute(*it);
+  clearKeepingSmall(path);  // an old state's path grew it to the history's length
 }
 
 Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& keys) const {
@@ -727,7 +826,8 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
     // listing the path.
     // Y = R⁻ᵀ by forward substitution, column by column; Σ = YᵀY is
     // symmetric as computed (entry (i, j) and (j, i) sum the same products).
-    const auto R = cliques_[static_cast<std::size_t>(root_of_one)].R();
+    const Clique& root = cliques_[static_cast<std::size_t>(root_of_one)];
+    const auto R = conditional(root).leftCols(root.dv);
     const Eigen::Index n = R.rows();
     Eigen::MatrixXd& Y = scratch_.stacked;
     Y.setIdentity(n, n);
@@ -767,12 +867,13 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   for (int c : path) {
     const Clique& cl = cliques_[static_cast<std::size_t>(c)];
     const Eigen::Index r0 = off.at(cl.frontal);
-    const auto R = cl.R();
-    const auto S = cl.S();
+    const auto C = conditional(cl);
+    const auto R = C.leftCols(cl.dv);
+    const auto S = C.middleCols(cl.dv, cl.width);
     for (Eigen::Index i = 0; i < R.rows(); ++i)
       for (Eigen::Index j = i; j < R.cols(); ++j) trip.emplace_back(r0 + i, r0 + j, R(i, j));
     Eigen::Index col = 0;
-    for (const auto& k : cl.separator()) {
+    for (const auto& k : separator(cl)) {
       const Eigen::Index dk = vars_.at(k).dim();
       const Eigen::Index c0 = off.at(k);
       for (Eigen::Index i = 0; i < S.rows(); ++i)
@@ -798,9 +899,10 @@ double BayesTreeEngine::linearizationError(int slot) const {
   const Slot& s = slots_.at(static_cast<std::size_t>(slot));
   if (!s.nonlinear) return 0.0;
   Scratch& e = scratch_;
-  pointAt(s.linear.keys(), nullptr);  // x̂ = anchor + δ̂
+  const LinearView f = slotView(s);
+  pointAt(f.keys(), nullptr);  // x̂ = anchor + δ̂
   std::size_t i = 0;
-  s.linear.residual([&](const Key&) { return e.factor_vars[i++]->delta(); }, e.rlin, e.term);  // r_lin(δ̂)
+  f.residual([&](const Key&) { return e.factor_vars[i++]->delta(); }, e.rlin, e.term);  // r_lin(δ̂)
   s.nonlinear.linearizeRobustAt(e.x.data(), e.r, nullptr);  // a moved weight is a linearization error too
   return (e.r - e.rlin).norm();
 }
@@ -826,10 +928,10 @@ double BayesTreeEngine::cost() const {
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
-      pointAt(s.linear.keys(), nullptr);
+      pointAt(slotKeys(s), nullptr);
       c += s.nonlinear.linearizeRobustAt(scratch_.x.data(), r, nullptr);  // ½ρ(‖r‖²)
     } else {
-      s.linear.residual(deltaOf, r, term);
+      slotView(s).residual(deltaOf, r, term);
       c += 0.5 * r.squaredNorm();
     }
   }
@@ -844,13 +946,14 @@ void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
-      const FactorPtr f = s.nonlinear.toFactor(s.linear.keys());
+      const FactorPtr f = s.nonlinear.toFactor(slotKeys(s));
       f->linearizeRobust(x, r, &J);
       const Eigen::MatrixXd C = residualCurvature(*f, x, r);
       sys.add(f->keys(), r, J, &C);
     } else {  // r = Σ A δ − b in δ coordinates: J = A, no curvature
-      s.linear.residual(deltaOf, r, term);
-      sys.add(s.linear.keys().toVector(), r, s.linear.blocks(dimOf), nullptr);
+      const LinearView f = slotView(s);
+      f.residual(deltaOf, r, term);
+      sys.add(f.keys().toVector(), r, f.blocks(dimOf), nullptr);
     }
   }
 }
@@ -867,23 +970,26 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   // Drop the factors this clique consumed; they are summarized by its marginal.
   for (int s : cl.owned) {
     Slot& slot = slots_[static_cast<std::size_t>(s)];
-    for (const auto& k : slot.linear.keys()) {
+    for (const auto& k : slotKeys(slot)) {
       if (k.isConstants()) continue;
       Var* on = vars_.find(k);
       if (!on) continue;
       auto& v = on->slots;
       v.erase(std::remove(v.begin(), v.end(), s), v.end());
     }
-    pool_.keep(std::move(slot.linear));
+    releaseRecord(slot);
     slot = Slot{};
     free_slots_.push_back(s);
     --slots_alive_;
   }
   // Its marginal on the separator becomes a fixed linear prior (first-estimate
   // Jacobians), owned by the parent, which consumed it when it was eliminated.
-  if (parent >= 0 && cl.marginal.rows() > 0) {
+  if (parent >= 0 && cl.mrows > 0) {
     const int s = allocSlot();
-    slots_[static_cast<std::size_t>(s)] = Slot{SlotFactor(), std::move(cl.marginal), parent, true};
+    Slot& slot = slots_[static_cast<std::size_t>(s)];
+    storeLinearization(slot, marginalView(cl));  // unpacked: a slot's linearization is dense
+    slot.owner = parent;
+    slot.alive = true;
     indexSlot(s);
     cliques_[static_cast<std::size_t>(parent)].owned.push_back(s);
   }
@@ -893,8 +999,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   } else {
     root_ = -1;
   }
-  pool_.keep(std::move(cliques_[static_cast<std::size_t>(c)]));
-  cliques_[static_cast<std::size_t>(c)] = Clique{};
+  releaseRecord(cliques_[static_cast<std::size_t>(c)]);
   clique_alive_[static_cast<std::size_t>(c)] = false;
   free_cliques_.push_back(c);
   --cliques_alive_;

@@ -19,6 +19,7 @@
 
 #include "gssm/factors/factors.h"
 #include "solvers/slot_factor.h"
+#include "solvers/record_store.h"
 #include "solvers/small_list.h"
 #include "solvers/var_table.h"
 
@@ -38,10 +39,88 @@ class ByteWriter;
 class ByteReader;
 class NewtonSystem;
 
-/// Whitened linear factor in δ coordinates: r(δ) = Σ_i A_i δ_{keys[i]} − b,
-/// held as one matrix Ab = [A_1 … A_n | b], block i as wide as keys[i]'s
-/// variable. One heap block where separate ones took n + 2: a full-history
-/// run keeps one linear factor per factor and one per clique.
+/// Keys read in place: a stored slot's or a clique's separator.
+class KeySpan {
+ public:
+  KeySpan() = default;
+  KeySpan(const Key* first, std::size_t n) : first_(first), n_(n) {}
+  const Key* begin() const { return first_; }
+  const Key* end() const { return first_ + n_; }
+  std::size_t size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  const Key& operator[](std::size_t i) const { return first_[i]; }
+  const Key& front() const { return first_[0]; }
+  std::vector<Key> toVector() const { return std::vector<Key>(begin(), end()); }
+
+ private:
+  const Key* first_ = nullptr;
+  std::size_t n_ = 0;
+};
+
+/// Words of an upper-trapezoidal rows × cols matrix held by columns, column
+/// j with its first min(j + 1, rows) entries (a clique's marginal [R_S | d_S]).
+inline std::size_t packedWords(Eigen::Index rows, Eigen::Index cols) {
+  const auto m = static_cast<std::size_t>(rows), n = static_cast<std::size_t>(cols);
+  return n <= m ? n * (n + 1) / 2 : m * (m + 1) / 2 + (n - m) * m;
+}
+
+/// A whitened linear factor r(δ) = Σ_i A_i δ_{keys[i]} − b read where it is
+/// held, [A_1 … A_n | b] by columns, block i as wide as keys[i]'s variable;
+/// `packed`: upper trapezoidal, each column without its zeros below the
+/// diagonal (packedWords).
+struct LinearView {
+  KeySpan keys_;
+  const double* ab = nullptr;
+  Eigen::Index rows_ = 0, cols_ = 0;
+  bool packed = false;
+
+  const KeySpan& keys() const { return keys_; }
+  Eigen::Index rows() const { return rows_; }
+  Eigen::Index cols() const { return cols_; }
+  /// Column j's held entries, rows 0 … colLength(j) − 1 (the rest are zero).
+  const double* col(Eigen::Index j) const { return ab + (packed ? packedWords(rows_, j) : static_cast<std::size_t>(j * rows_)); }
+  Eigen::Index colLength(Eigen::Index j) const { return packed ? std::min(j + 1, rows_) : rows_; }
+  /// [A | b] as a dense matrix.
+  Eigen::MatrixXd dense() const {
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(rows_, cols_);
+    for (Eigen::Index j = 0; j < cols_; ++j)
+      m.col(j).head(colLength(j)) = Eigen::Map<const Eigen::VectorXd>(col(j), colLength(j));
+    return m;
+  }
+  /// [A | b] in place (not packed).
+  Eigen::Map<const Eigen::MatrixXd> Ab() const { return {ab, rows_, cols_}; }
+  auto b() const { return Ab().col(cols_ - 1); }
+  /// r = Σ_i A_i δ_i − b, with δ_i = delta(keys[i]) (whose sizes are the
+  /// blocks' widths); `term` is scratch. Not packed.
+  template <class Delta>
+  void residual(Delta&& delta, Eigen::VectorXd& r, Eigen::VectorXd& term) const {
+    r = -b();
+    Eigen::Index c = 0;
+    for (const auto& k : keys()) {
+      const auto& d = delta(k);  // a vector or a map of one
+      term.noalias() = Ab().middleCols(c, d.size()) * d;  // the product, then the sum
+      r += term;
+      c += d.size();
+    }
+  }
+  /// The blocks A_i as separate matrices, block i dim(keys[i]) wide.
+  template <class Dim>
+  std::vector<Eigen::MatrixXd> blocks(Dim&& dim) const {
+    const Eigen::MatrixXd m = dense();
+    std::vector<Eigen::MatrixXd> out;
+    Eigen::Index c = 0;
+    for (const auto& k : keys()) {
+      const Eigen::Index w = dim(k);
+      out.emplace_back(m.middleCols(c, w));
+      c += w;
+    }
+    return out;
+  }
+};
+
+/// A linear factor being built (a linearization, an elimination's
+/// marginal) or added: its own keys and matrix [A_1 … A_n | b]. The engine
+/// holds what it keeps in its RecordStore instead.
 struct LinearFactor {
   const KeyList& keys() const { return keys_; }
   /// Sets its keys, in the storage it has (a pooled factor's: no allocation).
@@ -52,6 +131,7 @@ struct LinearFactor {
   Eigen::MatrixXd Ab;
   Eigen::Index rows() const { return Ab.rows(); }
   auto b() const { return Ab.col(Ab.cols() - 1); }
+  LinearView view() const { return {KeySpan(keys_.begin(), keys_.size()), Ab.data(), Ab.rows(), Ab.cols(), false}; }
   /// Lays the blocks A_i side by side in Ab with room for b after them
   /// (b's column is the caller's to fill); the inverse of blocks().
   void setBlocks(const std::vector<Eigen::MatrixXd>& A, Eigen::Index rows) {
@@ -64,51 +144,34 @@ struct LinearFactor {
       col += a.cols();
     }
   }
-  /// r = Σ_i A_i δ_i − b, with δ_i = delta(keys[i]) (whose sizes are the
-  /// blocks' widths); `term` is scratch.
-  template <class Delta>
-  void residual(Delta&& delta, Eigen::VectorXd& r, Eigen::VectorXd& term) const {
-    r = -b();
-    Eigen::Index col = 0;
-    for (const auto& k : keys()) {
-      const auto& d = delta(k);  // a vector or a map of one
-      term.noalias() = Ab.middleCols(col, d.size()) * d;  // the product, then the sum
-      r += term;
-      col += d.size();
-    }
-  }
-  /// The blocks A_i as separate matrices, block i dim(keys[i]) wide.
-  template <class Dim>
-  std::vector<Eigen::MatrixXd> blocks(Dim&& dim) const {
-    std::vector<Eigen::MatrixXd> out;
-    Eigen::Index col = 0;
-    for (const auto& k : keys()) {
-      const Eigen::Index w = dim(k);
-      out.emplace_back(Ab.middleCols(col, w));
-      col += w;
-    }
-    return out;
-  }
 
  private:
   KeyList keys_;
 };
 
+/// A clique as an elimination makes it: the conditional [R S d] in one
+/// matrix (R upper triangular d_f × d_f, S d_f × Σ d_sep, d d_f) and the
+/// marginal its subtree passes to its parent, on the separator (its keys).
+/// Kept in the engine's pool between updates for their storage.
+struct EliminatedClique {
+  Key frontal;
+  Eigen::MatrixXd conditional;
+  LinearFactor marginal;
+  SmallList<int, 2> owned;  // factor slots consumed by this clique's elimination
+};
+
+/// A clique as the engine holds it: the frontal variable, the tree links, and
+/// one record [separator keys | conditional [R S d] | marginal packed].
 struct Clique {
   Key frontal;
-  /// The conditional [R S d] in one matrix: R upper triangular (d_f × d_f),
-  /// S (d_f × Σ d_sep), d (d_f).
-  Eigen::MatrixXd conditional;
-  /// What this subtree passes to its parent, on the separator; its keys are
-  /// the separator (held once).
-  LinearFactor marginal;
-  const KeyList& separator() const { return marginal.keys(); }
-  SmallList<int, 2> owned;  // factor slots consumed by this clique's elimination
+  RecordStore::Ref record = 0;
+  std::uint16_t nsep = 0, dv = 0, width = 0, mrows = 0;  // [R S d] is dv × (dv + width + 1); marginal mrows × (width + 1)
   int parent = -1;
+  SmallList<int, 2> owned;     // factor slots consumed by this clique's elimination
   SmallList<int, 2> children;  // a chain's clique owns two factors and has one child: inline
-  auto R() const { return conditional.leftCols(conditional.rows()); }
-  auto S() const { return conditional.middleCols(conditional.rows(), conditional.cols() - conditional.rows() - 1); }
-  auto d() const { return conditional.col(conditional.cols() - 1); }
+  std::size_t conditionalOffset() const { return nsep; }
+  std::size_t marginalOffset() const { return nsep + std::size_t{dv} * (dv + width + 1u); }
+  std::size_t words() const { return marginalOffset() + packedWords(mrows, width + 1); }
 };
 
 // Where an input of the elimination comes from, so that commit() can give
@@ -148,8 +211,8 @@ struct UpdateLists {
   std::vector<int> removed_order;                   // cliques of the top, leaf to root
   std::vector<int> orphans;                         // subtrees hanging below the top
   std::vector<Key> keys;                            // variables to eliminate
-  std::vector<std::pair<const LinearFactor*, InputSource>> inputs;
-  std::vector<Clique> fresh;                        // one per ordering entry
+  std::vector<std::pair<LinearView, InputSource>> inputs;
+  std::vector<EliminatedClique> fresh;              // one per ordering entry
   // The factor inputs each fresh clique consumed, as (clique, source) in
   // clique order (one list per update, not one per clique).
   std::vector<std::pair<std::size_t, InputSource>> fresh_owned;
@@ -184,9 +247,10 @@ struct EngineCounts {
   int orphans = 0;
   int factors_relinearized = 0;
   int variables_backsubstituted = 0;
-  /// Zeroes the counts, keeping top's storage (a smoother reuses one per update).
+  /// Zeroes the counts, keeping top's storage unless a whole-history
+  /// update grew it (a smoother reuses one per update).
   void clear() {
-    top.clear();
+    clearKeepingSmall(top);
     cliques_reeliminated = orphans = factors_relinearized = variables_backsubstituted = 0;
   }
 };
@@ -281,12 +345,36 @@ class BayesTreeEngine {
 
  private:
   using Var = EngineVar;
+  /// A factor: the nonlinear one (none: a fixed linear factor) and its
+  /// linearization, held as the record [keys | Ab] (rows × cols).
   struct Slot {
-    SlotFactor nonlinear;  // none: a fixed linear factor
-    LinearFactor linear;
-    int owner = -1;
+    SlotFactor nonlinear;
+    RecordStore::Ref record = 0;
+    std::uint16_t nkeys = 0, rows = 0, cols = 0;
     bool alive = false;
+    int owner = -1;
+    std::size_t words() const { return nkeys + std::size_t{rows} * cols; }
   };
+  LinearView slotView(const Slot& s) const {
+    return {KeySpan(records_.keys(s.record), s.nkeys), records_.doubles(s.record, s.nkeys), s.rows, s.cols, false};
+  }
+  KeySpan slotKeys(const Slot& s) const { return KeySpan(records_.keys(s.record), s.nkeys); }
+  KeySpan separator(const Clique& c) const { return KeySpan(records_.keys(c.record), c.nsep); }
+  /// [R S d], dv × (dv + width + 1).
+  Eigen::Map<const Eigen::MatrixXd> conditional(const Clique& c) const {
+    return {records_.doubles(c.record, c.conditionalOffset()), c.dv, c.dv + c.width + 1};
+  }
+  LinearView marginalView(const Clique& c) const {
+    return {separator(c), records_.doubles(c.record, c.marginalOffset()), c.mrows, c.width + 1, true};
+  }
+  /// Holds `f` as slot s's keys and linearization (in its record if it has
+  /// one of that size).
+  void storeLinearization(Slot& s, const LinearView& f);
+  /// Gives slot s's record back (the slot keeps no linearization).
+  void releaseRecord(Slot& s);
+  /// The stored form of a clique an elimination made.
+  Clique storeClique(const EliminatedClique& e);
+  void releaseRecord(Clique& c);
 
   struct UpdatePlan;  // the work of one update before it is committed (bayes_tree.cpp)
   void linearizeInputs(UpdatePlan& plan) const;
@@ -305,7 +393,7 @@ class BayesTreeEngine {
   template <class Keys>
   void pointAt(const Keys& keys, const Values* extra) const;
   /// The elimination order of `keys` into `out`.
-  void order(const std::vector<Key>& keys, const std::vector<const LinearFactor*>& factors,
+  void order(const std::vector<Key>& keys, const std::vector<std::pair<LinearView, InputSource>>& factors,
              const Values& new_vars, std::vector<Key>& out) const;
   void backSubstitute(int c);
   int allocClique();
@@ -316,6 +404,7 @@ class BayesTreeEngine {
   OrderingMode mode_;
   double wildfire_;
   VarTable vars_;  // each state lists the factor slots on it
+  RecordStore records_;  // the slots' and cliques' keys and matrices
   std::vector<Clique> cliques_;
   std::vector<bool> clique_alive_;
   std::vector<int> free_cliques_;
@@ -339,23 +428,23 @@ class BayesTreeEngine {
     Eigen::MatrixXd stacked;  // a clique's [A | b] while it is triangularized
     std::vector<Key> separator;
     std::vector<std::vector<std::size_t>> pending_of;  // eliminateTop's queue, per ordering entry
-    std::vector<const LinearFactor*> pend;             // eliminateTop's inputs, then the marginals it makes
+    std::vector<LinearView> pend;                      // eliminateTop's inputs, then the marginals it makes
     std::vector<std::optional<InputSource>> pend_source;  // where each came from (nullopt: made there)
     std::vector<double> before;                        // backSubstituteTop: an orphan's δ before
     std::vector<int> path;                             // solvePath's cliques, leaf to root; backSubstituteTop's stack
     std::vector<char> in_top;                          // detachTop's marks, by clique id (all 0 between calls)
   };
   mutable NotCopied<Scratch> scratch_;
-  // Cliques replaced by an update and linearizations of dropped factors,
-  // kept so the next elimination and linearization refill their matrices
-  // and lists in place instead of allocating new ones (a fixed-lag update
-  // replaces the same few cliques and factors every step).
+  // Cliques an update made (once stored) and linearizations it made or
+  // dropped, kept so the next elimination and linearization refill their
+  // matrices and lists in place instead of allocating new ones (a fixed-lag
+  // update makes the same few cliques and factors every step).
   struct CliquePool {
     static constexpr std::size_t kMax = 64;
-    std::vector<Clique> spare;
+    std::vector<EliminatedClique> spare;
     std::vector<LinearFactor> spare_linear;  // linearizations of dropped factors, refilled by linearize()
     /// Keeps what an update discards, up to kMax of each.
-    void keep(Clique&& c) {
+    void keep(EliminatedClique&& c) {
       if (spare.size() < kMax) spare.push_back(std::move(c));
     }
     void keep(LinearFactor&& f) {

@@ -2,6 +2,7 @@
 // cliques as empty placeholders (their indices stay free), so allocation
 // after a restore picks the same indices as the uninterrupted run.
 #include <algorithm>
+#include <limits>
 #include <unordered_set>
 
 #include "core/byte_stream.h"
@@ -14,12 +15,12 @@ namespace gssm::internal {
 // from before the blocks were held side by side: old checkpoints still load).
 namespace {
 template <class Dim>
-void writeLinear(ByteWriter& out, const LinearFactor& f, Dim&& dim) {
+void writeLinear(ByteWriter& out, const LinearView& f, Dim&& dim) {
   out.keys(f.keys().toVector());
   const std::vector<Eigen::MatrixXd> blocks = f.blocks(dim);
   out.u64(blocks.size());
   for (const auto& a : blocks) out.mat(a);
-  out.vec(f.rows() > 0 || f.Ab.cols() > 0 ? Eigen::VectorXd(f.b()) : Eigen::VectorXd());
+  out.vec(f.cols() > 0 ? Eigen::VectorXd(f.dense().col(f.cols() - 1)) : Eigen::VectorXd());
 }
 LinearFactor readLinear(ByteReader& in, const Model& model, const std::string& what) {
   LinearFactor f;
@@ -38,6 +39,9 @@ LinearFactor readLinear(ByteReader& in, const Model& model, const std::string& w
               std::to_string(variableDim(model, keys[i])));
   f.setBlocks(blocks, b.size());
   f.Ab.col(f.Ab.cols() - 1) = b;
+  constexpr Eigen::Index kMax = std::numeric_limits<std::uint16_t>::max();  // an engine record's sizes
+  if (static_cast<Eigen::Index>(keys.size()) > kMax || f.Ab.rows() > kMax || f.Ab.cols() > kMax)
+    in.fail(what + ": more than " + std::to_string(kMax) + " keys, rows or columns");
   return f;
 }
 }  // namespace
@@ -64,8 +68,8 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     out.boolean(s.alive);
     if (!s.alive) continue;
     out.boolean(static_cast<bool>(s.nonlinear));
-    if (s.nonlinear) writeFactor(out, *s.nonlinear.toFactor(s.linear.keys()));
-    writeLinear(out, s.linear, dimOf);
+    if (s.nonlinear) writeFactor(out, *s.nonlinear.toFactor(slotKeys(s)));
+    writeLinear(out, slotView(s), dimOf);
     out.i32(s.owner);
   }
   out.ints(free_slots_);
@@ -75,11 +79,12 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     if (!clique_alive_[c]) continue;
     const Clique& cl = cliques_[c];
     out.key(cl.frontal);
-    out.keys(cl.separator().toVector());
-    out.mat(cl.R());
-    out.mat(cl.S());
-    out.vec(cl.d());
-    writeLinear(out, cl.marginal, dimOf);
+    out.keys(separator(cl).toVector());
+    const auto C = conditional(cl);
+    out.mat(C.leftCols(cl.dv));
+    out.mat(C.middleCols(cl.dv, cl.width));
+    out.vec(C.col(C.cols() - 1));
+    writeLinear(out, marginalView(cl), dimOf);
     out.ints(cl.owned.toVector());
     out.i32(cl.parent);
     out.ints(cl.children.toVector());
@@ -131,11 +136,12 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     ++e.slots_alive_;
     FactorPtr factor;
     if (in.boolean((name + " has a nonlinear factor").c_str())) factor = readFactor(in, model, name);
-    slot.linear = readLinear(in, model, name + " linearization");
+    const LinearFactor linear = readLinear(in, model, name + " linearization");
     if (factor) {  // the slot holds it as a running engine does (a model's factor as its numbers)
-      if (slot.linear.keys() != factor->keys()) in.fail(name + ": its linearization does not match its factor");
+      if (linear.keys() != factor->keys()) in.fail(name + ": its linearization does not match its factor");
       slot.nonlinear = SlotFactor(factor);
     }
+    e.storeLinearization(slot, linear.view());
     slot.owner = in.i32((name + " owner").c_str());
   }
   e.free_slots_ = in.ints("engine free slots");
@@ -146,26 +152,35 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     if (!in.boolean((name + " alive").c_str())) continue;
     e.clique_alive_[c] = true;
     ++e.cliques_alive_;
-    Clique& cl = e.cliques_[c];
-    cl.frontal = in.key(name + " frontal");
+    EliminatedClique el;
+    el.frontal = in.key(name + " frontal");
     const std::vector<Key> separator = in.keys(name + " separator");
     const Eigen::MatrixXd R = in.mat(name + " R");
     const Eigen::MatrixXd S = in.mat(name + " S");
     const Eigen::VectorXd d = in.vec(name + " d");
     if (R.rows() != R.cols() || S.rows() != R.rows() || d.size() != R.rows())
       in.fail(name + ": its conditional's R, S and d do not fit together");
-    cl.conditional.resize(R.rows(), R.cols() + S.cols() + 1);
-    cl.conditional << R, S, d;
-    cl.marginal = readLinear(in, model, name + " marginal");
-    if (cl.marginal.keys() != separator) {
+    el.conditional.resize(R.rows(), R.cols() + S.cols() + 1);
+    el.conditional << R, S, d;
+    el.marginal = readLinear(in, model, name + " marginal");
+    if (el.marginal.keys() != separator) {
       // The separator is held once, as the marginal's keys; an empty marginal
       // (a checkpoint may hold one) is an empty factor on the separator.
-      if (!cl.marginal.keys().empty()) in.fail(name + ": its marginal is not on its separator");
+      if (!el.marginal.keys().empty()) in.fail(name + ": its marginal is not on its separator");
       Eigen::Index width = 0;
       for (const auto& k : separator) width += variableDim(model, k);
-      cl.marginal.setKeys(separator);
-      cl.marginal.Ab.resize(0, width + 1);
+      el.marginal.setKeys(separator);
+      el.marginal.Ab.resize(0, width + 1);
     }
+    // Held packed, as an elimination leaves it: upper trapezoidal.
+    const Eigen::MatrixXd& m = el.marginal.Ab;
+    for (Eigen::Index j = 0; j < m.cols(); ++j)
+      for (Eigen::Index i = j + 1; i < m.rows(); ++i)
+        if (m(i, j) != 0) in.fail(name + ": its marginal is not upper triangular");
+    constexpr Eigen::Index kMax = std::numeric_limits<std::uint16_t>::max();
+    if (R.rows() > kMax || S.cols() > kMax) in.fail(name + ": its conditional is larger than the engine holds");
+    Clique& cl = e.cliques_[c];
+    cl = e.storeClique(el);
     const std::vector<int> owned = in.ints(name + " owned slots");
     cl.owned.assign(owned.begin(), owned.end());
     cl.parent = in.i32((name + " parent").c_str());
@@ -198,13 +213,13 @@ std::string BayesTreeEngine::invariantViolation() const {
     const Var* v = vars_.find(k);
     return v ? v->dim() : -1;
   };
-  auto linearOk = [&](const LinearFactor& f, const std::string& what) -> std::string {
+  auto linearOk = [&](const LinearView& f, const std::string& what) -> std::string {
     Eigen::Index width = 0;
     for (const auto& k : f.keys()) {
       if (dim(k) < 0) return what + " uses " + k.toString() + ", which is not a variable";
       width += dim(k);
     }
-    if (f.Ab.cols() != width + 1) return what + ": its blocks are not as wide as its variables";
+    if (f.cols() != width + 1) return what + ": its blocks are not as wide as its variables";
     return "";
   };
   if (clique_alive_.size() != cliques_.size()) return "clique flags and cliques differ in number";
@@ -226,9 +241,10 @@ std::string BayesTreeEngine::invariantViolation() const {
     if (!slot.alive) continue;
     ++alive_slots;
     const std::string what = "factor slot " + std::to_string(s);
-    const std::string lin = linearOk(slot.linear, what);
+    if (slot.record + slot.words() > records_.wordsUsed()) return what + ": its record is out of range";
+    const std::string lin = linearOk(slotView(slot), what);
     if (!lin.empty()) return lin;
-    if (slot.nonlinear && (!slot.nonlinear.fitsKeys(slot.linear.keys()) || slot.nonlinear.dim() != slot.linear.rows()))
+    if (slot.nonlinear && (!slot.nonlinear.fitsKeys(slotKeys(slot)) || slot.nonlinear.dim() != slot.rows))
       return what + ": its linearization does not match its factor";
     if (!aliveClique(slot.owner)) return what + " is owned by no live clique";
     const auto& owned = cliques_[static_cast<std::size_t>(slot.owner)].owned;
@@ -246,14 +262,14 @@ std::string BayesTreeEngine::invariantViolation() const {
     const std::string what = "clique " + std::to_string(c);
     const Eigen::Index df = dim(cl.frontal);
     if (df < 0 || vars_.at(cl.frontal).clique != c) return what + ": its frontal variable does not point back to it";
+    if (cl.record + cl.words() > records_.wordsUsed()) return what + ": its record is out of range";
     Eigen::Index dsep = 0;
-    for (const auto& k : cl.separator()) {
+    for (const auto& k : separator(cl)) {
       if (dim(k) < 0 || k == cl.frontal) return what + ": separator variable " + k.toString() + " is invalid";
       dsep += dim(k);
     }
-    if (cl.conditional.rows() != df || cl.conditional.cols() != df + dsep + 1)
-      return what + ": conditional has the wrong size";
-    const std::string lin = linearOk(cl.marginal, what + " marginal");
+    if (cl.dv != df || cl.width != dsep) return what + ": conditional has the wrong size";
+    const std::string lin = linearOk(marginalView(cl), what + " marginal");
     if (!lin.empty()) return lin;
     for (int s : cl.owned)
       if (!aliveSlot(s) || slots_[static_cast<std::size_t>(s)].owner != c) return what + " owns slot " + std::to_string(s) + " that is not its own";
@@ -261,8 +277,8 @@ std::string BayesTreeEngine::invariantViolation() const {
       if (!aliveClique(cl.parent)) return what + ": parent is not a live clique";
       const auto& ch = cliques_[static_cast<std::size_t>(cl.parent)].children;
       if (std::count(ch.begin(), ch.end(), c) != 1) return what + ": its parent does not list it once";
-      if (cl.separator().empty()) return what + " has a parent but no separator";
-    } else if (!cl.separator().empty()) {
+      if (cl.nsep == 0) return what + " has a parent but no separator";
+    } else if (cl.nsep != 0) {
       return what + " has a separator but no parent";
     }
     for (int ch : cl.children)

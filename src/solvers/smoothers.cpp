@@ -231,7 +231,7 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
     // being re-eliminated anyway.
     for (int it = 0; it < options.max_local_iterations; ++it) {
       std::vector<int>& local = local_slots_;
-      local.clear();
+      internal::clearKeepingSmall(local);  // a whole-history top grew it
       for (const auto& k : counts.top)
         if (!k.isConstants()) engine.appendSlotsOf(k, local);
       std::sort(local.begin(), local.end());
