@@ -43,16 +43,16 @@ std::vector<Eigen::VectorXd> randomPoint(const Model& m, const Factor& f, std::m
 // Held as numbers, f evaluates exactly as itself, and comes back as an
 // equal object.
 void expectSameEvaluation(const Model& m, const FactorPtr& f, std::mt19937& rng) {
-  const SlotFactor held(f);
+  const SlotFactor held(f, &m);
   ASSERT_TRUE(static_cast<bool>(held));
-  EXPECT_EQ(held.dim(), f->dim());
-  EXPECT_TRUE(held.fitsKeys(f->keys()));
+  EXPECT_EQ(held.dim(&m), f->dim());
+  EXPECT_TRUE(held.fitsKeys(&m, f->keys()));
   const std::vector<Key> reversed(f->keys().rbegin(), f->keys().rend());
   if (reversed.size() > 1) {
-    EXPECT_FALSE(held.fitsKeys(reversed));  // (the step is the keys': any step fits)
+    EXPECT_FALSE(held.fitsKeys(&m, reversed));  // (the step is the keys': any step fits)
   }
-  EXPECT_FALSE(held.fitsKeys(std::vector<Key>(f->keys().begin(), f->keys().end() - 1)));
-  const FactorPtr back = held.toFactor(f->keys());
+  EXPECT_FALSE(held.fitsKeys(&m, std::vector<Key>(f->keys().begin(), f->keys().end() - 1)));
+  const FactorPtr back = held.toFactor(&m, f->keys());
   EXPECT_EQ(back->describe(), f->describe());
   EXPECT_EQ(back->keys(), f->keys());
   for (int trial = 0; trial < 4; ++trial) {
@@ -62,7 +62,7 @@ void expectSameEvaluation(const Model& m, const FactorPtr& f, std::mt19937& rng)
     Eigen::VectorXd r_object, r_held, r_back;
     std::vector<Eigen::MatrixXd> J_object, J_held, J_back;
     const double cost_object = f->linearizeRobustAt(at.data(), r_object, &J_object);
-    const double cost_held = held.linearizeRobustAt(at.data(), r_held, &J_held);
+    const double cost_held = held.linearizeRobustAt(&m, at.data(), r_held, &J_held);
     const double cost_back = back->linearizeRobustAt(at.data(), r_back, &J_back);
     EXPECT_EQ(cost_held, cost_object) << f->describe();
     EXPECT_EQ(cost_back, cost_object);
@@ -74,7 +74,7 @@ void expectSameEvaluation(const Model& m, const FactorPtr& f, std::mt19937& rng)
       EXPECT_TRUE(J_back[i] == J_object[i]);
     }
     Eigen::VectorXd r_only;
-    EXPECT_EQ(held.linearizeRobustAt(at.data(), r_only, nullptr), cost_object);
+    EXPECT_EQ(held.linearizeRobustAt(&m, at.data(), r_only, nullptr), cost_object);
     EXPECT_TRUE(r_only == r_object);
   }
 }
@@ -111,10 +111,23 @@ TEST(SlotFactor, OtherFactorsAreKeptAsTheyAre) {
   const models::Radar2D radar;
   const FactorPtr prior = std::make_shared<PriorFactor>(Key::state(3), Gaussian{Eigen::VectorXd::Constant(1, 2.0),
                                                                                 Eigen::MatrixXd::Identity(1, 1)});
-  const SlotFactor held(prior);
-  EXPECT_EQ(held.toFactor(prior->keys()), prior);  // the same object
+  const SlotFactor held(prior, &radar);
+  EXPECT_EQ(held.toFactor(&radar, prior->keys()), prior);  // the same object
+  EXPECT_EQ(SlotFactor::modelOf(prior), nullptr);
   std::mt19937 rng(13);
   expectSameEvaluation(radar, prior, rng);
   EXPECT_FALSE(static_cast<bool>(SlotFactor()));
-  EXPECT_FALSE(static_cast<bool>(SlotFactor(FactorPtr())));
+  EXPECT_FALSE(static_cast<bool>(SlotFactor(FactorPtr(), &radar)));
+}
+
+// A slot holds one model's factors as numbers (the engine's, named in every
+// call); another model's factor stays an object and evaluates as itself.
+TEST(SlotFactor, AnotherModelsFactorIsKeptAsAnObject) {
+  const models::Radar2D radar, other;
+  const FactorPtr f = std::make_shared<MeasurementFactor>(other, 5, Eigen::VectorXd::Constant(1, 1002.0));
+  EXPECT_EQ(SlotFactor::modelOf(f), &other);
+  const SlotFactor held(f, &radar);
+  EXPECT_EQ(held.toFactor(&radar, f->keys()), f);  // kept as it is, not rebuilt on radar
+  EXPECT_EQ(SlotFactor(f, &other).toFactor(&other, f->keys())->describe(), f->describe());
+  EXPECT_NE(SlotFactor(f, &other).toFactor(&other, f->keys()), f);  // held as numbers, rebuilt
 }

@@ -146,7 +146,7 @@ namespace {
 // n doubles from `from` to `to`, inline (std::copy_n calls memmove: a call
 // per column of a few entries, 1% of a fixed-lag update).
 inline double* copyDoubles(const double* from, Eigen::Index n, double* to) {
-  Eigen::Map<Eigen::VectorXd>(to, n) = Eigen::Map<const Eigen::VectorXd>(from, n);
+  for (Eigen::Index i = 0; i < n; ++i) to[i] = from[i];
   return to + n;
 }
 template <class Keys>
@@ -182,8 +182,7 @@ void BayesTreeEngine::storeLinearization(Slot& s, const LinearView& f) {
   }
 }
 
-Clique BayesTreeEngine::storeClique(const EliminatedClique& e) {
-  Clique c;
+void BayesTreeEngine::storeClique(const EliminatedClique& e, Clique& c) {
   c.frontal = e.frontal;
   const KeyList& sep = e.marginal.keys();
   c.nsep = narrow16(static_cast<Eigen::Index>(sep.size()));
@@ -200,12 +199,15 @@ Clique BayesTreeEngine::storeClique(const EliminatedClique& e) {
     m = copyDoubles(e.marginal.Ab.data() + j * c.mrows, n, m);
   }
   c.owned = e.owned;
-  return c;
 }
 
 void BayesTreeEngine::releaseRecord(Clique& c) {
   records_.release(c.record, c.words());
-  c = Clique{};
+  c.record = 0;
+  c.nsep = c.dv = c.width = c.mrows = 0;
+  c.parent = -1;
+  c.owned.clear();
+  c.children.clear();
 }
 
 int BayesTreeEngine::allocSlot() {
@@ -254,7 +256,8 @@ void BayesTreeEngine::pointAt(const Keys& keys, const Values* extra) const {
 // Linearizes f at the current estimate: r(x) ≈ r(x̂) + J (δ − δ̂), i.e.
 // A = J, b = J δ̂ − r(x̂). `extra` holds initial values of variables being added.
 template <class Keys>
-LinearFactor BayesTreeEngine::linearize(const SlotFactor& f, const Keys& keys, const Values& extra) const {
+LinearFactor BayesTreeEngine::linearize(const SlotFactor& f, const Model* model, const Keys& keys,
+                                        const Values& extra) const {
   pointAt(keys, &extra);
   const std::vector<const Var*>& known = scratch_.factor_vars;  // null: a new variable (δ̂ = 0)
   LinearFactor lf;
@@ -265,11 +268,11 @@ LinearFactor BayesTreeEngine::linearize(const SlotFactor& f, const Keys& keys, c
   lf.setKeys(keys);
   Eigen::VectorXd& r = scratch_.r;
   std::vector<Eigen::MatrixXd>& J = scratch_.J;
-  f.linearizeRobustAt(scratch_.x.data(), r, &J);  // robust factors reweighted at each linearization
+  f.linearizeRobustAt(model, scratch_.x.data(), r, &J);  // robust factors reweighted at each linearization
   bool finite = r.allFinite();
   for (const auto& a : J) finite = finite && a.allFinite();
   if (!finite)
-    throw NumericalError("factor '" + f.toFactor(keys)->describe() +
+    throw NumericalError("factor '" + f.toFactor(model, keys)->describe() +
                          "' has a non-finite residual or Jacobian at the current estimate");
   lf.setBlocks(J, r.size());
   auto b = lf.Ab.col(lf.Ab.cols() - 1);
@@ -362,6 +365,7 @@ struct BayesTreeEngine::UpdatePlan {
   const Values& new_variables;
   const std::vector<FactorPtr>& new_factors;
   const std::vector<LinearFactor>& new_linear;
+  const Model* model = nullptr;  // the engine's, or the first model factor's (commit() keeps it)
   std::unordered_map<int, LinearFactor> relinearized;  // by slot (linearizeInputs)
   // The rest lives in the engine's UpdateLists, emptied here, so that its
   // vectors keep their capacity from update to update.
@@ -381,6 +385,7 @@ struct BayesTreeEngine::UpdatePlan {
 
 void BayesTreeEngine::update(const EngineUpdate& u, EngineCounts& counts) {
   UpdatePlan plan(u, lists_);
+  plan.model = model_;
   linearizeInputs(plan);  // validates; nothing modified until commit()
   detachTop(plan);
   eliminateTop(plan);
@@ -404,8 +409,9 @@ void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
       if (!known(k))
         throw InvalidArgument("factor '" + f->describe() + "' uses " + k.toString() +
                               ", which is neither in the smoother nor added with it");
-    p.held_new.emplace_back(f);
-    p.linearized_new.push_back(linearize(p.held_new.back(), f->keys(), p.new_variables));
+    if (!p.model) p.model = SlotFactor::modelOf(f);  // the engine's from the first model factor on
+    p.held_new.emplace_back(f, p.model);
+    p.linearized_new.push_back(linearize(p.held_new.back(), p.model, f->keys(), p.new_variables));
     checkHoldable(p.linearized_new.back(), [&] { return "factor '" + f->describe() + "'"; });
   }
   for (const auto& lf : p.new_linear) {
@@ -415,7 +421,8 @@ void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
   }
   for (int s : p.update.relinearize) {
     const Slot& slot = slots_.at(static_cast<std::size_t>(s));
-    if (slot.alive && slot.nonlinear) p.relinearized[s] = linearize(slot.nonlinear, slotKeys(slot), p.new_variables);
+    if (slot.alive && slot.nonlinear)
+      p.relinearized[s] = linearize(slot.nonlinear, p.model, slotKeys(slot), p.new_variables);
   }
 }
 
@@ -628,6 +635,7 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
 // slots, and re-attach the orphans below the lowest of their separator's
 // cliques. Nothing here throws short of memory.
 void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
+  model_ = p.model;
   for (auto& kv : p.relinearized) {
     storeLinearization(slots_[static_cast<std::size_t>(kv.first)], kv.second.view());  // same size: in place
     pool_.keep(std::move(kv.second));
@@ -681,9 +689,9 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   }
   for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
     EliminatedClique& fresh = p.fresh[vi];
-    Clique cl = storeClique(fresh);
+    Clique& cl = cliques_[static_cast<std::size_t>(p.fresh_id[vi])];  // a free one: no record, no links
+    storeClique(fresh, cl);
     cl.parent = fresh.marginal.keys().empty() ? -1 : vars_.at(fresh.marginal.keys().front()).clique;
-    cliques_[static_cast<std::size_t>(p.fresh_id[vi])] = std::move(cl);
     pool_.keep(std::move(fresh));
   }
   root_ = -1;
@@ -903,7 +911,7 @@ double BayesTreeEngine::linearizationError(int slot) const {
   pointAt(f.keys(), nullptr);  // x̂ = anchor + δ̂
   std::size_t i = 0;
   f.residual([&](const Key&) { return e.factor_vars[i++]->delta(); }, e.rlin, e.term);  // r_lin(δ̂)
-  s.nonlinear.linearizeRobustAt(e.x.data(), e.r, nullptr);  // a moved weight is a linearization error too
+  s.nonlinear.linearizeRobustAt(model_, e.x.data(), e.r, nullptr);  // a moved weight is a linearization error too
   return (e.r - e.rlin).norm();
 }
 
@@ -929,7 +937,7 @@ double BayesTreeEngine::cost() const {
     if (!s.alive) continue;
     if (s.nonlinear) {
       pointAt(slotKeys(s), nullptr);
-      c += s.nonlinear.linearizeRobustAt(scratch_.x.data(), r, nullptr);  // ½ρ(‖r‖²)
+      c += s.nonlinear.linearizeRobustAt(model_, scratch_.x.data(), r, nullptr);  // ½ρ(‖r‖²)
     } else {
       slotView(s).residual(deltaOf, r, term);
       c += 0.5 * r.squaredNorm();
@@ -946,7 +954,7 @@ void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
   for (const auto& s : slots_) {
     if (!s.alive) continue;
     if (s.nonlinear) {
-      const FactorPtr f = s.nonlinear.toFactor(slotKeys(s));
+      const FactorPtr f = s.nonlinear.toFactor(model_, slotKeys(s));
       f->linearizeRobust(x, r, &J);
       const Eigen::MatrixXd C = residualCurvature(*f, x, r);
       sys.add(f->keys(), r, J, &C);

@@ -372,8 +372,9 @@ class BayesTreeEngine {
   void storeLinearization(Slot& s, const LinearView& f);
   /// Gives slot s's record back (the slot keeps no linearization).
   void releaseRecord(Slot& s);
-  /// The stored form of a clique an elimination made.
-  Clique storeClique(const EliminatedClique& e);
+  /// Makes `into` (a free clique: no record, no links) the stored form of a
+  /// clique an elimination made; its parent and children are the caller's.
+  void storeClique(const EliminatedClique& e, Clique& into);
   void releaseRecord(Clique& c);
 
   struct UpdatePlan;  // the work of one update before it is committed (bayes_tree.cpp)
@@ -386,7 +387,7 @@ class BayesTreeEngine {
   /// f on `keys` linearized at the current estimate (`extra`: values of
   /// variables being added).
   template <class Keys>
-  LinearFactor linearize(const SlotFactor& f, const Keys& keys, const Values& extra) const;
+  LinearFactor linearize(const SlotFactor& f, const Model* model, const Keys& keys, const Values& extra) const;
   /// Points scratch_.x at the estimate of each of `keys` (anchor + δ, or
   /// extra's value of a variable being added); scratch_.factor_vars[i] is
   /// keys[i]'s variable, null if new.
@@ -404,6 +405,9 @@ class BayesTreeEngine {
   OrderingMode mode_;
   double wildfire_;
   VarTable vars_;  // each state lists the factor slots on it
+  // The model whose process and measurement factors the slots hold as their
+  // numbers (SlotFactor): the first one added (another's kept as objects).
+  const Model* model_ = nullptr;
   RecordStore records_;  // the slots' and cliques' keys and matrices
   std::vector<Clique> cliques_;
   std::vector<bool> clique_alive_;

@@ -68,7 +68,7 @@ void BayesTreeEngine::save(ByteWriter& out) const {
     out.boolean(s.alive);
     if (!s.alive) continue;
     out.boolean(static_cast<bool>(s.nonlinear));
-    if (s.nonlinear) writeFactor(out, *s.nonlinear.toFactor(slotKeys(s)));
+    if (s.nonlinear) writeFactor(out, *s.nonlinear.toFactor(model_, slotKeys(s)));
     writeLinear(out, slotView(s), dimOf);
     out.i32(s.owner);
   }
@@ -105,6 +105,7 @@ void BayesTreeEngine::save(ByteWriter& out) const {
 
 void BayesTreeEngine::load(ByteReader& in, const Model& model) {
   BayesTreeEngine e(mode_, wildfire_);
+  e.model_ = &model;  // the factors read refer to it
   const std::uint8_t mode = in.u8("engine ordering mode");
   if (mode != static_cast<std::uint8_t>(mode_))
     in.fail("engine ordering mode " + std::to_string(mode) + " differs from the estimator options'");
@@ -139,7 +140,7 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     const LinearFactor linear = readLinear(in, model, name + " linearization");
     if (factor) {  // the slot holds it as a running engine does (a model's factor as its numbers)
       if (linear.keys() != factor->keys()) in.fail(name + ": its linearization does not match its factor");
-      slot.nonlinear = SlotFactor(factor);
+      slot.nonlinear = SlotFactor(factor, &model);
     }
     e.storeLinearization(slot, linear.view());
     slot.owner = in.i32((name + " owner").c_str());
@@ -180,7 +181,7 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
     constexpr Eigen::Index kMax = std::numeric_limits<std::uint16_t>::max();
     if (R.rows() > kMax || S.cols() > kMax) in.fail(name + ": its conditional is larger than the engine holds");
     Clique& cl = e.cliques_[c];
-    cl = e.storeClique(el);
+    e.storeClique(el, cl);
     const std::vector<int> owned = in.ints(name + " owned slots");
     cl.owned.assign(owned.begin(), owned.end());
     cl.parent = in.i32((name + " parent").c_str());
@@ -244,7 +245,7 @@ std::string BayesTreeEngine::invariantViolation() const {
     if (slot.record + slot.words() > records_.wordsUsed()) return what + ": its record is out of range";
     const std::string lin = linearOk(slotView(slot), what);
     if (!lin.empty()) return lin;
-    if (slot.nonlinear && (!slot.nonlinear.fitsKeys(slotKeys(slot)) || slot.nonlinear.dim() != slot.rows))
+    if (slot.nonlinear && (!slot.nonlinear.fitsKeys(model_, slotKeys(slot)) || slot.nonlinear.dim(model_) != slot.rows))
       return what + ": its linearization does not match its factor";
     if (!aliveClique(slot.owner)) return what + " is owned by no live clique";
     const auto& owned = cliques_[static_cast<std::size_t>(slot.owner)].owned;

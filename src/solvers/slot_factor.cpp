@@ -6,15 +6,21 @@
 
 namespace gssm::internal {
 
-SlotFactor::SlotFactor(const FactorPtr& f) : SlotFactor() {
+const Model* SlotFactor::modelOf(const FactorPtr& f) {
+  if (const auto* p = dynamic_cast<const ProcessFactor*>(f.get())) return &p->model();
+  if (const auto* m = dynamic_cast<const MeasurementFactor*>(f.get())) return &m->model();
+  return nullptr;
+}
+
+SlotFactor::SlotFactor(const FactorPtr& f, const Model* model) : SlotFactor() {
   if (!f) return;
-  if (const auto* p = dynamic_cast<const ProcessFactor*>(f.get())) {
-    model_ = &p->model();
+  const auto* p = dynamic_cast<const ProcessFactor*>(f.get());
+  const auto* m = p ? nullptr : dynamic_cast<const MeasurementFactor*>(f.get());
+  if (p && &p->model() == model) {
     noise_ = p->noise();
     new (&step_) Step{p->dt(), p->input()};
     kind_ = Kind::Process;
-  } else if (const auto* m = dynamic_cast<const MeasurementFactor*>(f.get())) {
-    model_ = &m->model();
+  } else if (m && &m->model() == model) {
     noise_ = m->noise();
     channel_ = m->channel();
     loss_kind_ = static_cast<std::uint8_t>(m->loss().kind);
@@ -40,7 +46,6 @@ void SlotFactor::reset() {
 void SlotFactor::copyFrom(const SlotFactor& o) {
   loss_kind_ = o.loss_kind_;
   channel_ = o.channel_;
-  model_ = o.model_;
   noise_ = o.noise_;
   switch (o.kind_) {
     case Kind::None: break;
@@ -54,7 +59,6 @@ void SlotFactor::copyFrom(const SlotFactor& o) {
 void SlotFactor::moveFrom(SlotFactor& o) {
   loss_kind_ = o.loss_kind_;
   channel_ = o.channel_;
-  model_ = o.model_;
   noise_ = std::move(o.noise_);
   switch (o.kind_) {
     case Kind::None: break;
@@ -66,28 +70,28 @@ void SlotFactor::moveFrom(SlotFactor& o) {
   o.reset();
 }
 
-int SlotFactor::dim() const {
+int SlotFactor::dim(const Model* model) const {
   switch (kind_) {
     case Kind::None: return 0;
     case Kind::Object: return object_->dim();
-    case Kind::Process: return model_->dims().nc;
-    case Kind::Measurement: return model_->channel(channel_).dim();
+    case Kind::Process: return model->dims().nc;
+    case Kind::Measurement: return model->channel(channel_).dim();
   }
   return 0;
 }
 
-double SlotFactor::linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+double SlotFactor::linearizeRobustAt(const Model* model, const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                                      std::vector<Eigen::MatrixXd>* J) const {
   switch (kind_) {
     case Kind::None: break;
     case Kind::Object: return object_->linearizeRobustAt(x, r, J);
     case Kind::Process:
-      processResidual(*model_, step_.u, step_.dt, noise_, x, r, J);
+      processResidual(*model, step_.u, step_.dt, noise_, x, r, J);
       return robustify(RobustLoss{}, r, J);  // a process factor has no loss
     case Kind::Measurement: {
       const auto& y_ = observation_.y;
       const Eigen::Map<const Eigen::VectorXd> y(y_.begin(), static_cast<Eigen::Index>(y_.size()));
-      measurementResidual(*model_, channel_, y, noise_, x, r, J);
+      measurementResidual(*model, channel_, y, noise_, x, r, J);
       return robustify(loss(), r, J);
     }
   }
@@ -95,15 +99,15 @@ double SlotFactor::linearizeRobustAt(const Eigen::VectorXd* const* x, Eigen::Vec
   return 0.0;
 }
 
-FactorPtr SlotFactor::toFactorAt(std::int64_t step) const {
+FactorPtr SlotFactor::toFactorAt(const Model* model, std::int64_t step) const {
   switch (kind_) {
     case Kind::None: break;
     case Kind::Object: return object_;
-    case Kind::Process: return std::make_shared<ProcessFactor>(*model_, step, step_.u, step_.dt, noise_);
+    case Kind::Process: return std::make_shared<ProcessFactor>(*model, step, step_.u, step_.dt, noise_);
     case Kind::Measurement: {
       const auto& y_ = observation_.y;
       const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(y_.begin(), static_cast<Eigen::Index>(y_.size()));
-      return std::make_shared<MeasurementFactor>(*model_, step, y, channel_, noise_);
+      return std::make_shared<MeasurementFactor>(*model, step, y, channel_, noise_);
     }
   }
   return nullptr;
