@@ -9,7 +9,9 @@
 //
 // Each nonlinear factor keeps its own linearization (per-factor, not
 // per-variable, relinearization: docs/DESIGN.md §6). Anchors never move, so
-// relinearizing one factor changes only that factor's rows.
+// relinearizing one factor changes only that factor's rows. What slots and
+// cliques hold besides ids — keys and matrices — is one record each in the
+// engine's RecordStore.
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
@@ -29,10 +31,8 @@ class Model;
 
 namespace gssm::internal {
 
-/// A linear factor's or a clique's separator's keys: a model factor has at
-/// most three (x_c(k), x_c(k+1), x_b), a chain's separator two, held inline.
-/// (Packed into 16 bytes as a first step and counts they saved 48 bytes a
-/// step but cost the fixed lag 3% of its instructions in decoding.)
+/// A linear factor's keys while it is built: a model factor has at most
+/// three (x_c(k), x_c(k+1), x_b), held inline.
 using KeyList = SmallList<Key, 3>;
 
 class ByteWriter;
