@@ -130,8 +130,8 @@ std::uint16_t narrow16(Eigen::Index n) {
   if (n < 0 || n > kMaxRecordDim) throw std::logic_error("engine record size out of range");
   return static_cast<std::uint16_t>(n);
 }
-// Throws if f's keys or [A | b] are larger than a slot records; `what`
-// names it (called only then: a description costs more than an update).
+// Throws if f's keys or [A | b] are larger than a slot's record holds;
+// `what` names it (called only then: a description costs more than an update).
 template <class What>
 void checkHoldable(const LinearFactor& f, What&& what) {
   if (static_cast<Eigen::Index>(f.keys().size()) > kMaxRecordDim || f.Ab.rows() > kMaxRecordDim ||
@@ -140,9 +140,7 @@ void checkHoldable(const LinearFactor& f, What&& what) {
                           std::to_string(f.Ab.rows()) + " x " + std::to_string(f.Ab.cols()) +
                           " [A | b]; the engine holds at most " + std::to_string(kMaxRecordDim) + " of each");
 }
-}  // namespace
 
-namespace {
 // n doubles from `from` to `to`, inline (std::copy_n calls memmove: a call
 // per column of a few entries, 1% of a fixed-lag update).
 inline double* copyDoubles(const double* from, Eigen::Index n, double* to) {
@@ -517,10 +515,8 @@ void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   }
   p.fresh.assign(ordering.size(), EliminatedClique{});  // empty: no allocation
   p.fresh_owned.clear();
-  // A pooled clique of the same shape, if any, whose storage the new one
-  // then overwrites without allocating.
-  // (A marginalized clique gave its marginal away: matched by its
-  // conditional alone, its lists' capacity is what is reused.)
+  // A pooled clique of the same shape (one an earlier update made), if any,
+  // whose storage the new one then overwrites without allocating.
   auto reuse = [&](EliminatedClique& cl, Eigen::Index dv, Eigen::Index sep_cols) {
     auto& spare = pool_.spare;
     for (std::size_t i = spare.size(); i-- > 0;) {

@@ -179,7 +179,9 @@ void BayesTreeEngine::load(ByteReader& in, const Model& model) {
       for (Eigen::Index i = j + 1; i < m.rows(); ++i)
         if (m(i, j) != 0) in.fail(name + ": its marginal is not upper triangular");
     constexpr Eigen::Index kMax = std::numeric_limits<std::uint16_t>::max();
-    if (R.rows() > kMax || S.cols() > kMax) in.fail(name + ": its conditional is larger than the engine holds");
+    if (R.rows() > kMax || S.cols() > kMax || static_cast<Eigen::Index>(separator.size()) > kMax)
+      in.fail(name + ": its conditional is larger than the engine holds");
+    if (m.cols() != S.cols() + 1) in.fail(name + ": its marginal and its conditional's S differ in width");
     Clique& cl = e.cliques_[c];
     e.storeClique(el, cl);
     const std::vector<int> owned = in.ints(name + " owned slots");
