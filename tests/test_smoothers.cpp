@@ -400,3 +400,82 @@ TEST(IncrementalSmoother, StatesFarApartInStepEqualTheBatchSolve) {
     }
   }
 }
+
+// The engine holds one model's process and measurement factors as their
+// numbers and any other model's as objects (docs/DESIGN.md §6). A smoother
+// fed every other step's factors from a second, identical radar model takes
+// both paths — evaluation, relinearization, cost, covariances — and must
+// agree bit for bit with one fed a single model's (fails if a slot were
+// evaluated with the wrong model or its factor rebuilt on it).
+TEST(IncrementalSmoother, FactorsOfASecondModelAreHeldAsObjectsAndChangeNoBit) {
+  const models::Radar2D radar, twin;
+  const int steps = 200;
+  const SimulatedRun run = radarPaperRun(radar, steps, 3);
+  IncrementalSmoother one, mixed;
+  {
+    auto [f, v] = gssm::testing::initialStep(radar);
+    one.update(f, v);
+    auto [g, w] = gssm::testing::initialStep(twin);
+    mixed.update(g, w);
+  }
+  for (int k = 1; k <= steps; ++k) {
+    const Eigen::VectorXd& y = run.measurements[k - 1].y;
+    const double dt = run.times[k] - run.times[k - 1];
+    auto [f, v] = gssm::testing::nextStep(radar, one, k, y, dt);
+    const UpdateReport a = one.update(f, v);
+    auto [g, w] = gssm::testing::nextStep(k % 2 ? twin : radar, mixed, k, y, dt);
+    const UpdateReport b = mixed.update(g, w);
+    ASSERT_EQ(a.factors_relinearized, b.factors_relinearized) << "step " << k;
+    for (const Key& key : {Key::state(k), Key::state(k / 2)}) {
+      ASSERT_TRUE(one.estimate(key) == mixed.estimate(key)) << key.toString() << " at step " << k;
+      ASSERT_TRUE(one.jointMarginalCovariance({key, Key::constants()}) ==
+                  mixed.jointMarginalCovariance({key, Key::constants()}))
+          << key.toString() << " at step " << k;
+    }
+    ASSERT_TRUE(one.estimate(Key::constants()) == mixed.estimate(Key::constants())) << "step " << k;
+  }
+  EXPECT_GT(one.numFactors(), 2u * steps);
+}
+
+// The same with a second model whose measurement function differs (a linear
+// model of the same dimensions): every third step adds its measurement of
+// the state and constants. The smoother must solve the graph of both models'
+// factors, which the batch solver evaluates as the objects themselves (fails
+// if the engine evaluated the second model's factors with the first's h).
+TEST(IncrementalSmoother, FactorsOfTwoDifferentModelsEqualTheBatchSolve) {
+  const models::Radar2D radar;
+  std::mt19937 rng(21);
+  const models::LinearModel other(gssm::testing::randomLinearSystem(rng, 1, 2, 1, 0.05));
+  const int steps = 90;
+  const SimulatedRun run = radarPaperRun(radar, steps, 4);
+  SmootherOptions o;
+  o.iterate_to_convergence = true;
+  o.convergence_tolerance = 1e-12;
+  o.newton_polish_steps = 10;
+  IncrementalSmoother smoother(o);
+  FactorGraph graph;
+  auto [f0, v0] = gssm::testing::initialStep(radar);
+  smoother.update(f0, v0);
+  for (const auto& f : f0) graph.add(f);
+  for (int k = 1; k <= steps; ++k) {
+    auto [f, v] = gssm::testing::nextStep(radar, smoother, k, run.measurements[k - 1].y, run.times[k] - run.times[k - 1]);
+    if (k % 3 == 0) {  // the linear model's reading of the predicted state, 0.1 off
+      const Eigen::VectorXd y = other.h(v.at(Key::state(k)), smoother.estimate(Key::constants())).array() + 0.1;
+      f.push_back(std::make_shared<MeasurementFactor>(other, k, y));
+    }
+    smoother.update(f, v);
+    for (const auto& g : f) graph.add(g);
+    if (k % 30 != 0) continue;
+    Values x = smoother.calculateEstimate();  // a start at the answer: the test is where it ends
+    BatchSolverOptions bo;
+    bo.max_iterations = 5000;
+    bo.relative_cost_tolerance = 0;
+    bo.gradient_tolerance = 0;
+    bo.step_tolerance = 1e-13;
+    bo.newton_polish_steps = 10;
+    BatchSolver batch(bo);
+    ASSERT_TRUE(batch.solve(graph, x).converged);
+    for (const Key& key : {Key::state(k), Key::state(k / 2), Key::constants()})
+      EXPECT_LT(relativeError(smoother.estimate(key), x.at(key)), 1e-6) << key.toString() << " at step " << k;
+  }
+}
