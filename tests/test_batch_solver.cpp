@@ -349,3 +349,103 @@ TEST(NewtonPolish, BatchReachesTheSameRadarStartupMapFromDifferentStarts) {
   o.newton_polish_steps = -1;
   EXPECT_THROW(BatchSolver{o}, InvalidArgument);
 }
+
+namespace {
+// The radar graph of `steps` steps; with `star`, weak links from x_c(0) to
+// every x_c(k) as well (a graph that is no chain: its envelope is quadratic,
+// so CHOLMOD factors it).
+Problem radarGraph(const models::Radar2D& radar, int steps, bool star) {
+  Problem p = buildProblem(radar, radarPaperRun(radar, steps, 2).measurements);
+  if (star)
+    for (int k = 2; k <= steps; ++k) {
+      const Key a = Key::state(0), b = Key::state(k);
+      Values at;
+      at.insert(a, Eigen::VectorXd::Zero(1));
+      at.insert(b, Eigen::VectorXd::Zero(1));
+      p.graph.add(std::make_shared<LinearGaussianFactor>(
+          std::vector<Key>{a, b},
+          std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Constant(1, 1, 0.01), Eigen::MatrixXd::Constant(1, 1, -0.01)},
+          Eigen::VectorXd::Zero(1), at));
+    }
+  return p;
+}
+}  // namespace
+
+// Each way of factoring the information matrix — dense (≤ 64 unknowns), its
+// envelope (a chain), CHOLMOD (anything else) — gives the solution where the
+// dense gradient vanishes and the covariances of the dense inverse, on and
+// off the factor's pattern.
+TEST(BatchSolver, EveryFactorizationGivesTheDenseSolutionAndInverse) {
+  models::Radar2D::Params params;
+  params.q = 0.5;  // κ(H) small enough for a tight comparison (see above)
+  const models::Radar2D radar(params);
+  for (const auto& [steps, star, expected] :
+       {std::tuple{25, false, "dense"}, {150, false, "envelope"}, {150, true, "sparse"}}) {
+    SCOPED_TRACE(expected);
+    Problem p = radarGraph(radar, steps, star);
+    Values x = p.initial;
+    BatchSolver solver;
+    const BatchSolverSummary sum = solver.solve(p.graph, x);
+    ASSERT_TRUE(sum.converged) << sum.toString();
+    EXPECT_EQ(sum.linear_solver, expected);
+    EXPECT_NE(sum.toString().find(std::string(expected) + " Cholesky"), std::string::npos) << sum.toString();
+    Eigen::MatrixXd H;
+    Eigen::VectorXd g;
+    denseNormalEquations(p.graph, x, H, g);
+    EXPECT_LT(g.lpNorm<Eigen::Infinity>(), 1e-5);
+    const Eigen::MatrixXd Sigma = H.inverse();
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues();
+    const double tol = 100 * 2.2e-16 * ev.maxCoeff() / ev.minCoeff();
+    ASSERT_LT(tol, 1e-7);
+    const Eigen::Index b0 = steps + 1;  // x_c(0..steps), then x_b
+    EXPECT_LT(relativeError(solver.marginalCovariance(Key::constants()), Sigma.block(b0, b0, 2, 2)), tol);
+    for (int k : {0, 1, steps / 3, steps}) {
+      const Eigen::MatrixXd joint = solver.jointMarginalCovariance({Key::state(k), Key::constants()});
+      Eigen::MatrixXd ref(3, 3);
+      const std::vector<Eigen::Index> idx{k, b0, b0 + 1};
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) ref(i, j) = Sigma(idx[static_cast<std::size_t>(i)], idx[static_cast<std::size_t>(j)]);
+      EXPECT_LT(relativeError(joint, ref), tol) << "x_c(" << k << ")";
+    }
+    for (auto [a, b] : {std::pair{0, steps}, {3, steps / 2}}) {  // off the pattern (on it for x_c(0) with the star)
+      const Eigen::MatrixXd pair = solver.jointMarginalCovariance({Key::state(a), Key::state(b)});
+      EXPECT_NEAR(pair(0, 1), Sigma(a, b), tol * std::sqrt(Sigma(a, a) * Sigma(b, b))) << a << ", " << b;
+    }
+  }
+}
+
+// A constant nothing determines is named on every factorization path.
+TEST(BatchSolver, SingularSystemNamesTheVariableOnEveryFactorization) {
+  std::mt19937 rng(11);
+  models::LinearSystem sys = gssm::testing::randomLinearSystem(rng, 2, 2, 1, 0.1);
+  sys.A_b.col(1).setZero();
+  sys.C_b.col(1).setZero();
+  const models::LinearModel model(sys);
+  for (const auto& [steps, expected] : {std::pair{10, "dense"}, {60, "envelope"}}) {
+    std::vector<Measurement> ms;
+    for (int k = 1; k <= steps; ++k) ms.push_back({0.1 * k, Eigen::VectorXd::Constant(1, 0.3)});
+    Problem p = buildProblem(model, ms);
+    // The constants' prior replaced by one on b1 alone: b2 enters nothing.
+    FactorGraph graph;
+    for (const auto& f : p.graph)
+      if (!(f->keys().size() == 1 && f->keys()[0] == Key::constants())) graph.add(f);
+    Values lin;
+    lin.insert(Key::constants(), Eigen::VectorXd::Zero(2));
+    graph.add(std::make_shared<LinearGaussianFactor>(
+        std::vector<Key>{Key::constants()}, std::vector<Eigen::MatrixXd>{Eigen::RowVector2d(1, 0)},
+        Eigen::VectorXd::Zero(1), lin));
+    p.graph = graph;
+    Values x = p.initial;
+    BatchSolverOptions o;
+    o.method = BatchSolverOptions::Method::GaussNewton;
+    try {
+      BatchSolver(o).solve(p.graph, x);
+      FAIL() << expected << ": singular system accepted";
+    } catch (const NumericalError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("x_b"), std::string::npos) << expected << ": " << msg;
+      EXPECT_NE(msg.find("component 1"), std::string::npos) << expected << ": " << msg;
+    }
+    for (const auto& kv : p.initial) EXPECT_EQ(x.at(kv.first), kv.second) << expected;
+  }
+}

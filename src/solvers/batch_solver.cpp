@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "gssm/core/error.h"
+#include "linear/envelope_cholesky.h"
 #include "linear/normal_equations.h"
 #include "linear/sparse_cholesky.h"
 #include "solvers/damping.h"
@@ -56,6 +57,7 @@ std::string BatchSolverSummary::toString() const {
   std::ostringstream os;
   os << "BatchSolver: " << gssm::toString(termination) << " after " << iterations
      << " iterations (" << rejected_steps << " rejected, " << factorizations << " factorizations"
+     << (linear_solver.empty() ? std::string() : ", " + linear_solver + " Cholesky")
      << (newton_steps ? ", " + std::to_string(newton_steps) + " Newton" : std::string()) << "), cost " << initial_cost << " -> " << final_cost
      << ", max|gradient| " << gradient_norm << ", " << num_variables << " variables / "
      << num_factors << " factors / dim " << dimension << ", " << seconds << " s";
@@ -70,6 +72,11 @@ struct BatchSolver::Impl {
   std::vector<Key> layout;               // the variables' keys in column order (Key order)
   std::vector<Eigen::Index> offset;      // first column of each, by Values position; then n
   Eigen::Index n = 0;
+  // H is factored by its envelope where that is compact — a chain of
+  // states with the constants last: no entry lists, no symbolic analysis,
+  // an entry's place found by arithmetic — and by CHOLMOD otherwise.
+  bool use_envelope = false;
+  internal::EnvelopeCholesky envelope;
   internal::SparseCholesky chol;
   // Compact (a million-step run has 2M factors): each factor's variables as
   // positions in the layout, concatenated; factor i's are
@@ -85,6 +92,7 @@ struct BatchSolver::Impl {
   bool has_solution = false;
   // H⁻¹ on the factor's pattern, computed on the first covariance query.
   mutable std::optional<internal::SparseCholesky::SelectedInverse> selected;
+  mutable bool envelope_inverse = false;  // envelope.selectedInverse() done for this solution
 
   void setup(const FactorGraph& graph, const Values& values) {
     offset.clear();
@@ -128,6 +136,37 @@ struct BatchSolver::Impl {
     jacobians.resize(shapes.size());
     factor_offs.resize(max_keys);
     factor_x.resize(max_keys);
+    // The envelope: each column's first row reached by a factor. Compact
+    // (at most twice the entries factors add, plus the diagonal) for a chain
+    // in time order with the constants last; CHOLMOD for any other graph.
+    // Small systems keep SparseCholesky's dense path.
+    {
+      std::vector<int> first(static_cast<std::size_t>(n));
+      for (Eigen::Index j = 0; j < n; ++j) first[static_cast<std::size_t>(j)] = static_cast<int>(j);
+      std::size_t added = 0;
+      for (std::size_t fi = 0; fi < graph.size(); ++fi) {
+        const std::size_t count = offsetsOf(fi);
+        columns.place(factor_offs.data(), count, [&](std::size_t a) {
+          const std::size_t v = factor_vars[factor_begin[fi] + a];
+          return offset[v + 1] - offset[v];
+        });
+        internal::forEachUpperPair(columns, [&](std::size_t p, std::size_t q) {
+          int& f = first[static_cast<std::size_t>(columns.global[q])];
+          f = std::min(f, static_cast<int>(columns.global[p]));
+          ++added;
+        });
+      }
+      std::size_t size = 0;
+      for (Eigen::Index j = 0; j < n; ++j) size += static_cast<std::size_t>(j - first[static_cast<std::size_t>(j)] + 1);
+      use_envelope = n > internal::SparseCholesky::kDenseMax && size <= 2 * added + static_cast<std::size_t>(n);
+      if (use_envelope) {
+        chol.reset(0, 0);  // a previous graph's pattern and factor go
+        envelope.setPattern(std::move(first));
+        entry_slot = diagonal_slot = nullptr;
+        return;
+      }
+      envelope = internal::EnvelopeCholesky();
+    }
     // The pattern: every factor's upper JᵀJ entries, then the diagonal
     // (which the damping needs even where no factor reaches).
     std::size_t entries = 0;
@@ -180,8 +219,8 @@ struct BatchSolver::Impl {
   double linearize(const FactorGraph& graph, const Values& x, Eigen::VectorXd& g,
                    Eigen::VectorXd& diag, bool trial = false) {
     g.setZero(n);
-    double* H = chol.values();
-    std::fill(H, H + chol.nonzeros(), 0.0);
+    double* H = use_envelope ? envelope.values() : chol.values();
+    std::fill(H, H + (use_envelope ? envelope.entries() : chol.nonzeros()), 0.0);
     double cost = 0;
     const int* slot = entry_slot;
     Eigen::VectorXd r;
@@ -204,19 +243,52 @@ struct BatchSolver::Impl {
       cost += c;
       columns.gather(factor_offs.data(), J);
       for (std::size_t p = 0; p < columns.size(); ++p) g[columns.global[p]] += columns.dot(p, r.data());
-      internal::forEachUpperJtJ(columns, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
+      if (use_envelope)
+        internal::forEachUpperJtJ(columns, [&](Eigen::Index i, Eigen::Index j, double v, auto...) {
+          H[envelope.position(i, j)] += v;
+        });
+      else
+        internal::forEachUpperJtJ(columns, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
       ++fi;
     }
     diag.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) diag[i] = H[diagonal_slot[i]];
+    for (Eigen::Index i = 0; i < n; ++i) diag[i] = H[diagonalOf(i)];
     return cost;
+  }
+  const char* linearSolver() const {
+    return use_envelope ? "envelope" : n <= internal::SparseCholesky::kDenseMax ? "dense" : "sparse";
+  }
+  // Where H(i, i) lives in the factorization's values.
+  std::size_t diagonalOf(Eigen::Index i) const {
+    return use_envelope ? envelope.diagonal(i) : static_cast<std::size_t>(diagonal_slot[i]);
+  }
+  Eigen::Index factorize() {
+    selected.reset();
+    envelope_inverse = false;
+    return use_envelope ? envelope.factorize() : chol.factorize();
+  }
+  void solveInPlace(Eigen::VectorXd& b) {
+    if (use_envelope) envelope.solveInPlace(b);
+    else chol.solveInPlace(b);
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& B) { return use_envelope ? envelope.solve(B) : chol.solve(B); }
+  // H⁻¹(i, j) if the selected inverse holds it (computed on the first call).
+  bool inverseEntry(Eigen::Index i, Eigen::Index j, double& out) const {
+    if (use_envelope) {
+      if (!envelope_inverse) {
+        const_cast<internal::EnvelopeCholesky&>(envelope).selectedInverse();
+        envelope_inverse = true;
+      }
+      return envelope.inverseEntry(i, j, out);
+    }
+    if (!selected) selected = const_cast<internal::SparseCholesky&>(chol).selectedInverse();
+    return selected->lookup(i, j, out);
   }
 
   // H's diagonal = its undamped value (diag) + λ·max(diag, 1e-12).
   void setDamping(const Eigen::VectorXd& diag, double lambda) {
-    double* H = chol.values();
-    for (Eigen::Index i = 0; i < n; ++i)
-      H[diagonal_slot[i]] = diag[i] + lambda * std::max(diag[i], 1e-12);
+    double* H = use_envelope ? envelope.values() : chol.values();
+    for (Eigen::Index i = 0; i < n; ++i) H[diagonalOf(i)] = diag[i] + lambda * std::max(diag[i], 1e-12);
   }
 
   [[noreturn]] void throwSingular(Eigen::Index column) const {
@@ -255,6 +327,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   sum.num_factors = graph.size();
   sum.num_variables = values.size();
   sum.dimension = s.n;
+  sum.linear_solver = s.linearSolver();
 
   // The iterate lives in `values` itself (a copy of a million-step run is
   // 64 MB of fresh memory and a million small allocations); a flat copy of
@@ -303,7 +376,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     }
     s.setDamping(diag, policy.lambda());
     ++sum.factorizations;
-    const Eigen::Index bad = s.chol.factorize();
+    const Eigen::Index bad = s.factorize();
     if (bad >= 0) {
       // Undamped (Gauss–Newton, or LM finishing after its tests passed) the
       // information matrix itself is singular: the final factorization would
@@ -314,7 +387,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       continue;
     }
     delta = -g;
-    s.chol.solveInPlace(delta);  // −H⁻¹g, exactly the negated solution
+    s.solveInPlace(delta);  // −H⁻¹g, exactly the negated solution
     if (stepConverged(delta, x)) {
       if (policy.undamped()) {  // a tiny undamped step is still the exact correction: take it
         internal::addStep(x, delta, x);
@@ -387,7 +460,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   // marginal covariances and tells whether the solution is determined.
   s.setDamping(diag, 0.0);
   ++sum.factorizations;
-  const Eigen::Index bad = s.chol.factorize();
+  const Eigen::Index bad = s.factorize();
   if (bad >= 0) s.throwSingular(bad);
   s.has_solution = true;
   restore.armed = false;
@@ -409,7 +482,7 @@ void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
   Eigen::VectorXd g, diag;
   s.linearize(graph, values, g, diag);
   s.setDamping(diag, 0.0);
-  const Eigen::Index bad = s.chol.factorize();
+  const Eigen::Index bad = s.factorize();
   if (bad >= 0) s.throwSingular(bad);
   s.has_solution = true;
 }
@@ -436,13 +509,12 @@ Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& key
   // Fast path: every requested entry lies on the factor's pattern (true for
   // any x_c(k) with x_b), so it is read from the selected inverse; the lower
   // triangle mirrors the upper.
-  if (!s.selected) s.selected = s.chol.selectedInverse();
   bool on_pattern = true;
   for (std::size_t a = 0, r = 0; a < keys.size() && on_pattern; r += dims[a], ++a)
     for (std::size_t b = a, c = r; b < keys.size() && on_pattern; c += dims[b], ++b)
       for (Eigen::Index i = 0; i < dims[a] && on_pattern; ++i)
         for (Eigen::Index j = b == a ? i : 0; j < dims[b] && on_pattern; ++j) {
-          on_pattern = s.selected->lookup(offs[a] + i, offs[b] + j, out(r + i, c + j));
+          on_pattern = s.inverseEntry(offs[a] + i, offs[b] + j, out(r + i, c + j));
           if (on_pattern) out(c + j, r + i) = out(r + i, c + j);
         }
   if (on_pattern) return out;
@@ -451,7 +523,7 @@ Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& key
   Eigen::Index c = 0;
   for (std::size_t i = 0; i < keys.size(); ++i)
     for (Eigen::Index j = 0; j < dims[i]; ++j) E(offs[i] + j, c++) = 1.0;
-  const Eigen::MatrixXd X = s.chol.solve(E);
+  const Eigen::MatrixXd X = s.solve(E);
   Eigen::Index r = 0;
   for (std::size_t i = 0; i < keys.size(); ++i) {
     out.middleRows(r, dims[i]) = X.middleRows(offs[i], dims[i]);

@@ -1,8 +1,9 @@
 #pragma once
 // BatchSolver: the MAP estimate of a whole GSSM graph by sparse
 // Levenberg–Marquardt (or Gauss–Newton) on the normal equations
-// JᵀJ δ = −Jᵀr, factored by CHOLMOD with the states in time order and the
-// constants last (no fill beyond the constants' border). The correctness
+// JᵀJ δ = −Jᵀr with the states in time order and the constants last (no
+// fill beyond the constants' border), factored by its envelope when the
+// graph is such a chain and by CHOLMOD otherwise. The correctness
 // reference for every other estimator.
 #include <Eigen/Core>
 #include <memory>
@@ -62,6 +63,10 @@ struct BatchSolverSummary {
   int rejected_steps = 0;     ///< LM steps that raised the cost
   int factorizations = 0;
   int newton_steps = 0;       ///< full Newton steps taken by the polish
+  /// How the information matrix was factored: "envelope" (a chain in time
+  /// order with the constants last: its profile, no fill outside it),
+  /// "sparse" (CHOLMOD, any other graph) or "dense" (at most 64 unknowns).
+  std::string linear_solver;
   double initial_cost = 0;    ///< ½Σ‖r‖² at the initial values
   double final_cost = 0;
   double gradient_norm = 0;   ///< max |Jᵀr| at the solution

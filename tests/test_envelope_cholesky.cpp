@@ -1,0 +1,128 @@
+// The envelope Cholesky against a dense one (Eigen's LLᵀ and inverse) on
+// random SPD matrices of the batch solver's shapes — a chain of states with
+// a constants' border, scalar and 3-wide states, wider bands — and on a
+// general profile: the solution, H⁻¹ on the whole envelope, the first
+// column that is not positive definite.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <random>
+
+#include "gssm/core/error.h"
+#include "linear/envelope_cholesky.h"
+
+using gssm::internal::EnvelopeCholesky;
+
+namespace {
+// A random SPD matrix with the pattern of a chain of `steps` states of size
+// nc (each coupled to the next) and nb constants coupled to all, plus the
+// first row of each column's envelope.
+Eigen::MatrixXd chainMatrix(std::mt19937& rng, int steps, int nc, int nb, std::vector<int>& first) {
+  std::normal_distribution<double> g;
+  const int n = steps * nc + nb;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3 * n, n);
+  int row = 0;
+  for (int k = 0; k < steps; ++k)  // a factor on (x_k, x_{k+1}, x_b) per step, and one on (x_k, x_b)
+    for (int r = 0; r < nc; ++r, ++row) {
+      for (int c = k * nc; c < std::min((k + 2) * nc, steps * nc); ++c) J(row, c) = g(rng);
+      for (int c = steps * nc; c < n; ++c) J(row, c) = g(rng);
+      ++row;
+      for (int c = k * nc; c < (k + 1) * nc; ++c) J(row, c) = g(rng);
+      for (int c = steps * nc; c < n; ++c) J(row, c) = 0.5 * g(rng);
+    }
+  for (int c = 0; c < n; ++c, ++row) J(row % J.rows(), c) += 1.0;  // every column reached
+  const Eigen::MatrixXd H = J.transpose() * J + 1e-3 * Eigen::MatrixXd::Identity(n, n);
+  first.assign(static_cast<std::size_t>(n), 0);
+  for (int j = 0; j < n; ++j) {
+    int f = j;
+    for (int i = 0; i < j; ++i)
+      if (H(i, j) != 0) {
+        f = i;
+        break;
+      }
+    first[static_cast<std::size_t>(j)] = f;
+  }
+  return H;
+}
+
+void fill(EnvelopeCholesky& c, const Eigen::MatrixXd& H, const std::vector<int>& first) {
+  c.setPattern(first);
+  for (Eigen::Index j = 0; j < H.cols(); ++j)
+    for (Eigen::Index i = first[static_cast<std::size_t>(j)]; i <= j; ++i) c.values()[c.position(i, j)] = H(i, j);
+}
+
+void expectMatchesDense(const Eigen::MatrixXd& H, const std::vector<int>& first, std::mt19937& rng) {
+  EnvelopeCholesky c;
+  fill(c, H, first);
+  ASSERT_EQ(c.factorize(), -1);
+  std::normal_distribution<double> g;
+  Eigen::VectorXd b(H.rows());
+  for (Eigen::Index i = 0; i < b.size(); ++i) b[i] = g(rng);
+  const Eigen::VectorXd x_dense = H.llt().solve(b);
+  Eigen::VectorXd x = b;
+  c.solveInPlace(x);
+  EXPECT_LT((x - x_dense).norm(), 1e-9 * (1 + x_dense.norm()));
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(H.rows(), 3);
+  EXPECT_LT((c.solve(B) - H.llt().solve(B)).norm(), 1e-9 * (1 + B.norm()));
+  c.selectedInverse();
+  const Eigen::MatrixXd Hinv = H.inverse();
+  double worst = 0;
+  for (Eigen::Index j = 0; j < H.cols(); ++j)
+    for (Eigen::Index i = 0; i < H.rows(); ++i) {
+      double z = 0;
+      const bool in = c.inverseEntry(i, j, z);
+      EXPECT_EQ(in, std::min(i, j) >= first[static_cast<std::size_t>(std::max(i, j))]) << i << ", " << j;
+      if (in) worst = std::max(worst, std::abs(z - Hinv(i, j)) / std::max(1.0, std::abs(Hinv(i, j))));
+    }
+  EXPECT_LT(worst, 1e-9);
+}
+}  // namespace
+
+TEST(EnvelopeCholesky, ChainsWithAConstantsBorderMatchTheDenseFactorization) {
+  std::mt19937 rng(2);
+  for (auto [steps, nc, nb] : {std::tuple{1, 1, 0}, {50, 1, 2}, {40, 3, 2}, {30, 2, 0}, {25, 1, 6}, {10, 4, 5}}) {
+    std::vector<int> first;
+    const Eigen::MatrixXd H = chainMatrix(rng, steps, nc, nb, first);
+    SCOPED_TRACE(::testing::Message() << steps << " steps, nc " << nc << ", nb " << nb);
+    expectMatchesDense(H, first, rng);
+  }
+}
+
+TEST(EnvelopeCholesky, AGeneralProfileMatchesTheDenseFactorization) {
+  // Random first rows (the envelope a loop closure would make), zeros inside.
+  std::mt19937 rng(3);
+  const int n = 60;
+  std::uniform_int_distribution<int> u(0, 100);
+  std::normal_distribution<double> g;
+  std::vector<int> first(n);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (int j = 0; j < n; ++j) {
+    first[static_cast<std::size_t>(j)] = u(rng) < 20 ? u(rng) * j / 100 : std::max(0, j - 2);
+    for (int i = first[static_cast<std::size_t>(j)]; i < j; ++i)
+      if (i == first[static_cast<std::size_t>(j)] || u(rng) < 40) A(i, j) = A(j, i) = g(rng);
+  }
+  for (int j = 0; j < n; ++j) A(j, j) = 1 + A.col(j).cwiseAbs().sum();  // diagonally dominant: SPD
+  expectMatchesDense(A, first, rng);
+}
+
+TEST(EnvelopeCholesky, ReportsTheFirstColumnThatIsNotPositiveDefinite) {
+  std::mt19937 rng(4);
+  std::vector<int> first;
+  Eigen::MatrixXd H = chainMatrix(rng, 20, 1, 2, first);
+  // Make column 7 dependent on the earlier ones: H(7,7) = its Schur complement's 0.
+  EnvelopeCholesky c;
+  fill(c, H, first);
+  ASSERT_EQ(c.factorize(), -1);
+  const Eigen::Index bad = 7;
+  const Eigen::MatrixXd Hs = H.topLeftCorner(bad, bad);
+  const Eigen::VectorXd h = H.col(bad).head(bad);
+  H(bad, bad) = h.dot(Hs.llt().solve(h)) - 1e-9;  // just below: not positive definite
+  fill(c, H, first);
+  EXPECT_EQ(c.factorize(), bad);
+  H(bad, bad) = std::nan("");
+  fill(c, H, first);
+  EXPECT_EQ(c.factorize(), bad);
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(H.rows());
+  EXPECT_THROW(c.solveInPlace(b), gssm::NumericalError);
+}
