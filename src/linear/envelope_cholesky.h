@@ -55,7 +55,7 @@ class EnvelopeCholesky {
  private:
   std::vector<int> first_;
   std::vector<std::ptrdiff_t> base_;  // column j's entry for row i at base_[j] + i (i from first_[j] to j)
-  std::vector<double> h_, u_;  // H (or H⁻¹ on the envelope after selectedInverse()), its factor U
+  std::vector<double> h_, u_;  // H (or H⁻¹ on the envelope after selectedInverse()); U, 1/U(j, j) on its diagonal
   bool factored_ = false, inverse_ = false, h_valid_ = true;
 };
 
