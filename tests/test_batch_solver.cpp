@@ -371,16 +371,16 @@ Problem radarGraph(const models::Radar2D& radar, int steps, bool star) {
 }
 }  // namespace
 
-// Each way of factoring the information matrix — dense (≤ 64 unknowns), its
-// envelope (a chain), CHOLMOD (anything else) — gives the solution where the
-// dense gradient vanishes and the covariances of the dense inverse, on and
-// off the factor's pattern.
+// Both ways of factoring a large information matrix — its envelope (a
+// chain), CHOLMOD (anything else) — give the solution where the dense
+// gradient vanishes and the covariances of the dense inverse, on and off the
+// factor's pattern (a small chain is factored by its envelope too).
 TEST(BatchSolver, EveryFactorizationGivesTheDenseSolutionAndInverse) {
   models::Radar2D::Params params;
   params.q = 0.5;  // κ(H) small enough for a tight comparison (see above)
   const models::Radar2D radar(params);
   for (const auto& [steps, star, expected] :
-       {std::tuple{25, false, "dense"}, {150, false, "envelope"}, {150, true, "sparse"}}) {
+       {std::tuple{25, false, "envelope"}, {150, false, "envelope"}, {150, true, "sparse"}}) {
     SCOPED_TRACE(expected);
     Problem p = radarGraph(radar, steps, star);
     Values x = p.initial;
@@ -421,7 +421,7 @@ TEST(BatchSolver, SingularSystemNamesTheVariableOnEveryFactorization) {
   sys.A_b.col(1).setZero();
   sys.C_b.col(1).setZero();
   const models::LinearModel model(sys);
-  for (const auto& [steps, expected] : {std::pair{10, "dense"}, {60, "envelope"}}) {
+  for (const auto& [steps, star, expected] : {std::tuple{10, false, "envelope"}, {60, true, "sparse"}}) {
     std::vector<Measurement> ms;
     for (int k = 1; k <= steps; ++k) ms.push_back({0.1 * k, Eigen::VectorXd::Constant(1, 0.3)});
     Problem p = buildProblem(model, ms);
@@ -434,6 +434,16 @@ TEST(BatchSolver, SingularSystemNamesTheVariableOnEveryFactorization) {
     graph.add(std::make_shared<LinearGaussianFactor>(
         std::vector<Key>{Key::constants()}, std::vector<Eigen::MatrixXd>{Eigen::RowVector2d(1, 0)},
         Eigen::VectorXd::Zero(1), lin));
+    if (star)  // weak links from x_c(0) to every state: no chain
+      for (int k = 2; k <= steps; ++k) {
+        Values at;
+        at.insert(Key::state(0), Eigen::VectorXd::Zero(2));
+        at.insert(Key::state(k), Eigen::VectorXd::Zero(2));
+        graph.add(std::make_shared<LinearGaussianFactor>(
+            std::vector<Key>{Key::state(0), Key::state(k)},
+            std::vector<Eigen::MatrixXd>{0.01 * Eigen::Matrix2d::Identity(), -0.01 * Eigen::Matrix2d::Identity()},
+            Eigen::VectorXd::Zero(2), at));
+      }
     p.graph = graph;
     Values x = p.initial;
     BatchSolverOptions o;
@@ -447,5 +457,56 @@ TEST(BatchSolver, SingularSystemNamesTheVariableOnEveryFactorization) {
       EXPECT_NE(msg.find("component 1"), std::string::npos) << expected << ": " << msg;
     }
     for (const auto& kv : p.initial) EXPECT_EQ(x.at(kv.first), kv.second) << expected;
+  }
+}
+
+// A small graph that is no chain (x_c(k) linked to x_c(29 − k)) is factored
+// densely: the solution and covariances of the dense inverse; a state no
+// factor reaches is named.
+TEST(BatchSolver, ASmallGraphThatIsNoChainIsFactoredDensely) {
+  auto graphOf = [](bool leave_out_3) {
+    FactorGraph g;
+    for (int k = 0; k < 30; ++k) {
+      if (leave_out_3 && k == 3) continue;
+      g.add(std::make_shared<PriorFactor>(
+          Key::state(k), Gaussian{Eigen::VectorXd::Constant(1, 0.1 * k), Eigen::MatrixXd::Constant(1, 1, 1.0 + k)}));
+    }
+    for (int k = 0; k < 15; ++k) {
+      if (leave_out_3 && (k == 3 || 29 - k == 3)) continue;
+      Values at;
+      at.insert(Key::state(k), Eigen::VectorXd::Zero(1));
+      at.insert(Key::state(29 - k), Eigen::VectorXd::Zero(1));
+      g.add(std::make_shared<LinearGaussianFactor>(
+          std::vector<Key>{Key::state(k), Key::state(29 - k)},
+          std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Constant(1, 1, 2.0), Eigen::MatrixXd::Constant(1, 1, -1.0)},
+          Eigen::VectorXd::Constant(1, 0.5), at));
+    }
+    return g;
+  };
+  Values x;
+  for (int k = 0; k < 30; ++k) x.insert(Key::state(k), Eigen::VectorXd::Zero(1));
+  const Values start = x;
+  const FactorGraph g = graphOf(false);
+  BatchSolver solver;
+  const BatchSolverSummary sum = solver.solve(g, x);
+  ASSERT_TRUE(sum.converged) << sum.toString();
+  EXPECT_EQ(sum.linear_solver, "dense");
+  Eigen::MatrixXd H;
+  Eigen::VectorXd grad;
+  denseNormalEquations(g, x, H, grad);
+  EXPECT_LT(grad.lpNorm<Eigen::Infinity>(), 1e-9);
+  const Eigen::MatrixXd Sigma = H.inverse();
+  for (auto [a, b] : {std::pair{0, 29}, {3, 26}, {5, 6}, {10, 10}}) {
+    const Eigen::MatrixXd pair = solver.jointMarginalCovariance({Key::state(a), Key::state(b == a ? 29 - a : b)});
+    const int c = b == a ? 29 - a : b;
+    EXPECT_NEAR(pair(0, 1), Sigma(a, c), 1e-12 * std::sqrt(Sigma(a, a) * Sigma(c, c))) << a << ", " << c;
+    EXPECT_NEAR(pair(0, 0), Sigma(a, a), 1e-12 * Sigma(a, a));
+  }
+  Values y = start;
+  try {
+    BatchSolver().solve(graphOf(true), y);
+    FAIL() << "a state no factor reaches was accepted";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find(Key::state(3).toString()), std::string::npos) << e.what();
   }
 }

@@ -138,8 +138,10 @@ struct BatchSolver::Impl {
     factor_x.resize(max_keys);
     // The envelope: each column's first row reached by a factor. Compact
     // (at most twice the entries factors add, plus the diagonal) for a chain
-    // in time order with the constants last; CHOLMOD for any other graph.
-    // Small systems keep SparseCholesky's dense path.
+    // in time order with the constants last, small or large (a paper window
+    // of 10 steps: 1.4× faster than the dense factorization of its 14
+    // unknowns); SparseCholesky for any other graph (dense up to 64
+    // unknowns, CHOLMOD beyond).
     {
       std::vector<int> first(static_cast<std::size_t>(n));
       for (Eigen::Index j = 0; j < n; ++j) first[static_cast<std::size_t>(j)] = static_cast<int>(j);
@@ -158,7 +160,7 @@ struct BatchSolver::Impl {
       }
       std::size_t size = 0;
       for (Eigen::Index j = 0; j < n; ++j) size += static_cast<std::size_t>(j - first[static_cast<std::size_t>(j)] + 1);
-      use_envelope = n > internal::SparseCholesky::kDenseMax && size <= 2 * added + static_cast<std::size_t>(n);
+      use_envelope = n > 0 && size <= 2 * added + static_cast<std::size_t>(n);
       if (use_envelope) {
         chol.reset(0, 0);  // a previous graph's pattern and factor go
         envelope.setPattern(std::move(first));

@@ -64,8 +64,8 @@ struct BatchSolverSummary {
   int factorizations = 0;
   int newton_steps = 0;       ///< full Newton steps taken by the polish
   /// How the information matrix was factored: "envelope" (a chain in time
-  /// order with the constants last: its profile, no fill outside it),
-  /// "sparse" (CHOLMOD, any other graph) or "dense" (at most 64 unknowns).
+  /// order with the constants last: its profile, no fill outside it), or
+  /// for any other graph "dense" (at most 64 unknowns) or "sparse" (CHOLMOD).
   std::string linear_solver;
   double initial_cost = 0;    ///< ½Σ‖r‖² at the initial values
   double final_cost = 0;
