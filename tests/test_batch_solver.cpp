@@ -49,6 +49,16 @@ void denseNormalEquations(const FactorGraph& graph, const Values& x, Eigen::Matr
   g = J.transpose() * r_all;
 }
 
+// A linear model whose constant b2 enters neither f nor h (with its prior
+// left out, nothing determines it).
+models::LinearModel modelBlindToB2() {
+  std::mt19937 rng(11);
+  models::LinearSystem sys = gssm::testing::randomLinearSystem(rng, 2, 2, 1, 0.1);
+  sys.A_b.col(1).setZero();
+  sys.C_b.col(1).setZero();
+  return models::LinearModel(sys);
+}
+
 }  // namespace
 
 // r(x) = x³ − x on one variable: zero (a minimum of ½r²) at −1, 0 and 1.
@@ -212,11 +222,7 @@ TEST(BatchSolver, MarginalCovariancesEqualDenseInverse) {
 TEST(BatchSolver, SingularSystemNamesTheVariableAndLeavesValuesUnchanged) {
   // A linear model where constant b2 enters nothing and has no prior
   // information beyond... we remove its prior by building the graph by hand.
-  std::mt19937 rng(11);
-  models::LinearSystem sys = gssm::testing::randomLinearSystem(rng, 2, 2, 1, 0.1);
-  sys.A_b.col(1).setZero();
-  sys.C_b.col(1).setZero();
-  const models::LinearModel model(sys);
+  const models::LinearModel model = modelBlindToB2();
   FactorGraph g;
   g.add(std::make_shared<PriorFactor>(Key::state(0), model.priorState()));
   g.add(std::make_shared<ProcessFactor>(model, 0, Eigen::VectorXd(0), 0.1));
@@ -416,11 +422,7 @@ TEST(BatchSolver, EveryFactorizationGivesTheDenseSolutionAndInverse) {
 
 // A constant nothing determines is named on every factorization path.
 TEST(BatchSolver, SingularSystemNamesTheVariableOnEveryFactorization) {
-  std::mt19937 rng(11);
-  models::LinearSystem sys = gssm::testing::randomLinearSystem(rng, 2, 2, 1, 0.1);
-  sys.A_b.col(1).setZero();
-  sys.C_b.col(1).setZero();
-  const models::LinearModel model(sys);
+  const models::LinearModel model = modelBlindToB2();
   for (const auto& [steps, star, expected] : {std::tuple{10, false, "envelope"}, {60, true, "sparse"}}) {
     std::vector<Measurement> ms;
     for (int k = 1; k <= steps; ++k) ms.push_back({0.1 * k, Eigen::VectorXd::Constant(1, 0.3)});

@@ -29,6 +29,31 @@ models::LinearModel randomLinear(unsigned seed) {
   return models::LinearModel(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1));
 }
 
+// A smoother iterated to convergence, finished by Newton steps, and a batch
+// solver as strict: stopping on the step size only (the cost change is below
+// rounding long before the radar's slow start-up steps have converged).
+// Steps 1-9 of the radar: the MAP has a 50σ range residual (the prior forces
+// h > 1150 while the range is ~1000) and x is determined only to ±5 m along
+// a valley where the cost changes by 3e-7 over 4e-3 m: Gauss–Newton and LM
+// converge linearly with a rate near 1 there, and stop up to 4e-6 apart;
+// both finish with full Newton steps (second-order terms restored).
+SmootherOptions iteratedToConvergence() {
+  SmootherOptions o;
+  o.iterate_to_convergence = true;
+  o.convergence_tolerance = 1e-12;
+  o.newton_polish_steps = 10;
+  return o;
+}
+BatchSolverOptions strictBatch() {
+  BatchSolverOptions bo;
+  bo.max_iterations = 5000;
+  bo.relative_cost_tolerance = 0;
+  bo.gradient_tolerance = 0;
+  bo.step_tolerance = 1e-13;
+  bo.newton_polish_steps = 10;
+  return bo;
+}
+
 Eigen::VectorXd stacked(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) {
   Eigen::VectorXd z(xc.size() + xb.size());
   z << xc, xb;
@@ -109,16 +134,7 @@ TEST(IncrementalSmoother, RadarPaperEqualsBatchAfterEveryUpdateWhenIterated) {
   const models::Radar2D radar;
   const int steps = 300;
   const SimulatedRun run = radarPaperRun(radar, steps, 1);
-  SmootherOptions o;
-  o.iterate_to_convergence = true;
-  o.convergence_tolerance = 1e-12;
-  // Steps 1-9: the MAP has a 50σ range residual (the prior forces h > 1150
-  // while the range is ~1000) and x is determined only to ±5 m along a
-  // valley where the cost changes by 3e-7 over 4e-3 m: Gauss–Newton and LM
-  // converge linearly with a rate near 1 there, and stop up to 4e-6 apart.
-  // Both finish with full Newton steps (second-order terms restored).
-  o.newton_polish_steps = 10;
-  IncrementalSmoother smoother(o);
+  IncrementalSmoother smoother(iteratedToConvergence());
   auto [f0, v0] = gssm::testing::initialStep(radar);
   smoother.update(f0, v0);
   Values warm;  // the batch starts from its previous solution (as the smoother does)
@@ -131,15 +147,7 @@ TEST(IncrementalSmoother, RadarPaperEqualsBatchAfterEveryUpdateWhenIterated) {
     Problem p = buildProblem(radar, upto);
     Values x = p.initial;
     for (const auto& kv : warm) x.at(kv.first) = kv.second;
-    // Equally strict batch: stop on the step size only (the cost change is
-    // below rounding long before the slow start-up steps have converged).
-    BatchSolverOptions bo;
-    bo.max_iterations = 5000;
-    bo.relative_cost_tolerance = 0;
-    bo.gradient_tolerance = 0;
-    bo.step_tolerance = 1e-13;
-    bo.newton_polish_steps = 10;
-    BatchSolver batch(bo);
+    BatchSolver batch(strictBatch());  // equally strict
     const auto sum = batch.solve(p.graph, x);
     ASSERT_TRUE(sum.converged) << sum.toString();
     warm = x;
@@ -448,11 +456,7 @@ TEST(IncrementalSmoother, FactorsOfTwoDifferentModelsEqualTheBatchSolve) {
   const models::LinearModel other(gssm::testing::randomLinearSystem(rng, 1, 2, 1, 0.05));
   const int steps = 90;
   const SimulatedRun run = radarPaperRun(radar, steps, 4);
-  SmootherOptions o;
-  o.iterate_to_convergence = true;
-  o.convergence_tolerance = 1e-12;
-  o.newton_polish_steps = 10;
-  IncrementalSmoother smoother(o);
+  IncrementalSmoother smoother(iteratedToConvergence());
   FactorGraph graph;
   auto [f0, v0] = gssm::testing::initialStep(radar);
   smoother.update(f0, v0);
@@ -467,13 +471,7 @@ TEST(IncrementalSmoother, FactorsOfTwoDifferentModelsEqualTheBatchSolve) {
     for (const auto& g : f) graph.add(g);
     if (k % 30 != 0) continue;
     Values x = smoother.calculateEstimate();  // a start at the answer: the test is where it ends
-    BatchSolverOptions bo;
-    bo.max_iterations = 5000;
-    bo.relative_cost_tolerance = 0;
-    bo.gradient_tolerance = 0;
-    bo.step_tolerance = 1e-13;
-    bo.newton_polish_steps = 10;
-    BatchSolver batch(bo);
+    BatchSolver batch(strictBatch());
     ASSERT_TRUE(batch.solve(graph, x).converged);
     for (const Key& key : {Key::state(k), Key::state(k / 2), Key::constants()})
       EXPECT_LT(relativeError(smoother.estimate(key), x.at(key)), 1e-6) << key.toString() << " at step " << k;

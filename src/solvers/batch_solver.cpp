@@ -146,18 +146,11 @@ struct BatchSolver::Impl {
       std::vector<int> first(static_cast<std::size_t>(n));
       for (Eigen::Index j = 0; j < n; ++j) first[static_cast<std::size_t>(j)] = static_cast<int>(j);
       std::size_t added = 0;
-      for (std::size_t fi = 0; fi < graph.size(); ++fi) {
-        const std::size_t count = offsetsOf(fi);
-        columns.place(factor_offs.data(), count, [&](std::size_t a) {
-          const std::size_t v = factor_vars[factor_begin[fi] + a];
-          return offset[v + 1] - offset[v];
-        });
-        internal::forEachUpperPair(columns, [&](std::size_t p, std::size_t q) {
-          int& f = first[static_cast<std::size_t>(columns.global[q])];
-          f = std::min(f, static_cast<int>(columns.global[p]));
-          ++added;
-        });
-      }
+      forEachFactorEntry(graph.size(), [&](Eigen::Index i, Eigen::Index j) {
+        int& f = first[static_cast<std::size_t>(j)];
+        f = std::min(f, static_cast<int>(i));
+        ++added;
+      });
       std::size_t size = 0;
       for (Eigen::Index j = 0; j < n; ++j) size += static_cast<std::size_t>(j - first[static_cast<std::size_t>(j)] + 1);
       use_envelope = n > 0 && size <= 2 * added + static_cast<std::size_t>(n);
@@ -174,21 +167,29 @@ struct BatchSolver::Impl {
     std::size_t entries = 0;
     chol.assemblePattern(n, [&](auto&& emit) {
       entries = 0;
-      for (std::size_t fi = 0; fi < graph.size(); ++fi) {
-        const std::size_t count = offsetsOf(fi);
-        columns.place(factor_offs.data(), count, [&](std::size_t a) {
-          const std::size_t v = factor_vars[factor_begin[fi] + a];
-          return offset[v + 1] - offset[v];
-        });
-        internal::forEachUpperPair(columns, [&](std::size_t p, std::size_t q) {
-          emit(columns.global[p], columns.global[q]);
-          ++entries;
-        });
-      }
+      forEachFactorEntry(graph.size(), [&](Eigen::Index i, Eigen::Index j) {
+        emit(i, j);
+        ++entries;
+      });
       for (Eigen::Index i = 0; i < n; ++i) emit(i, i);
     });
     entry_slot = chol.slots();
     diagonal_slot = entry_slot + entries;
+  }
+
+  // emit(i, j) for every upper-triangle entry (i <= j) of every factor's
+  // JᵀJ, factor by factor, in the order linearize() fills them.
+  template <class Emit>
+  void forEachFactorEntry(std::size_t factors, Emit&& emit) {
+    for (std::size_t fi = 0; fi < factors; ++fi) {
+      const std::size_t count = offsetsOf(fi);
+      columns.place(factor_offs.data(), count, [&](std::size_t a) {
+        const std::size_t v = factor_vars[factor_begin[fi] + a];
+        return offset[v + 1] - offset[v];
+      });
+      internal::forEachUpperPair(columns,
+                                 [&](std::size_t p, std::size_t q) { emit(columns.global[p], columns.global[q]); });
+    }
   }
 
   static constexpr std::size_t npos = static_cast<std::size_t>(-1);
