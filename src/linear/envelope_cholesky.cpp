@@ -30,12 +30,11 @@ void EnvelopeCholesky::setPattern(std::vector<int> first) {
   h_.assign(static_cast<std::size_t>(size), 0.0);
   u_.clear();
   factored_ = inverse_ = false;
-  h_valid_ = true;
 }
 
 Eigen::Index EnvelopeCholesky::factorize() {
-  if (!h_valid_) throw NumericalError("EnvelopeCholesky: H was replaced by its inverse; refill values() first");
-  factored_ = inverse_ = false;
+  if (inverse_) throw NumericalError("EnvelopeCholesky: H was replaced by its inverse; refill values() first");
+  factored_ = false;
   u_.resize(h_.size());
   const auto n = static_cast<std::ptrdiff_t>(first_.size());
   // Column by column (H = UᵀU, U upper): U(i, j) for i < j from the columns
@@ -64,10 +63,9 @@ Eigen::Index EnvelopeCholesky::factorize() {
   return -1;
 }
 
-void EnvelopeCholesky::solveInPlace(Eigen::VectorXd& b) const {
+void EnvelopeCholesky::solveInPlace(double* x) const {
   if (!factored_) throw NumericalError("EnvelopeCholesky: solve before a successful factorize()");
   const auto n = static_cast<std::ptrdiff_t>(first_.size());
-  double* x = b.data();
   for (std::ptrdiff_t j = 0; j < n; ++j) {  // Uᵀ y = b
     const std::ptrdiff_t fj = first_[static_cast<std::size_t>(j)];
     const double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
@@ -83,13 +81,8 @@ void EnvelopeCholesky::solveInPlace(Eigen::VectorXd& b) const {
 }
 
 Eigen::MatrixXd EnvelopeCholesky::solve(const Eigen::MatrixXd& B) const {
-  Eigen::MatrixXd X = B;
-  Eigen::VectorXd col;
-  for (Eigen::Index c = 0; c < X.cols(); ++c) {
-    col = X.col(c);
-    solveInPlace(col);
-    X.col(c) = col;
-  }
+  Eigen::MatrixXd X = B;  // column-major: each column solved where it lies
+  for (Eigen::Index c = 0; c < X.cols(); ++c) solveInPlace(X.col(c).data());
   return X;
 }
 
@@ -99,7 +92,6 @@ void EnvelopeCholesky::selectedInverse() {
   // H⁻¹ takes H's storage (the batch solver refills H before it factors
   // again): no fresh memory for it.
   std::vector<double>& z = h_;
-  h_valid_ = false;
   auto zAt = [&](Eigen::Index a, Eigen::Index b) -> double {  // Z(a, b) = Z(b, a), in the envelope
     return a <= b ? z[position(a, b)] : z[position(b, a)];
   };

@@ -32,7 +32,6 @@ class EnvelopeCholesky {
   /// H's upper envelope by columns; the caller fills it before factorize()
   /// (and again after selectedInverse(), which takes its storage).
   double* values() {
-    h_valid_ = true;
     inverse_ = false;
     return h_.data();
   }
@@ -41,7 +40,7 @@ class EnvelopeCholesky {
   /// success, else the first column whose pivot is not positive and finite.
   Eigen::Index factorize();
   /// Solves H x = b in place.
-  void solveInPlace(Eigen::VectorXd& b) const;
+  void solveInPlace(Eigen::VectorXd& b) const { solveInPlace(b.data()); }
   /// Solves H X = B (n × m).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& B) const;
 
@@ -56,7 +55,9 @@ class EnvelopeCholesky {
   std::vector<int> first_;
   std::vector<std::ptrdiff_t> base_;  // column j's entry for row i at base_[j] + i (i from first_[j] to j)
   std::vector<double> h_, u_;  // H (or H⁻¹ on the envelope after selectedInverse()); U, 1/U(j, j) on its diagonal
-  bool factored_ = false, inverse_ = false, h_valid_ = true;
+  void solveInPlace(double* x) const;  // x: n entries
+  // inverse_: h_ holds H⁻¹ on the envelope, not H (values() must refill it).
+  bool factored_ = false, inverse_ = false;
 };
 
 }  // namespace gssm::internal
