@@ -146,7 +146,7 @@ int main(int argc, char** argv) {
     const auto names = model->stackedStateNames();
     const auto px = std::find(names.begin(), names.end(), "px"), py = std::find(names.begin(), names.end(), "py");
     if (px != names.end() && py != names.end()) {
-      plan = gssm::plot::PlanView{px - names.begin(), py - names.begin(), gssm::io::landmarks(config, data), "beacons", {}};
+      plan = gssm::plot::PlanView{px - names.begin(), py - names.begin(), model->landmarks(), "beacons", {}};
       if (rows == gssm::RowTimes::Inputs) {  // dead reckoning: the filter with no measurements
         gssm::EstimatorOptions dr = options;
         dr.method = gssm::Method::Ekf;

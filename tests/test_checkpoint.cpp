@@ -249,7 +249,7 @@ TEST(Checkpoint, ForeignModelVersionAndFileErrorsNameTheCause) {
   const std::string bytes = radarCheckpoint();
   std::mt19937 rng(1);
   const models::LinearModel linear(gssm::testing::randomLinearSystem(rng, 2, 2, 1, 1.0));
-  EXPECT_NE(errorOf([&] { restoreCheckpointBytes(linear, bytes); }).find("written by model 'radar2d'"), std::string::npos);
+  EXPECT_NE(errorOf([&] { restoreCheckpointBytes(linear, bytes); }).find("written by model 'radar_2d'"), std::string::npos);
   models::Radar2D::Params p;
   p.r *= 2;
   const models::Radar2D other(p);

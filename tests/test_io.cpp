@@ -72,7 +72,7 @@ TEST(Config, BuiltinScenarioBuildsThePaperModel) {
   const auto ini = IniDocument::parse(builtinScenario("paper", 3, 50).toString(), "p.ini");
   const auto model = makeModel(ini);
   const models::Radar2D paper;
-  EXPECT_EQ(model->name(), "radar2d");
+  EXPECT_EQ(model->name(), "radar_2d");
   EXPECT_EQ(model->noise().Q, paper.noise().Q);
   EXPECT_EQ(model->priorConstants().mean, paper.priorConstants().mean);
   EXPECT_EQ(model->priorConstants().covariance, paper.priorConstants().covariance);

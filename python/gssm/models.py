@@ -1,18 +1,75 @@
-"""Models: the built-in ones (the C++ defaults as keyword defaults), the
-linear model from matrices, and PythonModel for models written in Python."""
+"""Models: every registered model type (Radar2D, Nav2D, RangeBeacon2D,
+Linear, and any a C++ library registers) as a class whose keywords are the
+type's parameters, the same keys as its INI form ([model] key, [prior] key as
+prior_key); PythonModel for models written in Python.
+
+The parameters, their defaults and their checks live in C++ (one
+registration per model type, docs/DESIGN.md §3 "Adding a model"): a keyword
+left out keeps the C++ default, and `model.params` gives every value used.
+"""
 import numpy as _np
 
 from . import _gssm
 
 Model = _gssm.models.Model
 Channel = _gssm.models.Channel
-Radar2D = _gssm.models.Radar2D
-Nav2D = _gssm.models.Nav2D
-RangeBeacon2D = _gssm.models.RangeBeacon2D
-Linear = _gssm.models.Linear
 from_ini = _gssm.models.from_ini
 
-__all__ = ["Model", "Channel", "Radar2D", "Nav2D", "RangeBeacon2D", "Linear", "PythonModel", "from_ini"]
+
+class _RegisteredType(type):
+    """The class of a registered model type: calling it builds the model in
+    C++ (an instance of Model); isinstance asks the registry."""
+
+    def __call__(cls, **params):
+        return _gssm.models._make(cls._type_name, params)
+
+    def __instancecheck__(cls, obj):
+        return isinstance(obj, Model) and _gssm.models._type_of(obj) == cls._type_name
+
+
+def _type_doc(info):
+    lines = [info["summary"], "", "Keywords (absent: the C++ default; see .params):"]
+    for p in info["params"]:
+        need = ", required" if p["required"] else ""
+        lines.append("    %s (%s%s): %s  [INI: [%s] %s]" % (p["name"], p["kind"], need, p["doc"], p["section"], p["key"]))
+    return "\n".join(lines)
+
+
+def _registered_class(info):
+    return _RegisteredType(info["class_name"], (), {"_type_name": info["name"], "__doc__": _type_doc(info),
+                                                    "__module__": __name__})
+
+
+def registered_types():
+    """Every registered model type, as dicts: name, aliases, class_name,
+    summary and params (name, section, key, kind, required, doc)."""
+    return _gssm.models._types()
+
+
+_CLASSES = {}
+
+
+def _refresh():
+    for info in registered_types():
+        if info["class_name"] not in _CLASSES:
+            _CLASSES[info["class_name"]] = _registered_class(info)
+    return _CLASSES
+
+
+globals().update(_refresh())
+
+
+def __getattr__(name):
+    """A model type registered after this module was imported (a C++
+    extension that registers its own)."""
+    classes = _refresh()
+    if name in classes:
+        globals()[name] = classes[name]
+        return classes[name]
+    raise AttributeError("module 'gssm.models' has no attribute %r" % name)
+
+
+__all__ = ["Model", "Channel", *sorted(_CLASSES), "PythonModel", "from_ini", "registered_types"]
 
 
 class PythonModel(_gssm.models._FunctionModel):
@@ -60,5 +117,5 @@ def _rebuild_python_model(args):
 
 
 def _from_ini_pickled(text):
-    """Unpickles a built-in model (pickled through its INI form)."""
+    """Unpickles a registered model (pickled through its INI form)."""
     return from_ini(text)

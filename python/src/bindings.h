@@ -21,6 +21,10 @@ namespace gssm::python {
 
 void bindErrors(py::module_& m);
 void bindModels(py::module_& models);
+/// The registered model types as gssm.models._types/_make (model_params.cpp).
+void bindModelRegistry(py::module_& models);
+/// A registered model's parameters as a dict of its class's keywords.
+py::dict modelParams(const Model& model);
 void bindEstimator(py::module_& m);
 void bindIo(py::module_& io);
 void bindAnalysis(py::module_& analysis);

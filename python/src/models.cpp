@@ -1,9 +1,9 @@
-// gssm.models: the built-in models with the C++ defaults as keyword
-// defaults, the linear model from matrices, and models written in Python
+// gssm.models: the Model interface, and models written in Python
 // (FunctionModel over Python callables; central differences where no
-// Jacobian is given). Built-in models pickle through their INI form
-// (io::writeModel / io::makeModel); the Python package pickles PythonModel
-// from its constructor arguments.
+// Jacobian is given). The registered model types (Radar2D, Linear, ...)
+// are bound generically from the registry (model_params.cpp). Registered
+// models pickle through their INI form (io::writeModel / io::makeModel);
+// the Python package pickles PythonModel from its constructor arguments.
 #include <pybind11/functional.h>
 
 #include "bindings.h"
@@ -11,10 +11,6 @@
 #include "gssm/io/config.h"
 #include "gssm/io/ini.h"
 #include "gssm/models/function_model.h"
-#include "gssm/models/linear.h"
-#include "gssm/models/nav2d.h"
-#include "gssm/models/radar2d.h"
-#include "gssm/models/range_beacon2d.h"
 
 namespace gssm::python {
 
@@ -24,32 +20,6 @@ namespace {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
-
-std::vector<Eigen::Vector2d> points(const Eigen::MatrixXd& m, const char* what) {
-  if (m.size() > 0 && m.cols() != 2)
-    throw InvalidArgument(std::string(what) + ": expected an array of shape (k, 2), got (" +
-                          std::to_string(m.rows()) + ", " + std::to_string(m.cols()) + ")");
-  std::vector<Eigen::Vector2d> out;
-  for (Eigen::Index i = 0; i < m.rows(); ++i) out.emplace_back(m(i, 0), m(i, 1));
-  return out;
-}
-
-MatrixXd pointsMatrix(const std::vector<Eigen::Vector2d>& p) {
-  MatrixXd m(static_cast<Eigen::Index>(p.size()), 2);
-  for (std::size_t i = 0; i < p.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = p[i].transpose();
-  return m;
-}
-
-RobustLoss lossNamed(const std::string& name, double scale) {
-  RobustLoss loss;
-  for (auto k : {RobustLoss::Kind::None, RobustLoss::Kind::Huber, RobustLoss::Kind::Cauchy, RobustLoss::Kind::Tukey})
-    if (name == RobustLoss::name(k)) {
-      loss.kind = k;
-      loss.scale = scale;
-      return loss;
-    }
-  throw InvalidArgument("loss '" + name + "': expected none, huber, cauchy or tukey");
-}
 
 /// A callable's result as a vector of `n` values (a float is a 1-vector),
 /// or an InvalidArgument naming the model and the function.
@@ -172,9 +142,7 @@ std::string modelIni(const Model& m) {
   return ini.toString();
 }
 
-}  // namespace
-
-void bindModels(py::module_& models) {
+void bindChannel(py::module_& models) {
   py::class_<MeasurementChannel>(models, "Channel", "A sensor of a model: its name, components, noise and loss.")
       .def_readonly("name", &MeasurementChannel::name)
       .def_readonly("components", &MeasurementChannel::components)
@@ -188,8 +156,11 @@ void bindModels(py::module_& models) {
         return "Channel(name='" + c.name + "', dim=" + std::to_string(c.dim()) + ", loss='" +
                RobustLoss::name(c.loss.kind) + "')";
       });
+}
 
-  py::class_<Model, std::shared_ptr<Model>>(models, "Model",
+// The Model's read-only description: sizes, names, noise, priors, channels.
+py::class_<Model, std::shared_ptr<Model>> bindModelProperties(py::module_& models) {
+  auto cls = py::class_<Model, std::shared_ptr<Model>>(models, "Model",
                                             "A GSSM: x_c(k+1) = f(x_c(k), x_b, u, dt) + q, y = h(x_c, x_b) + r "
                                             "(docs/DESIGN.md §2). Abstract: use a built-in model or PythonModel.")
       .def_property_readonly("name", &Model::name)
@@ -220,8 +191,20 @@ void bindModels(py::module_& models) {
                                return out;
                              })
       .def("channel_index", &Model::channelIndex, py::arg("name"), "index of the channel called `name`")
-      .def_property_readonly("angle_states", &Model::angleStates, "stacked components that are angles")
-      .def(
+      .def_property_readonly("angle_states", &Model::angleStates, "stacked components that are angles");
+  cls.def_property_readonly("landmarks", [](const Model& m) {
+        Eigen::MatrixXd out(static_cast<Eigen::Index>(m.landmarks().size()), 2);
+        for (std::size_t i = 0; i < m.landmarks().size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.landmarks()[i];
+        return out;
+      }, "fixed points its measurements refer to (beacons), one row (x, y) each")
+      .def_property_readonly("params", &modelParams,
+                             "a registered model's parameters, as the keywords of its class");
+  return cls;
+}
+
+// Evaluating the model: f, h with their Jacobians, Q(dt), the Jacobian check.
+void bindModelFunctions(py::class_<Model, std::shared_ptr<Model>>& cls) {
+  cls      .def(
           "f",
           [](const Model& m, const VectorXd& xc, const VectorXd& xb, const VectorXd& u, double dt,
              bool jacobians) -> py::object {
@@ -271,7 +254,12 @@ void bindModels(py::module_& models) {
           },
           py::arg("xc"), py::arg("xb"), py::arg("u") = VectorXd(), py::arg("dt") = std::nan(""),
           py::arg("eps") = 1e-6, "analytic Jacobians against central differences at one point")
-      .def("to_ini", &modelIni, "the model's INI form ([model], [noise], [prior]), as gssm-process reads it")
+      ;
+}
+
+// The model as INI text, pickling, repr.
+void bindModelText(py::class_<Model, std::shared_ptr<Model>>& cls) {
+  cls.def("to_ini", &modelIni, "the model's INI form ([model], [noise], [prior]), as gssm-process reads it")
       .def("__reduce__",
            [](const Model& m) {
              return py::make_tuple(py::module_::import("gssm.models").attr("_from_ini_pickled"),
@@ -283,137 +271,9 @@ void bindModels(py::module_& models) {
                " nu=" + std::to_string(d.nu) + " ny=" + std::to_string(d.ny) + " channels=" +
                std::to_string(m.numChannels()) + ">";
       });
+}
 
-  models.def(
-      "from_ini",
-      [](const std::string& text, const std::string& data_dir) -> std::shared_ptr<Model> {
-        return std::shared_ptr<Model>(io::makeModel(io::IniDocument::parse(text, "<ini text>"), data_dir));
-      },
-      py::arg("text"), py::arg("data_dir") = "",
-      "The model an INI text describes (as in a dataset's scenario.ini); file names in it are read from data_dir.");
-
-  const models::Radar2D::Params rp;
-  py::class_<models::Radar2D, Model, std::shared_ptr<models::Radar2D>>(
-      models, "Radar2D", "The paper's radar example: x_c = x, x_b = [xdot, h], y = range (docs/DESIGN.md §2).")
-      .def(py::init([](double T, double q, double r, double prior_x, double prior_xdot, double prior_h,
-                       double prior_var_x, double prior_var_xdot, double prior_var_h) {
-             models::Radar2D::Params p;
-             p.T = T, p.q = q, p.r = r, p.prior_x = prior_x, p.prior_xdot = prior_xdot, p.prior_h = prior_h;
-             p.prior_var_x = prior_var_x, p.prior_var_xdot = prior_var_xdot, p.prior_var_h = prior_var_h;
-             return std::make_shared<models::Radar2D>(p);
-           }),
-           py::arg("T") = rp.T, py::arg("q") = rp.q, py::arg("r") = rp.r, py::arg("prior_x") = rp.prior_x,
-           py::arg("prior_xdot") = rp.prior_xdot, py::arg("prior_h") = rp.prior_h,
-           py::arg("prior_var_x") = rp.prior_var_x, py::arg("prior_var_xdot") = rp.prior_var_xdot,
-           py::arg("prior_var_h") = rp.prior_var_h);
-
-  const models::Nav2D::Params np;
-  py::class_<models::Nav2D, Model, std::shared_ptr<models::Nav2D>>(
-      models, "Nav2D", "Constant-velocity vehicle ranging to beacons, with a range bias and clock drift as constants.")
-      .def(py::init([](double T, double accel_noise, double range_sigma, const MatrixXd& beacons,
-                       const Eigen::Vector4d& prior_state, const Eigen::Vector4d& prior_state_sd,
-                       const Eigen::Vector3d& prior_constants, const Eigen::Vector3d& prior_constants_sd) {
-             models::Nav2D::Params p;
-             p.T = T, p.accel_noise = accel_noise, p.range_sigma = range_sigma;
-             p.beacons = points(beacons, "Nav2D beacons");
-             p.prior_state = prior_state, p.prior_state_sd = prior_state_sd;
-             p.prior_constants = prior_constants, p.prior_constants_sd = prior_constants_sd;
-             return std::make_shared<models::Nav2D>(p);
-           }),
-           py::arg("T") = np.T, py::arg("accel_noise") = np.accel_noise, py::arg("range_sigma") = np.range_sigma,
-           py::arg("beacons") = pointsMatrix(np.beacons), py::arg("prior_state") = np.prior_state,
-           py::arg("prior_state_sd") = np.prior_state_sd, py::arg("prior_constants") = np.prior_constants,
-           py::arg("prior_constants_sd") = np.prior_constants_sd)
-      .def_property_readonly("beacons", [](const models::Nav2D& m) { return pointsMatrix(m.beacons()); });
-
-  const models::RangeBeacon2D::Params bp;
-  py::class_<models::RangeBeacon2D, Model, std::shared_ptr<models::RangeBeacon2D>>(
-      models, "RangeBeacon2D",
-      "A vehicle with odometry ranging to known beacons (the CMU Plaza logs); range scale, per-beacon offsets "
-      "and odometry scale as optional constants; one channel per beacon.")
-      .def(py::init([](const std::vector<int>& beacon_ids, const MatrixXd& beacons, double T, bool range_scale,
-                       bool range_offsets, bool odometry_scale, double range_sd, double distance_sd, double turn_sd,
-                       double heading_drift_sd, double position_sd_per_s, double heading_sd_per_s,
-                       const Eigen::Vector3d& start, const Eigen::Vector3d& start_sd, double range_scale_sd,
-                       double range_offset_sd, double odometry_scale_sd, const std::string& range_loss,
-                       double range_loss_scale, double ekf_gate) {
-             models::RangeBeacon2D::Params p;
-             p.beacon_ids = beacon_ids;
-             p.beacons = points(beacons, "RangeBeacon2D beacons");
-             p.T = T, p.range_scale = range_scale, p.range_offsets = range_offsets, p.odometry_scale = odometry_scale;
-             p.range_sd = range_sd, p.distance_sd = distance_sd, p.turn_sd = turn_sd;
-             p.heading_drift_sd = heading_drift_sd, p.position_sd_per_s = position_sd_per_s;
-             p.heading_sd_per_s = heading_sd_per_s, p.start = start, p.start_sd = start_sd;
-             p.range_scale_sd = range_scale_sd, p.range_offset_sd = range_offset_sd;
-             p.odometry_scale_sd = odometry_scale_sd;
-             p.range_loss = lossNamed(range_loss, range_loss_scale);
-             p.ekf_gate = ekf_gate;
-             return std::make_shared<models::RangeBeacon2D>(p);
-           }),
-           py::arg("beacon_ids"), py::arg("beacons"), py::arg("T") = bp.T, py::arg("range_scale") = bp.range_scale,
-           py::arg("range_offsets") = bp.range_offsets, py::arg("odometry_scale") = bp.odometry_scale,
-           py::arg("range_sd") = bp.range_sd, py::arg("distance_sd") = bp.distance_sd,
-           py::arg("turn_sd") = bp.turn_sd, py::arg("heading_drift_sd") = bp.heading_drift_sd,
-           py::arg("position_sd_per_s") = bp.position_sd_per_s, py::arg("heading_sd_per_s") = bp.heading_sd_per_s,
-           py::arg("start") = bp.start, py::arg("start_sd") = bp.start_sd,
-           py::arg("range_scale_sd") = bp.range_scale_sd, py::arg("range_offset_sd") = bp.range_offset_sd,
-           py::arg("odometry_scale_sd") = bp.odometry_scale_sd, py::arg("range_loss") = "none",
-           py::arg("range_loss_scale") = 1.345, py::arg("ekf_gate") = bp.ekf_gate)
-      .def_property_readonly("beacons", [](const models::RangeBeacon2D& m) { return pointsMatrix(m.params().beacons); })
-      .def_property_readonly("beacon_ids", [](const models::RangeBeacon2D& m) { return m.params().beacon_ids; });
-
-  py::class_<models::LinearModel, Model, std::shared_ptr<models::LinearModel>>(
-      models, "Linear",
-      "A linear GSSM from matrices: x_c' = A_c x_c + A_b x_b + B u (continuous time, discretized by "
-      "`discretization`), y = C_c x_c + C_b x_b; channels: further sensors as dicts with name, C_c, C_b, R.")
-      .def(py::init([](const MatrixXd& A_c, const MatrixXd& C_c, const MatrixXd& Q, const MatrixXd& R,
-                       const std::optional<MatrixXd>& A_b, const std::optional<MatrixXd>& B,
-                       const std::optional<MatrixXd>& C_b, const std::optional<VectorXd>& prior_state_mean,
-                       const std::optional<MatrixXd>& prior_state_cov,
-                       const std::optional<VectorXd>& prior_constants_mean,
-                       const std::optional<MatrixXd>& prior_constants_cov, double T, const std::string& discretization,
-                       const std::vector<py::dict>& channels, const std::vector<std::string>& state_names,
-                       const std::vector<std::string>& constant_names, const std::vector<std::string>& input_names,
-                       const std::vector<std::string>& measurement_names) {
-             const Eigen::Index nc = A_c.rows();
-             const Eigen::Index nb = A_b ? A_b->cols() : (C_b ? C_b->cols() : 0);
-             models::LinearSystem s;
-             s.A_c = A_c;
-             s.C_c = C_c;
-             s.A_b = A_b ? *A_b : MatrixXd::Zero(nc, nb);
-             s.B = B ? *B : MatrixXd::Zero(nc, 0);
-             s.C_b = C_b ? *C_b : MatrixXd::Zero(C_c.rows(), nb);
-             s.noise.T = T;
-             s.noise.Q = Q;
-             s.noise.R = R;
-             s.noise.prior_state = gaussian(prior_state_mean, prior_state_cov, static_cast<int>(nc));
-             s.noise.prior_constants = gaussian(prior_constants_mean, prior_constants_cov, static_cast<int>(nb));
-             s.names = {state_names, constant_names, input_names, measurement_names};
-             for (const py::dict& c : channels) {
-               models::LinearChannel ch;
-               ch.name = c["name"].cast<std::string>();
-               ch.C_c = c["C_c"].cast<MatrixXd>();
-               ch.C_b = c.contains("C_b") ? c["C_b"].cast<MatrixXd>() : MatrixXd::Zero(ch.C_c.rows(), nb);
-               ch.R = c["R"].cast<MatrixXd>();
-               if (c.contains("components")) ch.components = c["components"].cast<std::vector<std::string>>();
-               s.channels.push_back(std::move(ch));
-             }
-             if (discretization != "euler" && discretization != "exact")
-               throw InvalidArgument("Linear: discretization '" + discretization + "': expected euler or exact");
-             return std::make_shared<models::LinearModel>(
-                 std::move(s), discretization == "exact" ? models::Discretization::Exact : models::Discretization::Euler);
-           }),
-           py::arg("A_c"), py::arg("C_c"), py::arg("Q"), py::arg("R"), py::arg("A_b") = py::none(),
-           py::arg("B") = py::none(), py::arg("C_b") = py::none(), py::arg("prior_state_mean") = py::none(),
-           py::arg("prior_state_cov") = py::none(), py::arg("prior_constants_mean") = py::none(),
-           py::arg("prior_constants_cov") = py::none(), py::arg("T") = 1.0, py::arg("discretization") = "euler",
-           py::arg("channels") = std::vector<py::dict>{}, py::arg("state_names") = std::vector<std::string>{},
-           py::arg("constant_names") = std::vector<std::string>{}, py::arg("input_names") = std::vector<std::string>{},
-           py::arg("measurement_names") = std::vector<std::string>{})
-      .def_property_readonly("discretization", [](const models::LinearModel& m) {
-        return m.discretization() == models::Discretization::Exact ? "exact" : "euler";
-      });
-
+void bindFunctionModel(py::module_& models) {
   py::class_<models::FunctionModel, Model, std::shared_ptr<models::FunctionModel>>(
       models, "_FunctionModel", "Base of gssm.models.PythonModel (use that).")
       .def(py::init(&makePythonModel), py::arg("nc"), py::arg("nb"), py::arg("nu"), py::arg("ny"), py::arg("f"),
@@ -425,6 +285,23 @@ void bindModels(py::module_& models) {
            py::arg("input_names") = std::vector<std::string>{},
            py::arg("measurement_names") = std::vector<std::string>{}, py::arg("verify_jacobians") = false)
       .def_property_readonly("jacobian_source", &models::FunctionModel::jacobianSource);
+}
+}  // namespace
+
+void bindModels(py::module_& models) {
+  bindChannel(models);
+  auto cls = bindModelProperties(models);
+  bindModelFunctions(cls);
+  bindModelText(cls);
+  models.def(
+      "from_ini",
+      [](const std::string& text, const std::string& data_dir) -> std::shared_ptr<Model> {
+        return std::shared_ptr<Model>(io::makeModel(io::IniDocument::parse(text, "<ini text>"), data_dir));
+      },
+      py::arg("text"), py::arg("data_dir") = "",
+      "The model an INI text describes (as in a dataset's scenario.ini); file names in it are read from data_dir.");
+  bindFunctionModel(models);
+  bindModelRegistry(models);
 }
 
 }  // namespace gssm::python

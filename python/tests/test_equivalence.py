@@ -104,7 +104,7 @@ def test_measurement_with_its_own_R_and_progress(repo):
     """add_measurement(R=...) equals a model whose channel has that R; the
     progress callback of gssm.run sees every measurement."""
     data = gssm.io.read_dataset(os.path.join(repo, "datasets", "radar-paper"))
-    noisy = gssm.models.Radar2D(r=36.0)
+    noisy = gssm.models.Radar2D(R=36.0)
     for method in gssm.methods(streaming_only=True):
         a = gssm.make_estimator(gssm.models.Radar2D(), method)
         b = gssm.make_estimator(noisy, method)

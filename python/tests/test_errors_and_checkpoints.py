@@ -100,7 +100,7 @@ def test_checkpoint_continues_bit_for_bit(method, data, tmp_path):
 
 def test_builtin_models_pickle_through_their_ini_form(repo):
     plaza = gssm.io.read_dataset(os.path.join(repo, "datasets", "plaza2"))
-    for model in (gssm.models.Radar2D(r=4.0), gssm.models.Nav2D(), plaza.model,
+    for model in (gssm.models.Radar2D(R=4.0), gssm.models.Nav2D(), plaza.model,
                   gssm.models.Linear(A_c=[[0.0]], C_c=[[1.0]], Q=[[0.1]], R=[[1.0]], T=0.5)):
         copy = pickle.loads(pickle.dumps(model))
         assert type(copy) is type(model) and copy.to_ini() == model.to_ini()

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/byte_stream.h"
+#include "gssm/model/registry.h"
 
 namespace gssm {
 
@@ -30,6 +31,14 @@ void writeModelIdentity(internal::ByteWriter& out, const Model& m) {
   out.u64(internal::fnv1a64(params.bytes().data(), params.bytes().size()));
 }
 
+// The checkpoint's model tag names m's type: the same name, or an older
+// name the type still answers to ("radar2d" for radar_2d).
+bool sameModelType(const std::string& tag, const Model& m) {
+  if (tag == m.name()) return true;
+  const ModelType* t = findModelType(tag);
+  return t && t == findModelType(m.name());
+}
+
 void checkModelIdentity(internal::ByteReader& in, const Model& m, CheckpointInfo& info) {
   info.model = in.str("model name");
   int dims[4];
@@ -39,7 +48,7 @@ void checkModelIdentity(internal::ByteReader& in, const Model& m, CheckpointInfo
   writeModelIdentity(mine, m);
   const ModelDims& d = m.dims();
   std::ostringstream os;
-  if (info.model != m.name() || dims[0] != d.nc || dims[1] != d.nb || dims[2] != d.nu || dims[3] != d.ny) {
+  if (!sameModelType(info.model, m) || dims[0] != d.nc || dims[1] != d.nb || dims[2] != d.nu || dims[3] != d.ny) {
     os << "written by model '" << info.model << "' (n_c " << dims[0] << ", n_b " << dims[1] << ", n_u "
        << dims[2] << ", n_y " << dims[3] << "), cannot continue on model '" << m.name() << "' (n_c " << d.nc
        << ", n_b " << d.nb << ", n_u " << d.nu << ", n_y " << d.ny << ")";

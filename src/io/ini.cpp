@@ -166,6 +166,11 @@ const IniDocument::Entry& IniDocument::require(const std::string& section,
   return *e;
 }
 
+std::string IniDocument::where(const std::string& section, const std::string& key) const {
+  const Entry* e = find(section, key);
+  return source_ + (e ? ":" + std::to_string(e->line) : std::string()) + ": [" + section + "] " + key;
+}
+
 void IniDocument::fail(const std::string& section, const Entry& e,
                        const std::string& expected) const {
   throw InputError(source_ + ":" + std::to_string(e.line) + ": [" + section + "] " + e.key +

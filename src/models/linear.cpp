@@ -3,6 +3,8 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "gssm/core/error.h"
+#include "gssm/model/noise_params.h"
+#include "gssm/model/registry.h"
 
 namespace gssm::models {
 
@@ -130,5 +132,111 @@ Eigen::VectorXd LinearModel::h(int c, const Eigen::VectorXd& xc, const Eigen::Ve
   if (J_h_xb) *J_h_xb = ch.C_b;
   return ch.C_c * xc + ch.C_b * xb;
 }
+
+namespace {
+std::vector<ParamSpec> linearParams() {
+  using namespace param;
+  std::vector<ParamSpec> p{required(matrix("model", "A_c", "d/dt x_c = A_c x_c + A_b x_b + B u (n_c×n_c)")),
+                           matrix("model", "A_b", "n_c×n_b; absent: no constants"),
+                           matrix("model", "B", "n_c×n_u; absent: no input"),
+                           required(matrix("model", "C_c", "y = C_c x_c + C_b x_b (n_y×n_c)")),
+                           matrix("model", "C_b", "n_y×n_b"),
+                           text("model", "discretization", "euler (F = I + A T, the paper's) or exact (expm)"),
+                           sections("model", "channels", "channel", "further sensors, each a [channel.<name>]"),
+                           matrix("channel", "C_c", "the channel's C_c"),
+                           matrix("channel", "C_b", "the channel's C_b"),
+                           matrix("channel", "R", "the channel's noise covariance"),
+                           names("channel", "components", "the channel's component names"),
+                           names("model", "state_names", "names of x_c (default x1..)"),
+                           names("model", "constant_names", "names of x_b (default b1..)"),
+                           names("model", "input_names", "names of u (default u1..)"),
+                           names("model", "measurement_names", "names of y (default y1..)")};
+  for (ParamSpec& n : noiseParams()) {
+    if (n.key == "Q" || n.key == "R") n.required = true;
+    p.push_back(n);
+  }
+  return p;
+}
+
+Eigen::MatrixXd matrixOr(const ParamSource& in, const std::string& section, const char* key, Eigen::Index rows,
+                         Eigen::Index cols) {
+  return in.has(section, key) ? in.matrix(section, key, rows, cols) : Eigen::MatrixXd::Zero(rows, cols);
+}
+
+std::vector<LinearChannel> readChannels(const ParamSource& in, Eigen::Index nc, Eigen::Index nb) {
+  std::vector<LinearChannel> out;
+  if (!in.has("model", "channels")) return out;
+  for (const std::string& name : in.names("model", "channels")) {
+    const std::string section = "channel." + name;
+    LinearChannel c;
+    c.name = name;
+    c.C_c = in.matrix(section, "C_c", -1, nc);
+    c.C_b = matrixOr(in, section, "C_b", c.C_c.rows(), nb);
+    c.R = in.matrix(section, "R", c.C_c.rows(), c.C_c.rows());
+    if (in.has(section, "components")) c.components = in.names(section, "components");
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::unique_ptr<Model> readLinear(const ParamSource& in) {
+  LinearSystem s;
+  s.A_c = in.matrix("model", "A_c");
+  const Eigen::Index nc = s.A_c.rows();
+  s.C_c = in.matrix("model", "C_c", -1, nc);
+  // No A_b and C_b: a model without constants (n_b = 0).
+  const Eigen::Index nb = in.has("model", "A_b")   ? in.matrix("model", "A_b").cols()
+                          : in.has("model", "C_b") ? in.matrix("model", "C_b").cols()
+                                                   : 0;
+  s.A_b = matrixOr(in, "model", "A_b", nc, nb);
+  s.C_b = matrixOr(in, "model", "C_b", s.C_c.rows(), nb);
+  s.B = in.has("model", "B") ? in.matrix("model", "B", nc, -1) : Eigen::MatrixXd::Zero(nc, 0);
+  s.channels = readChannels(in, nc, nb);
+  for (auto [key, names] : {std::pair{"state_names", &s.names.state}, {"constant_names", &s.names.constants},
+                            {"input_names", &s.names.input}, {"measurement_names", &s.names.measurement}})
+    if (in.has("model", key)) *names = in.names("model", key);
+  const ModelDims d{static_cast<int>(nc), static_cast<int>(nb), static_cast<int>(s.B.cols()),
+                    static_cast<int>(s.C_c.rows())};
+  ModelNoise fallback;  // priors: zero mean, unit covariance
+  fallback.prior_state = {Eigen::VectorXd::Zero(nc), Eigen::MatrixXd::Identity(nc, nc)};
+  fallback.prior_constants = {Eigen::VectorXd::Zero(nb), Eigen::MatrixXd::Identity(nb, nb)};
+  s.noise = readNoise(in, d, fallback);
+  const std::string disc = in.text("model", "discretization", "euler");
+  if (disc != "euler" && disc != "exact")
+    throw InputError(in.where("model", "discretization") + " = '" + disc + "': expected euler or exact");
+  return std::make_unique<LinearModel>(std::move(s), disc == "exact" ? Discretization::Exact : Discretization::Euler);
+}
+
+void writeLinear(const LinearModel& lin, ParamSink& out) {
+  const LinearSystem& s = lin.system();
+  out.matrix("model", "A_c", s.A_c);
+  if (s.A_b.cols() > 0) out.matrix("model", "A_b", s.A_b);
+  if (s.B.size()) out.matrix("model", "B", s.B);
+  out.matrix("model", "C_c", s.C_c);
+  if (s.C_b.cols() > 0) out.matrix("model", "C_b", s.C_b);
+  std::vector<std::string> channels;
+  for (const auto& c : s.channels) {
+    channels.push_back(c.name);
+    out.matrix("channel." + c.name, "C_c", c.C_c);
+    if (c.C_b.cols() > 0) out.matrix("channel." + c.name, "C_b", c.C_b);
+    out.matrix("channel." + c.name, "R", c.R);
+    if (!c.components.empty()) out.names("channel." + c.name, "components", c.components);
+  }
+  if (!channels.empty()) out.names("model", "channels", channels);
+  out.text("model", "discretization", lin.discretization() == Discretization::Exact ? "exact" : "euler");
+  for (auto [key, names] : {std::pair{"state_names", &s.names.state}, {"constant_names", &s.names.constants},
+                            {"input_names", &s.names.input}, {"measurement_names", &s.names.measurement}})
+    if (!names->empty()) out.names("model", key, *names);
+  writeNoise(lin, out);
+}
+
+const ModelRegistration registration{{
+    "linear", {}, "Linear",
+    "A linear GSSM from matrices: x_c' = A_c x_c + A_b x_b + B u (continuous time, discretized by "
+    "`discretization`), y = C_c x_c + C_b x_b; channels: further sensors.",
+    linearParams(), readLinear,
+    [](const Model& m, ParamSink& out) { writeLinear(dynamic_cast<const LinearModel&>(m), out); },
+    [](const Model& m) { return dynamic_cast<const LinearModel*>(&m) != nullptr; }}};
+}  // namespace
 
 }  // namespace gssm::models

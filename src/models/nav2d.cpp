@@ -1,6 +1,8 @@
 #include "gssm/models/nav2d.h"
 
 #include "gssm/core/error.h"
+#include "gssm/model/noise_params.h"
+#include "gssm/model/registry.h"
 
 namespace gssm::models {
 
@@ -80,5 +82,48 @@ Eigen::VectorXd Nav2D::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, E
   }
   return y;
 }
+
+std::vector<Eigen::Vector2d> Nav2D::landmarks() const { return beacons_; }
+
+namespace {
+std::vector<Eigen::Vector2d> points(const Eigen::MatrixXd& rows) {
+  std::vector<Eigen::Vector2d> out;
+  for (Eigen::Index i = 0; i < rows.rows(); ++i) out.emplace_back(rows(i, 0), rows(i, 1));
+  return out;
+}
+
+std::vector<ParamSpec> navParams() {
+  std::vector<ParamSpec> p = noiseParams({false, true});
+  p.push_back(param::real("model", "accel_noise", "white acceleration noise density (m/s²/√Hz)"));
+  p.push_back(param::table("model", "beacons", {"x", "y"}, "beacon positions (m), one row 'x y' each"));
+  return p;
+}
+
+// [model] type = nav_2d: beacons, accel_noise, T, R and the priors; absent
+// keys keep Nav2D::Params' defaults (R: range_sigma² per beacon).
+const ModelRegistration registration{{
+    "nav_2d", {"nav2d"}, "Nav2D",
+    "Constant-velocity vehicle ranging to beacons, with an accelerometer bias and a range bias as constants.",
+    navParams(),
+    [](const ParamSource& in) -> std::unique_ptr<Model> {
+      Nav2D::Params p;
+      if (in.has("model", "beacons")) p.beacons = points(in.table("model", "beacons", {"x", "y"}));
+      if (p.beacons.empty()) throw InputError(in.where("model", "beacons") + ": expected at least one beacon");
+      p.accel_noise = in.real("model", "accel_noise", p.accel_noise);
+      const Nav2D defaults(p);
+      return std::make_unique<Nav2D>(readNoise(in, defaults.dims(), defaults.noise(), {false, true}), p.beacons,
+                                     p.accel_noise);
+    },
+    [](const Model& m, ParamSink& out) {
+      const auto& nav = dynamic_cast<const Nav2D&>(m);
+      Eigen::MatrixXd B(static_cast<Eigen::Index>(nav.beacons().size()), 2);
+      for (std::size_t i = 0; i < nav.beacons().size(); ++i)
+        B.row(static_cast<Eigen::Index>(i)) = nav.beacons()[i].transpose();
+      out.matrix("model", "beacons", B);
+      out.real("model", "accel_noise", nav.accelNoise());
+      writeNoise(m, out, {false, true});
+    },
+    [](const Model& m) { return dynamic_cast<const Nav2D*>(&m) != nullptr; }}};
+}  // namespace
 
 }  // namespace gssm::models

@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include "gssm/model/noise_params.h"
+#include "gssm/model/registry.h"
+
 namespace gssm::models {
 
 namespace {
@@ -52,5 +55,20 @@ Eigen::VectorXd Radar2D::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
   }
   return Eigen::VectorXd::Constant(1, rho);
 }
+
+namespace {
+// [model] type = radar_2d: T, Q, R and the priors; absent keys keep the
+// paper's settings.
+const ModelRegistration registration{{
+    "radar_2d", {"radar2d"}, "Radar2D",
+    "The paper's radar example: x_c = x, x_b = [xdot, h], y = range (docs/DESIGN.md §2).",
+    noiseParams(),
+    [](const ParamSource& in) -> std::unique_ptr<Model> {
+      const Radar2D paper;
+      return std::make_unique<Radar2D>(readNoise(in, paper.dims(), paper.noise()));
+    },
+    [](const Model& m, ParamSink& out) { writeNoise(m, out); },
+    [](const Model& m) { return dynamic_cast<const Radar2D*>(&m) != nullptr; }}};
+}  // namespace
 
 }  // namespace gssm::models

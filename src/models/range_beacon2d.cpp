@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "gssm/core/error.h"
+#include "gssm/model/noise_params.h"
+#include "gssm/model/registry.h"
 
 namespace gssm::models {
 
@@ -126,5 +128,108 @@ Eigen::MatrixXd RangeBeacon2D::processNoiseOf(double dt, const Eigen::VectorXd& 
                       p_.heading_sd_per_s * p_.heading_sd_per_s * dt;
   return Eigen::Vector3d(pos, pos, head).asDiagonal();
 }
+
+std::vector<Eigen::Vector2d> RangeBeacon2D::landmarks() const { return p_.beacons; }
+
+namespace {
+std::vector<ParamSpec> rangeBeaconParams() {
+  using namespace param;
+  std::vector<ParamSpec> p{
+      real("model", "T", "nominal odometry period (s)"),
+      required(table("model", "beacons", {"beacon", "x", "y"}, "beacons: rows 'id x y' (m), or a CSV file beacon,x,y")),
+      flag("model", "range_scale", "estimate a common range scale s_r"),
+      flag("model", "range_offsets", "estimate a range offset per beacon"),
+      flag("model", "odometry_scale", "estimate an odometry distance scale s_d"),
+      real("model", "range_sd", "σ of one range (m)"),
+      real("model", "distance_sd", "odometry position noise, m per √m travelled"),
+      real("model", "turn_sd", "heading noise, rad per √rad turned"),
+      real("model", "heading_drift_sd", "heading noise, rad per √m travelled"),
+      real("model", "position_sd_per_s", "position noise floor, m per √s"),
+      real("model", "heading_sd_per_s", "heading noise floor, rad per √s")};
+  for (auto& l : lossParams("model")) p.push_back(l);
+  for (auto& q : {real("model", "ekf_gate", "EKF NIS gate of every range (0: none)"),
+                  any("prior", "start", "prior mean of [px, py] (m), or 'truth': the truth file's first row"),
+                  real("prior", "position_sd", "prior σ of px and py (m)"),
+                  real("prior", "heading", "prior mean of the heading (rad)"),
+                  real("prior", "heading_sd", "prior σ of the heading (rad)"),
+                  real("prior", "range_scale_sd", "prior σ of s_r (mean 1)"),
+                  real("prior", "range_offset_sd", "prior σ of each range offset (mean 0), m"),
+                  real("prior", "odometry_scale_sd", "prior σ of s_d (mean 1)")})
+    p.push_back(q);
+  return p;
+}
+
+// [prior] start: "x y", or "truth" (the first row of [dataset] truth).
+Eigen::Vector2d readStart(const ParamSource& in) {
+  if (in.has("prior", "start") && in.text("prior", "start") == "truth") {
+    const Eigen::MatrixXd t = in.dataFile(in.text("dataset", "truth", "truth.csv"), {"px", "py"});
+    if (t.rows() == 0) throw InputError(in.where("prior", "start") + " = truth: the truth file has no rows");
+    return t.row(0).transpose();
+  }
+  return in.has("prior", "start") ? Eigen::Vector2d(in.vector("prior", "start", 2)) : Eigen::Vector2d::Zero();
+}
+
+RangeBeacon2D::Params readRangeBeacon(const ParamSource& in) {
+  RangeBeacon2D::Params p;
+  const Eigen::MatrixXd B = in.table("model", "beacons", {"beacon", "x", "y"});
+  for (Eigen::Index i = 0; i < B.rows(); ++i) {
+    if (B(i, 0) != std::floor(B(i, 0)))
+      throw InputError(in.where("model", "beacons") + ": row " + std::to_string(i + 1) + ": id must be an integer");
+    p.beacon_ids.push_back(static_cast<int>(B(i, 0)));
+    p.beacons.emplace_back(B(i, 1), B(i, 2));
+  }
+  p.T = in.real("model", "T", p.T);
+  p.range_scale = in.flag("model", "range_scale", p.range_scale);
+  p.range_offsets = in.flag("model", "range_offsets", p.range_offsets);
+  p.odometry_scale = in.flag("model", "odometry_scale", p.odometry_scale);
+  for (auto [key, value] : {std::pair{"range_sd", &p.range_sd}, {"distance_sd", &p.distance_sd},
+                            {"turn_sd", &p.turn_sd}, {"heading_drift_sd", &p.heading_drift_sd},
+                            {"position_sd_per_s", &p.position_sd_per_s}, {"heading_sd_per_s", &p.heading_sd_per_s}})
+    *value = in.real("model", key, *value);
+  p.range_loss = readLoss(in, "model");
+  p.ekf_gate = in.real("model", "ekf_gate", p.ekf_gate);
+  p.start.head<2>() = readStart(in);
+  p.start[2] = in.real("prior", "heading", 0.0);
+  const double psd = in.real("prior", "position_sd", 1.0);
+  p.start_sd << psd, psd, in.real("prior", "heading_sd", M_PI);
+  p.range_scale_sd = in.real("prior", "range_scale_sd", p.range_scale_sd);
+  p.range_offset_sd = in.real("prior", "range_offset_sd", p.range_offset_sd);
+  p.odometry_scale_sd = in.real("prior", "odometry_scale_sd", p.odometry_scale_sd);
+  return p;
+}
+
+void writeRangeBeacon(const RangeBeacon2D::Params& p, ParamSink& out) {
+  Eigen::MatrixXd B(static_cast<Eigen::Index>(p.beacons.size()), 3);
+  for (std::size_t i = 0; i < p.beacons.size(); ++i)
+    B.row(static_cast<Eigen::Index>(i)) << p.beacon_ids[i], p.beacons[i].x(), p.beacons[i].y();
+  out.real("model", "T", p.T);
+  out.matrix("model", "beacons", B);
+  out.flag("model", "range_scale", p.range_scale);
+  out.flag("model", "range_offsets", p.range_offsets);
+  out.flag("model", "odometry_scale", p.odometry_scale);
+  for (auto [key, value] : {std::pair{"range_sd", p.range_sd}, {"distance_sd", p.distance_sd}, {"turn_sd", p.turn_sd},
+                            {"heading_drift_sd", p.heading_drift_sd}, {"position_sd_per_s", p.position_sd_per_s},
+                            {"heading_sd_per_s", p.heading_sd_per_s}})
+    out.real("model", key, value);
+  writeLoss(p.range_loss, "model", out);
+  out.real("model", "ekf_gate", p.ekf_gate);
+  out.vector("prior", "start", p.start.head<2>());
+  out.real("prior", "position_sd", p.start_sd[0]);
+  out.real("prior", "heading", p.start[2]);
+  out.real("prior", "heading_sd", p.start_sd[2]);
+  out.real("prior", "range_scale_sd", p.range_scale_sd);
+  out.real("prior", "range_offset_sd", p.range_offset_sd);
+  out.real("prior", "odometry_scale_sd", p.odometry_scale_sd);
+}
+
+const ModelRegistration registration{{
+    "range_beacon_2d", {}, "RangeBeacon2D",
+    "A vehicle with odometry ranging to known beacons (the CMU Plaza logs); range scale, per-beacon offsets and "
+    "odometry scale as optional constants; one channel per beacon.",
+    rangeBeaconParams(),
+    [](const ParamSource& in) -> std::unique_ptr<Model> { return std::make_unique<RangeBeacon2D>(readRangeBeacon(in)); },
+    [](const Model& m, ParamSink& out) { writeRangeBeacon(dynamic_cast<const RangeBeacon2D&>(m).params(), out); },
+    [](const Model& m) { return dynamic_cast<const RangeBeacon2D*>(&m) != nullptr; }}};
+}  // namespace
 
 }  // namespace gssm::models

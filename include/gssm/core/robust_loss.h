@@ -58,6 +58,15 @@ struct RobustLoss {
     }
     return "?";
   }
+  /// The kind called `text` ("none", "huber", "cauchy", "tukey"); false if none is.
+  static bool named(const std::string& text, Kind* kind) {
+    for (Kind k : {Kind::None, Kind::Huber, Kind::Cauchy, Kind::Tukey})
+      if (text == name(k)) return *kind = k, true;
+    return false;
+  }
+  /// The usual scale of each kind: Huber's 1.345 (95% efficiency on
+  /// Gaussian noise), 2.5 for Cauchy and Tukey.
+  static double defaultScale(Kind k) { return k == Kind::Huber ? 1.345 : 2.5; }
   bool validate(std::string* why = nullptr) const {
     if (robust() && !(scale > 0 && std::isfinite(scale))) {
       if (why) *why = std::string("robust loss ") + name(kind) + ": scale must be > 0";

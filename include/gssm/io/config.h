@@ -1,9 +1,9 @@
 #pragma once
 // Models, estimator options and scenarios from an INI configuration. Each
 // component reads its own section:
-//   [model]  type (radar2d | linear), T, Q, R  (linear: A_c, A_b, B, C_c, C_b,
-//            discretization = euler | exact)
-//   [prior]  state_mean, state_cov, constants_mean, constants_cov
+//   [model]  type (a registered model: radar_2d, nav_2d, range_beacon_2d,
+//            linear, ...) and its parameters; [prior] its priors (each
+//            model type declares its keys: docs/DESIGN.md §3, "Adding a model")
 //   [truth]  state0, constants (absent: drawn from the prior), process_noise,
 //            measurement_noise
 //   [scenario] name, seed, steps
@@ -27,11 +27,11 @@ namespace gssm::io {
 /// its start position comes from) are read from `data_dir` when given, else
 /// from the INI's folder.
 std::unique_ptr<Model> makeModel(const IniDocument& ini, const std::string& data_dir = "");
-/// Positions of the model's landmarks ([model] beacons, rows of "x y");
-/// empty if it has none.
-std::vector<Eigen::Vector2d> landmarks(const IniDocument& ini, const std::string& data_dir = "");
-/// Writes a model's [model] and [prior] sections (radar2d and linear).
+/// Writes a model's [model] and [prior] sections (and a linear model's
+/// [channel.<name>]s); InvalidArgument for a model type not registered.
 void writeModel(const Model& model, IniDocument& ini);
+/// A file named in the INI: in `data_dir` when given, else beside the INI.
+std::string dataFile(const IniDocument& ini, const std::string& data_dir, const std::string& file);
 
 /// The method named by `text`; InputError naming `where` (e.g. "option
 /// --method" or "s.ini: [run] method") and the known names otherwise.

@@ -54,6 +54,8 @@ class IniDocument {
   void requireOnlyKeys(const std::string& section, const std::vector<std::string>& allowed) const;
 
   const std::string& source() const { return source_; }
+  /// "file:line: [section] key" where the key is, "file: [section] key" where it is not.
+  std::string where(const std::string& section, const std::string& key) const;
 
  private:
   struct Entry {

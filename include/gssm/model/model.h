@@ -60,7 +60,8 @@ class Model {
  public:
   virtual ~Model() = default;
 
-  /// Short identifier ("radar2d", "linear").
+  /// Short identifier: the registered type's name ("radar_2d", "linear";
+  /// docs/DESIGN.md §3, "Adding a model"), the checkpoint's model tag.
   virtual std::string name() const = 0;
 
   /// Discrete process model x_c(k+1) = f(x_c(k), x_b, u_k, dt); fills the
@@ -120,6 +121,10 @@ class Model {
   GaussianNoise processNoiseModel(double dt, std::int64_t step) const;
   const Gaussian& priorState() const { return noise_.prior_state; }
   const Gaussian& priorConstants() const { return noise_.prior_constants; }
+
+  /// Fixed points its measurements refer to (beacons), in the world frame,
+  /// for plan-view figures; none by default.
+  virtual std::vector<Eigen::Vector2d> landmarks() const { return {}; }
 
   /// All state names in the stacked order [x_c; x_b].
   std::vector<std::string> stackedStateNames() const;

@@ -30,9 +30,10 @@ class Nav2D final : public Model {
   /// Any noise and priors (e.g. from a config file) with the given beacons.
   Nav2D(const ModelNoise& noise, std::vector<Eigen::Vector2d> beacons, double accel_noise);
 
-  std::string name() const override { return "nav2d"; }
+  std::string name() const override { return "nav_2d"; }
   const std::vector<Eigen::Vector2d>& beacons() const { return beacons_; }
   double accelNoise() const { return accel_noise_; }
+  std::vector<Eigen::Vector2d> landmarks() const override;
 
   /// White-noise acceleration over dt: q·[[dt³/3 I, dt²/2 I], [dt²/2 I, dt I]].
   Eigen::MatrixXd processNoise(double dt) const override;

@@ -22,7 +22,7 @@ class Radar2D final : public Model {
   /// Any step, noise and (full-covariance) priors, e.g. from a config file.
   explicit Radar2D(const ModelNoise& noise);
 
-  std::string name() const override { return "radar2d"; }
+  std::string name() const override { return "radar_2d"; }
 
   Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     const Eigen::VectorXd& u, double dt, Eigen::MatrixXd* J_f_xc = nullptr,

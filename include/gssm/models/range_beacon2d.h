@@ -45,6 +45,7 @@ class RangeBeacon2D final : public Model {
 
   std::string name() const override { return "range_beacon_2d"; }
   const Params& params() const { return p_; }
+  std::vector<Eigen::Vector2d> landmarks() const override;
   /// Index of s_r, o_<id>, s_d in x_b, or −1 when not estimated.
   int rangeScaleIndex() const { return i_scale_; }
   int rangeOffsetIndex(std::size_t beacon) const { return i_offset_ < 0 ? -1 : i_offset_ + static_cast<int>(beacon); }

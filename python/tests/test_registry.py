@@ -1,0 +1,79 @@
+"""Registered model types in Python (docs/DESIGN.md §3, "Adding a model"):
+every class comes from its C++ registration (keywords = its INI keys, the
+C++ defaults); a model defined in the test tree (tests/models/drift_1d)
+appears in gssm.models once its extension is loaded."""
+import importlib
+import os
+import pickle
+import sys
+
+import numpy as np
+import pytest
+
+import gssm
+from conftest import BUILD
+
+
+def load_test_models():
+    path = os.path.join(BUILD, "tests", "python")
+    if not os.path.isdir(path):
+        pytest.skip("tests/models extension not built")
+    sys.path.insert(0, path)
+    try:
+        return importlib.import_module("gssm_test_models")
+    finally:
+        sys.path.remove(path)
+
+
+def test_test_tree_model_appears_in_python():
+    load_test_models()
+    names = [t["class_name"] for t in gssm.models.registered_types()]
+    assert "Drift1D" in names
+    model = gssm.models.Drift1D(q=0.04, prior_start=3.0)
+    assert isinstance(model, gssm.models.Drift1D) and not isinstance(model, gssm.models.Radar2D)
+    assert model.name == "drift_1d" and model.nb == 2
+    assert model.params["q"] == 0.04 and model.params["prior_start"] == 3.0
+    assert model.params["r"] == 0.25  # the C++ default
+    # Through its INI form and pickling, the same model.
+    again = gssm.models.from_ini(model.to_ini())
+    assert again.params == model.params
+    assert pickle.loads(pickle.dumps(model)).params == model.params
+    with pytest.raises(gssm.InvalidArgument, match="unknown parameter 'qq'.*known: T, q, r"):
+        gssm.models.Drift1D(qq=1.0)
+
+
+def test_test_tree_model_estimates_as_the_equivalent_linear_model():
+    load_test_models()
+    drift = gssm.models.Drift1D(T=0.5, q=0.02, r=0.3)
+    Q = drift.Q
+    linear = gssm.models.Linear(A_c=[[0.0]], A_b=[[1.0, 0.0]], C_c=[[1.0]], C_b=[[0.0, 1.0]], Q=Q, R=drift.R,
+                                T=0.5, prior_state_mean=drift.prior_state[0], prior_state_cov=drift.prior_state[1],
+                                prior_constants_mean=drift.prior_constants[0],
+                                prior_constants_cov=drift.prior_constants[1])
+    data = gssm.simulate(linear, seed=4, steps=50)
+    a = gssm.run(drift, data, method="incremental")
+    b = gssm.run(linear, data, method="incremental")
+    np.testing.assert_allclose(a.mean, b.mean, rtol=1e-9, atol=1e-9)
+
+
+def test_keywords_are_the_ini_keys_and_defaults_are_the_cpp_ones(repo):
+    # Radar2D() is the paper's model, as the INI of the radar-paper dataset says.
+    ini = gssm.models.from_ini(open(os.path.join(repo, "datasets", "radar-paper", "scenario.ini")).read())
+    paper = gssm.models.Radar2D()
+    for name in ("T", "Q", "R", "prior_state_mean", "prior_state_cov", "prior_constants_mean", "prior_constants_cov"):
+        np.testing.assert_array_equal(np.asarray(paper.params[name]), np.asarray(ini.params[name]))
+    assert gssm.models.Radar2D(R=36.0).params["R"][0, 0] == 36.0
+    for info in gssm.models.registered_types():
+        cls = getattr(gssm.models, info["class_name"])
+        assert info["summary"] in cls.__doc__
+        for p in info["params"]:
+            assert p["name"] in cls.__doc__
+
+
+def test_bad_keyword_values_name_the_keyword():
+    with pytest.raises(gssm.InvalidArgument, match=r"Radar2D\(R=...\).*shape \(2, 2\)"):
+        gssm.models.Radar2D(R=np.eye(2))
+    with pytest.raises(gssm.InvalidArgument, match=r"RangeBeacon2D\(beacons=...\).*no default"):
+        gssm.models.RangeBeacon2D()
+    with pytest.raises(gssm.Error, match=r"RangeBeacon2D\(loss=...\).*huber"):
+        gssm.models.RangeBeacon2D(beacons=[[0, 0.0, 0.0]], loss="hubber")

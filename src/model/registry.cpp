@@ -1,0 +1,110 @@
+#include "gssm/model/registry.h"
+
+#include <algorithm>
+#include <deque>
+#include <mutex>
+
+#include "gssm/core/error.h"
+
+namespace gssm {
+
+namespace {
+// One registry per process, built on first use (registrations run during
+// static initialization, in any order).
+struct Registry {
+  std::mutex mutex;
+  std::deque<ModelType> types;  // a deque: pointers stay valid as types are added
+};
+
+Registry& registry() {
+  static Registry r;
+  return r;
+}
+
+bool named(const ModelType& t, const std::string& name) {
+  return t.name == name || std::find(t.aliases.begin(), t.aliases.end(), name) != t.aliases.end();
+}
+
+void requireComplete(const ModelType& t) {
+  if (t.name.empty() || t.class_name.empty())
+    throw InvalidArgument("registerModelType: a model type needs a name and a class name");
+  if (!t.read || !t.write || !t.owns)
+    throw InvalidArgument("registerModelType '" + t.name + "': read, write and owns must all be given");
+  for (std::size_t i = 0; i < t.params.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (t.params[i].pythonKey() == t.params[j].pythonKey())
+        throw InvalidArgument("registerModelType '" + t.name + "': parameter '" + t.params[i].pythonKey() +
+                              "' declared twice");
+}
+}  // namespace
+
+const ParamSpec* ModelType::param(const std::string& section, const std::string& key) const {
+  for (const auto& p : params)
+    if (p.section == section && p.key == key) return &p;
+  return nullptr;
+}
+
+std::vector<std::string> ModelType::sections() const {
+  std::vector<std::string> out;
+  for (const auto& p : params) {
+    const bool sub = std::any_of(params.begin(), params.end(), [&](const ParamSpec& q) {
+      return q.kind == ParamKind::Sections && q.subsection == p.section;
+    });
+    if (!sub && std::find(out.begin(), out.end(), p.section) == out.end()) out.push_back(p.section);
+  }
+  return out;
+}
+
+std::vector<std::string> ModelType::keysOf(const std::string& section) const {
+  const std::string base = section.substr(0, section.find('.'));
+  std::vector<std::string> out;
+  for (const auto& p : params)
+    if (p.section == base) out.push_back(p.key);
+  return out;
+}
+
+void registerModelType(ModelType type) {
+  requireComplete(type);
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  for (const auto& t : r.types) {
+    bool clash = named(t, type.name) || t.class_name == type.class_name;
+    for (const auto& a : type.aliases) clash = clash || named(t, a);
+    if (clash)
+      throw InvalidArgument("registerModelType '" + type.name + "' (" + type.class_name +
+                            "): the name, an alias or the class name is taken by '" + t.name + "'");
+  }
+  r.types.push_back(std::move(type));
+}
+
+const ModelType* findModelType(const std::string& name) {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  for (const auto& t : r.types)
+    if (named(t, name)) return &t;
+  return nullptr;
+}
+
+const ModelType* modelTypeOf(const Model& model) {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  for (const auto& t : r.types)
+    if (t.owns(model)) return &t;
+  return nullptr;
+}
+
+std::vector<const ModelType*> modelTypes() {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  std::vector<const ModelType*> out;
+  for (const auto& t : r.types) out.push_back(&t);
+  return out;
+}
+
+std::string modelTypeNames() {
+  std::string out;
+  for (const ModelType* t : modelTypes()) out += (out.empty() ? "" : ", ") + t->name;
+  return out;
+}
+
+}  // namespace gssm
