@@ -9,6 +9,7 @@
 #include "gssm/io/config.h"
 #include "gssm/io/csv.h"
 #include "gssm/io/ini.h"
+#include "gssm/io/json_text.h"
 #include "gssm/io/number_text.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
@@ -257,4 +258,15 @@ TEST(Csv, WriteThenReadGivesTheSameDoubles) {
   ASSERT_EQ(t.rows.size(), rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i)
     EXPECT_EQ(std::vector<double>(t.rows[i].begin(), t.rows[i].end()), rows[i]) << "row " << i;
+}
+
+TEST(JsonText, EscapesEveryControlCharacterAndKeepsUtf8) {
+  EXPECT_EQ(io::jsonQuoted("a\"b\\c"), "\"a\\\"b\\\\c\"");
+  EXPECT_EQ(io::jsonQuoted("\t\n\r\b\f"), "\"\\t\\n\\r\\b\\f\"");
+  EXPECT_EQ(io::jsonQuoted(std::string("\x01\x1f\x7f", 3)), "\"\\u0001\\u001f\\u007f\"");
+  EXPECT_EQ(io::jsonQuoted(std::string("\0", 1)), "\"\\u0000\"");
+  EXPECT_EQ(io::jsonQuoted("Zürich 東京 🚗"), "\"Zürich 東京 🚗\"");  // valid UTF-8 as it is
+  // Invalid UTF-8 (a lone continuation byte, a truncated sequence, an overlong '/') is replaced.
+  EXPECT_EQ(io::jsonQuoted("\x80x\xe6\x9d"), "\"\\ufffdx\\ufffd\\ufffd\"");
+  EXPECT_EQ(io::jsonQuoted("\xc0\xaf"), "\"\\ufffd\\ufffd\"");
 }

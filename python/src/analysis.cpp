@@ -138,7 +138,7 @@ void bindAnalysis(py::module_& a) {
       "What the data determine about x_b, from its posterior covariance and the model's prior.");
 
   a.def("chi2_quantile", &chiSquareQuantile, py::arg("p"), py::arg("dof"),
-        "χ²_dof quantile (Wilson–Hilferty), as the consistency verdicts use");
+        "χ²_dof quantile (exact: inversion of the regularized incomplete gamma), as the consistency verdicts use");
   a.def(
       "nees_interval",
       [](int dof, int runs, double probability) {

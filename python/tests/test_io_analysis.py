@@ -68,3 +68,31 @@ def test_bounds_and_identifiability():
     assert ident["rank"] == 2 and ident["determined"]
     lo, hi = gssm.analysis.nees_interval(3, runs=1)
     assert np.isclose(lo, gssm.analysis.chi2_quantile(0.025, 3)) and lo < 3 < hi
+
+
+def test_nees_interval_of_one_degree_is_exact():
+    # χ²₁'s 2.5% and 97.5% quantiles, from the normal's: (Φ⁻¹(0.4875))², (Φ⁻¹(0.0125))².
+    from statistics import NormalDist
+    lo, hi = gssm.analysis.nees_interval(dof=1)
+    assert np.isclose(lo, NormalDist().inv_cdf(0.4875) ** 2, rtol=1e-9)
+    assert np.isclose(hi, NormalDist().inv_cdf(0.0125) ** 2, rtol=1e-9)
+    assert round(lo, 6) == 0.000982 and round(hi, 3) == 5.024
+    lo10, hi10 = gssm.analysis.nees_interval(dof=1, runs=10)  # the mean of ten: χ²₁₀ / 10
+    assert np.isclose(lo10, gssm.analysis.chi2_quantile(0.025, 10) / 10, rtol=1e-12) and lo < lo10 < 1 < hi10 < hi
+
+
+AWKWARD = "plaza\t2\nrun \"a\" \\ b\x01 Zürich 東京"
+
+
+def test_metrics_json_keeps_any_name(repo, tmp_path, gssm_process):
+    import shutil
+    data = gssm.io.read_dataset(os.path.join(repo, "datasets", "radar-paper"))
+    run = gssm.run(data.model, data, method="ekf")
+    text = gssm.analysis.metrics_json(data.model, [run], truth=data, dataset=AWKWARD)
+    assert json.loads(text)["dataset"] == AWKWARD
+    # The app, on a folder with such a name (legal on Linux): its metrics.json loads back.
+    folder = tmp_path / AWKWARD.replace("/", "")
+    shutil.copytree(os.path.join(repo, "datasets", "radar-paper"), folder)
+    run_app(gssm_process, "--data", folder, "--method", "ekf", "--out", tmp_path / "out")
+    with open(tmp_path / "out" / "metrics.json", encoding="utf-8") as f:
+        assert json.load(f)["dataset"] == str(folder)

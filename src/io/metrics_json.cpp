@@ -4,23 +4,16 @@
 #include <sstream>
 
 #include "gssm/io/ini.h"
+#include "gssm/io/json_text.h"
 
 namespace gssm::io {
 
 namespace {
 std::string num(double v) { return std::isfinite(v) ? io::formatDouble(v) : "null"; }
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
 std::string perState(const std::vector<std::string>& names, const Eigen::VectorXd& v) {
   std::string out = "{";
   for (std::size_t i = 0; i < names.size(); ++i)
-    out += (i ? ", " : "") + quoted(names[i]) + ": " + num(v[static_cast<Eigen::Index>(i)]);
+    out += (i ? ", " : "") + jsonQuoted(names[i]) + ": " + num(v[static_cast<Eigen::Index>(i)]);
   return out + "}";
 }
 }  // namespace
@@ -28,14 +21,14 @@ std::string perState(const std::vector<std::string>& names, const Eigen::VectorX
 std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& dataset,
                         const DatasetStatus& status) {
   std::ostringstream os;
-  os << "{\n  \"dataset\": " << quoted(dataset) << ",\n  \"partial\": " << (status.partial ? "true" : "false");
-  if (status.partial) os << ",\n  \"stopped_at\": " << quoted(status.stopped_at);
+  os << "{\n  \"dataset\": " << jsonQuoted(dataset) << ",\n  \"partial\": " << (status.partial ? "true" : "false");
+  if (status.partial) os << ",\n  \"stopped_at\": " << jsonQuoted(status.stopped_at);
   os << ",\n  \"skipped_rows\": " << status.skipped.size() << ",\n  \"skipped\": [";
-  for (std::size_t i = 0; i < status.skipped.size(); ++i) os << (i ? ", " : "") << quoted(status.skipped[i]);
+  for (std::size_t i = 0; i < status.skipped.size(); ++i) os << (i ? ", " : "") << jsonQuoted(status.skipped[i]);
   os << "],\n  \"methods\": {";
   for (std::size_t r = 0; r < runs.size(); ++r) {
     const RunMetrics& m = runs[r];
-    os << (r ? "," : "") << "\n    " << quoted(methodName(m.method)) << ": {\n";
+    os << (r ? "," : "") << "\n    " << jsonQuoted(methodName(m.method)) << ": {\n";
     os << "      \"rows\": " << m.rows << ",\n";
     if (m.has_truth) {
       os << "      \"rmse\": " << perState(m.names, m.rmse) << ",\n";

@@ -1,6 +1,7 @@
 #pragma once
 // Monte Carlo comparison of estimators on a scenario over many seeds
 // (the paper's claim, tested honestly).
+#include "gssm/analysis/chi_square.h"  // the consistency verdicts' intervals
 #include <Eigen/Core>
 #include <functional>
 #include <optional>
@@ -108,8 +109,5 @@ MonteCarloResult summarizeMonteCarlo(const MonteCarloScenario& scenario, const M
 /// one seed.
 MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
                                const std::function<NormalSampler(unsigned)>& sampler_for_seed);
-
-/// χ²_k quantile (Wilson–Hilferty; accurate to ~1% for k ≥ 10).
-double chiSquareQuantile(double p, int k);
 
 }  // namespace gssm
