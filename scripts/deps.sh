@@ -13,6 +13,7 @@ GSSM_PACKAGES=(
   python3
   pybind11-dev python3-dev python3-numpy python3-pytest python3-distributed python3-matplotlib
   clang libclang-rt-14-dev
+  locales
 )
 
 gssm_install_deps() {

@@ -32,7 +32,7 @@ struct Snapshot {
     EXPECT_EQ(e.step(), step) << what;
     EXPECT_EQ(e.current().mean, mean) << what;
     EXPECT_EQ(e.current().covariance, cov) << what;
-    EXPECT_EQ(e.report().steps, report.steps) << what;
+    EXPECT_EQ(e.report().measurements, report.measurements) << what;
     EXPECT_EQ(e.report().smoother.num_variables, report.smoother.num_variables) << what;
     EXPECT_EQ(e.report().smoother.num_factors, report.smoother.num_factors) << what;
     EXPECT_EQ(e.report().detail, report.detail) << what;

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <clocale>
+#include <cstdlib>
 #include <random>
 
 #include "gssm/core/error.h"
@@ -269,4 +271,76 @@ TEST(JsonText, EscapesEveryControlCharacterAndKeepsUtf8) {
   // Invalid UTF-8 (a lone continuation byte, a truncated sequence, an overlong '/') is replaced.
   EXPECT_EQ(io::jsonQuoted("\x80x\xe6\x9d"), "\"\\ufffdx\\ufffd\\ufffd\"");
   EXPECT_EQ(io::jsonQuoted("\xc0\xaf"), "\"\\ufffd\\ufffd\"");
+}
+
+// Run under a comma-decimal locale by the ctest entry io.IniNumbersUnderGermanLocale
+// (tests/apps/german_locale.sh, GSSM_EXPECT_COMMA_LOCALE=1); alone, under the C locale.
+TEST(IniLocale, NumbersParseTheSameUnderAnyLocale) {
+  const char* set = std::setlocale(LC_ALL, "");
+  if (std::getenv("GSSM_EXPECT_COMMA_LOCALE")) {
+    ASSERT_NE(set, nullptr) << "the comma-decimal locale is not available";
+    ASSERT_STREQ(std::localeconv()->decimal_point, ",") << "locale " << set;
+  }
+  const auto ini = IniDocument::parse("[s]\nx = 0.5\nm = [1.25 -2e-3; 3.5 4]\nbad = 0,5\n", "l.ini");
+  EXPECT_EQ(ini.getDouble("s", "x"), 0.5);
+  EXPECT_EQ(ini.getMatrix("s", "m")(0, 1), -2e-3);
+  EXPECT_EQ(ini.getMatrix("s", "m")(1, 0), 3.5);
+  EXPECT_THROW(ini.getDouble("s", "bad"), InputError);  // a comma is never a decimal point
+  IniDocument out;
+  out.set("s", "y", 0.25);
+  EXPECT_NE(out.toString().find("y = 0.25"), std::string::npos);
+  std::setlocale(LC_ALL, "C");
+}
+
+TEST(Config, EveryEstimatorSettingRoundTripsThroughItsSection) {
+  // Every field away from its default, written, read back: each key is read
+  // from the section it is written to (a key the reader skipped stays default).
+  const models::Radar2D radar;
+  EstimatorOptions o(Method::Batch);
+  o.ekf.constant_process_noise = Eigen::Vector2d(1e-6, 2e-6);
+  o.ekf.joseph_form = false;
+  o.smoother.relinearize = false;
+  o.smoother.relinearize_threshold = 0.25;
+  o.smoother.constants_check_sigmas = 2.5;
+  o.smoother.max_local_iterations = 7;
+  o.smoother.wildfire_threshold = 1e-3;
+  o.smoother.iterate_to_convergence = true;
+  o.smoother.convergence_tolerance = 1e-7;
+  o.smoother.max_iterations = 77;
+  o.smoother.newton_polish_steps = 2;
+  o.incremental.ordering = EliminationOrdering::TimeOrdered;
+  o.fixed_lag.window = 17;
+  o.paper_window.window = 19;
+  o.batch.method = BatchSolverOptions::Method::GaussNewton;
+  o.batch.max_iterations = 33;
+  o.batch.relative_cost_tolerance = 1e-9;
+  o.batch.step_tolerance = 1e-7;
+  o.batch.gradient_tolerance = 1e-6;
+  o.batch.initial_lambda = 1e-3;
+  o.batch.max_lambda = 1e9;
+  o.batch.newton_polish_steps = 3;
+  IniDocument ini;
+  writeModel(radar, ini);
+  writeEstimatorOptions(o, ini);
+  const EstimatorOptions r = estimatorOptions(IniDocument::parse(ini.toString(), "o.ini"), radar, Method::Batch);
+  IniDocument again;
+  writeEstimatorOptions(r, again);
+  EXPECT_EQ(again.toString(), IniDocument::parse(ini.toString()).toString().substr(ini.toString().find("[ekf]")));
+  EXPECT_EQ(r.smoother.max_local_iterations, 7);
+  EXPECT_EQ(r.batch.method, BatchSolverOptions::Method::GaussNewton);
+  EXPECT_EQ(r.batch.max_lambda, 1e9);
+  EXPECT_EQ(r.paper_window.window, 19);
+  EXPECT_EQ(r.incremental.ordering, EliminationOrdering::TimeOrdered);
+  // Every section's key list is what the reader accepts, and no more.
+  for (const auto& [section, keys] : estimatorIniKeys()) {
+    EXPECT_FALSE(keys.empty()) << section;
+    IniDocument bad = IniDocument::parse(ini.toString(), "bad.ini");
+    bad.set(section, "not_a_key", "1");
+    try {
+      estimatorOptions(bad, radar);
+      ADD_FAILURE() << section << ": an unknown key was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("not_a_key"), std::string::npos) << e.what();
+    }
+  }
 }

@@ -97,7 +97,7 @@ class EstimatorReport:
     method: str
     window: int
     ordering: Optional[str]
-    steps: int
+    measurements: int
     seconds: float
     iterations: int
     rejected: int

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "bindings.h"
+#include "gssm/estimator/option_keys.h"
 #include "gssm/analysis/offline.h"
 #include "gssm/checkpoint/checkpoint.h"
 #include "gssm/core/error.h"
@@ -56,7 +57,7 @@ py::array_t<double> stack(const std::vector<EstimateRow>& rows, Eigen::Index n, 
 
 std::string reportRepr(const EstimatorReport& r) {
   std::ostringstream os;
-  os << "EstimatorReport(method='" << methodName(r.method) << "', steps=" << r.steps << ", seconds=" << r.seconds
+  os << "EstimatorReport(method='" << methodName(r.method) << "', measurements=" << r.measurements << ", seconds=" << r.seconds
      << ", iterations=" << r.iterations << ", window=" << r.window << ", rejected=" << r.rejected << ", nis=" << r.nis
      << ", detail='" << r.detail << "')";
   return os.str();
@@ -64,41 +65,93 @@ std::string reportRepr(const EstimatorReport& r) {
 
 }  // namespace
 
+namespace {
+// An options struct's settings as properties, from the same key list the
+// INI reader uses (gssm/estimator/option_keys.h): Python has every INI key
+// and no other, with the C++ defaults.
+struct OptionGetter {
+  const std::string& key;
+  py::object value;
+  template <class T>
+  void operator()(const char* k, T& v) {
+    if (key == k) value = py::cast(v);
+  }
+  template <class E>
+  void operator()(const char* k, Choice<E>& c) {
+    if (key == k) value = py::str(c.name(c.value));
+  }
+};
+
+struct OptionSetter {
+  const std::string& key;
+  const py::object& value;
+  template <class T>
+  void operator()(const char* k, T& v) {
+    if (key != k) return;
+    try {
+      v = value.cast<T>();
+    } catch (const py::cast_error&) {
+      throw InvalidArgument("option '" + key + "': cannot take " + py::repr(value).cast<std::string>());
+    }
+  }
+  template <class E>
+  void operator()(const char* k, Choice<E>& c) {
+    if (key != k) return;
+    const auto named = c.named(py::str(value).cast<std::string>());
+    if (!named) throw InvalidArgument("option '" + key + "' = " + py::repr(value).cast<std::string>() + ": expected " + c.expected);
+    c.value = *named;
+  }
+};
+
+// An options group as {key: value} (pickling), and back.
+template <class Options>
+py::dict optionDict(Options o) {
+  py::dict d;
+  for (const std::string& key : optionKeyNames<Options>()) {
+    OptionGetter get{key, py::none()};
+    optionKeys(get, o);
+    d[key.c_str()] = get.value;
+  }
+  return d;
+}
+
+template <class Options>
+void setOptions(Options& o, const py::dict& d) {
+  for (const auto& item : d) {
+    const std::string key = py::str(item.first).cast<std::string>();
+    const py::object value = py::reinterpret_borrow<py::object>(item.second);
+    OptionSetter set{key, value};
+    optionKeys(set, o);
+  }
+}
+
+template <class Options>
+void bindOptionFields(py::class_<Options> cls) {
+  for (const std::string& key : optionKeyNames<Options>())
+    cls.def_property(
+        key.c_str(),
+        [key](Options& o) {
+          OptionGetter get{key, py::none()};
+          optionKeys(get, o);
+          return get.value;
+        },
+        [key](Options& o, const py::object& v) {
+          OptionSetter set{key, v};
+          optionKeys(set, o);
+        });
+}
+}  // namespace
+
 void bindEstimator(py::module_& m) {
   // ---- options ------------------------------------------------------------
-  py::class_<ExtendedKalmanFilterOptions>(m, "EkfOptions", "Settings of the EKF baseline ([ekf]).")
-      .def(py::init<>())
-      .def_readwrite("constant_process_noise", &ExtendedKalmanFilterOptions::constant_process_noise,
-                     "per-step variance added to each constant (empty: none)")
-      .def_readwrite("joseph_form", &ExtendedKalmanFilterOptions::joseph_form);
-  py::class_<SmootherOptions>(m, "SmootherOptions", "Relinearization policy of the smoothers ([smoother]).")
-      .def(py::init<>())
-      .def_readwrite("relinearize", &SmootherOptions::relinearize)
-      .def_readwrite("relinearize_threshold", &SmootherOptions::relinearize_threshold)
-      .def_readwrite("constants_check_sigmas", &SmootherOptions::constants_check_sigmas)
-      .def_readwrite("max_local_iterations", &SmootherOptions::max_local_iterations)
-      .def_readwrite("wildfire_threshold", &SmootherOptions::wildfire_threshold)
-      .def_readwrite("iterate_to_convergence", &SmootherOptions::iterate_to_convergence)
-      .def_readwrite("convergence_tolerance", &SmootherOptions::convergence_tolerance)
-      .def_readwrite("max_iterations", &SmootherOptions::max_iterations)
-      .def_readwrite("newton_polish_steps", &SmootherOptions::newton_polish_steps);
-  py::class_<BatchSolverOptions>(m, "BatchOptions", "Settings of the batch MAP solver ([batch]).")
-      .def(py::init<>())
-      .def_property(
-          "algorithm",
-          [](const BatchSolverOptions& o) { return BatchSolverOptions::methodName(o.method); },
-          [](BatchSolverOptions& o, const std::string& s) {
-            const auto m = BatchSolverOptions::methodNamed(s);
-            if (!m) throw InvalidArgument("batch algorithm '" + s + "': expected levenberg-marquardt or gauss-newton");
-            o.method = *m;
-          })
-      .def_readwrite("max_iterations", &BatchSolverOptions::max_iterations)
-      .def_readwrite("relative_cost_tolerance", &BatchSolverOptions::relative_cost_tolerance)
-      .def_readwrite("step_tolerance", &BatchSolverOptions::step_tolerance)
-      .def_readwrite("gradient_tolerance", &BatchSolverOptions::gradient_tolerance)
-      .def_readwrite("initial_lambda", &BatchSolverOptions::initial_lambda)
-      .def_readwrite("max_lambda", &BatchSolverOptions::max_lambda)
-      .def_readwrite("newton_polish_steps", &BatchSolverOptions::newton_polish_steps);
+  bindOptionFields(py::class_<ExtendedKalmanFilterOptions>(m, "EkfOptions", "Settings of the EKF baseline ([ekf]).")
+                       .def(py::init<>()));
+  bindOptionFields(py::class_<SmootherOptions>(m, "SmootherOptions",
+                                               "Relinearization policy of the smoothers ([smoother]; its ordering "
+                                               "is EstimatorOptions.ordering).")
+                       .def(py::init<>()));
+  bindOptionFields(py::class_<BatchSolverOptions>(m, "BatchOptions", "Settings of the batch MAP solver ([batch]).")
+                       .def(py::init<>()));
 
   py::class_<EstimatorOptions>(m, "EstimatorOptions",
                                "Every method's settings; `method` says which run. gssm.make_estimator and gssm.run "
@@ -133,47 +186,20 @@ void bindEstimator(py::module_& m) {
           py::arg("model"), "raises gssm.InvalidArgument naming the option at fault")
       .def(py::pickle(
           [](const EstimatorOptions& o) {
-            return py::make_tuple(std::string(methodName(o.method)), o.t0, o.compute_nis, o.ekf.constant_process_noise,
-                                  o.ekf.joseph_form,
-                                  py::make_tuple(o.smoother.relinearize, o.smoother.relinearize_threshold,
-                                                 o.smoother.constants_check_sigmas, o.smoother.max_local_iterations,
-                                                 o.smoother.wildfire_threshold, o.smoother.iterate_to_convergence,
-                                                 o.smoother.convergence_tolerance, o.smoother.max_iterations,
-                                                 o.smoother.newton_polish_steps),
-                                  orderingName(o.incremental.ordering), o.fixed_lag.window, o.paper_window.window,
-                                  py::make_tuple(static_cast<int>(o.batch.method), o.batch.max_iterations,
-                                                 o.batch.relative_cost_tolerance, o.batch.step_tolerance,
-                                                 o.batch.gradient_tolerance, o.batch.initial_lambda,
-                                                 o.batch.max_lambda, o.batch.newton_polish_steps));
+            return py::make_tuple(std::string(methodName(o.method)), o.t0, o.compute_nis, optionDict(o.ekf),
+                                  optionDict(o.smoother), orderingName(o.incremental.ordering), o.fixed_lag.window,
+                                  o.paper_window.window, optionDict(o.batch));
           },
           [](const py::tuple& t) {
             EstimatorOptions o(methodFromName(t[0].cast<std::string>()));
             o.t0 = t[1].cast<double>();
             o.compute_nis = t[2].cast<bool>();
-            o.ekf.constant_process_noise = t[3].cast<VectorXd>();
-            o.ekf.joseph_form = t[4].cast<bool>();
-            const py::tuple s = t[5];
-            o.smoother.relinearize = s[0].cast<bool>();
-            o.smoother.relinearize_threshold = s[1].cast<double>();
-            o.smoother.constants_check_sigmas = s[2].cast<double>();
-            o.smoother.max_local_iterations = s[3].cast<int>();
-            o.smoother.wildfire_threshold = s[4].cast<double>();
-            o.smoother.iterate_to_convergence = s[5].cast<bool>();
-            o.smoother.convergence_tolerance = s[6].cast<double>();
-            o.smoother.max_iterations = s[7].cast<int>();
-            o.smoother.newton_polish_steps = s[8].cast<int>();
-            o.incremental.ordering = orderingFromName(t[6].cast<std::string>());
-            o.fixed_lag.window = t[7].cast<int>();
-            o.paper_window.window = t[8].cast<int>();
-            const py::tuple b = t[9];
-            o.batch.method = static_cast<BatchSolverOptions::Method>(b[0].cast<int>());
-            o.batch.max_iterations = b[1].cast<int>();
-            o.batch.relative_cost_tolerance = b[2].cast<double>();
-            o.batch.step_tolerance = b[3].cast<double>();
-            o.batch.gradient_tolerance = b[4].cast<double>();
-            o.batch.initial_lambda = b[5].cast<double>();
-            o.batch.max_lambda = b[6].cast<double>();
-            o.batch.newton_polish_steps = b[7].cast<int>();
+            setOptions(o.ekf, t[3]);
+            setOptions(o.smoother, t[4]);
+            o.incremental.ordering = orderingFromName(t[5].cast<std::string>());
+            o.fixed_lag.window = t[6].cast<int>();
+            o.paper_window.window = t[7].cast<int>();
+            setOptions(o.batch, t[8]);
             return o;
           }));
 
@@ -226,7 +252,7 @@ void bindEstimator(py::module_& m) {
                                if (!r.ordering) return py::none();
                                return py::str(orderingName(*r.ordering));
                              })
-      .def_readonly("steps", &EstimatorReport::steps)
+      .def_readonly("measurements", &EstimatorReport::measurements)
       .def_readonly("seconds", &EstimatorReport::seconds)
       .def_readonly("iterations", &EstimatorReport::iterations)
       .def_readonly("rejected", &EstimatorReport::rejected)
@@ -238,7 +264,7 @@ void bindEstimator(py::module_& m) {
         d["method"] = methodName(r.method);
         d["window"] = r.window;
         d["ordering"] = r.ordering ? py::object(py::str(orderingName(*r.ordering))) : py::object(py::none());
-        d["steps"] = r.steps;
+        d["measurements"] = r.measurements;
         d["seconds"] = r.seconds;
         d["iterations"] = r.iterations;
         d["rejected"] = r.rejected;

@@ -56,6 +56,8 @@ NormalSampler simulationSampler(unsigned seed) {
 }
 
 void bindIo(py::module_& io) {
+  io.def("ini_option_keys", &io::estimatorIniKeys,
+         "[(section, [keys])] of every estimator section of a scenario.ini, as the INI reader takes them");
   py::class_<PyDataset>(io, "Dataset",
                         "Measurements (with channels), inputs and optional truth of one run, with the model and "
                         "settings of its scenario.ini when it came from a folder or a simulation.")

@@ -112,8 +112,8 @@ def test_report_and_marginals(data):
     for t, y in zip(data.t[:100], data.y[:100]):
         est.add_measurement(t, y)
     r = est.report()
-    assert r.method == "incremental" and r.steps == 100 and r.ordering == "colamd" and np.isfinite(r.nis)
-    assert r.to_dict()["steps"] == 100 and "variables" in r.detail
+    assert r.method == "incremental" and r.measurements == 100 and r.ordering == "colamd" and np.isfinite(r.nis)
+    assert r.to_dict()["measurements"] == 100 and "variables" in r.detail
     joint = est.marginal_covariance(states=[50, 100], constants=True)
     assert joint.shape == (4, 4)
     s50 = est.smoothed(50)

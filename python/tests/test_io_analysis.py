@@ -96,3 +96,21 @@ def test_metrics_json_keeps_any_name(repo, tmp_path, gssm_process):
     run_app(gssm_process, "--data", folder, "--method", "ekf", "--out", tmp_path / "out")
     with open(tmp_path / "out" / "metrics.json", encoding="utf-8") as f:
         assert json.load(f)["dataset"] == str(folder)
+
+
+def test_options_objects_have_the_ini_keys_and_the_cpp_defaults():
+    keys = dict(gssm.io.ini_option_keys())
+
+    def public(obj):
+        return {k for k in dir(obj) if not k.startswith("_")}
+    assert set(keys["ekf"]) == public(gssm.EkfOptions())
+    # [smoother] ordering is the incremental smoother's: EstimatorOptions.ordering.
+    assert set(keys["smoother"]) == public(gssm.SmootherOptions()) | {"ordering"}
+    assert set(keys["batch"]) == public(gssm.BatchOptions())
+    assert keys["fixed_lag"] == ["window"] and keys["paper_window"] == ["window"]
+    o = gssm.EstimatorOptions("fixed-lag")
+    assert {"ordering", "fixed_lag_window", "paper_window_window"} <= public(o)
+    # Defaults are the C++ structs' (the INI a default EstimatorOptions would write).
+    assert gssm.BatchOptions().algorithm == "levenberg-marquardt" and gssm.BatchOptions().initial_lambda == 1e-8
+    with pytest.raises(gssm.InvalidArgument, match="algorithm.*levenberg-marquardt or gauss-newton"):
+        gssm.BatchOptions().algorithm = "newton"

@@ -56,7 +56,7 @@ void fields(Io& io, EstimatorOptions& o) {  // after the method, which goes by n
 
 template <class Io>
 void fields(Io& io, EstimatorReport& r) {  // all but what the options determine
-  io(r.steps, "report steps");
+  io(r.measurements, "report measurements");
   io(r.seconds, "report seconds");
   io(r.iterations, "report iterations");
   fields(io, r.smoother);
@@ -150,7 +150,7 @@ void Estimator::advance(double t) {
   doStep(k_ + 1, t - t_, inputInForce(), nullptr);
   t_ = t;
   ++k_;
-  report_.steps = k_;
+  report_.measurements = k_;
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -215,7 +215,7 @@ void Estimator::addMeasurement(const Measurement& m) {
     ++k_;
   }
   report_.nis = nis;
-  report_.steps = k_;
+  report_.measurements = k_;
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

@@ -12,13 +12,13 @@
 
 namespace gssm::internal {
 
-/// r = L_Q⁻¹ (x_c(k+1) − f(x_c(k), x_b, u, dt)) (docs/DESIGN.md eq. 3) with
+/// r = L_Q⁻¹ (x_c(k+1) − f(x_c(k), x_b, u, dt)) (docs/DESIGN.md eq. 2) with
 /// its Jacobian blocks J = [J_r_xk, J_r_xk1, J_r_xb]; x = [x_c(k), x_c(k+1),
 /// x_b], x_b only if the model has constants.
 void processResidual(const Model& model, const Eigen::VectorXd& u, double dt, const GaussianNoise& noise,
                      const Eigen::VectorXd* const* x, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J);
 
-/// r = L_R⁻¹ (h_c(x_c(k), x_b) − y) on `channel` (eq. 4), its angle
+/// r = L_R⁻¹ (h_c(x_c(k), x_b) − y) on `channel` (eq. 3), its angle
 /// components wrapped; x = [x_c(k), x_b], x_b only if the model has constants.
 void measurementResidual(const Model& model, int channel, const Eigen::Ref<const Eigen::VectorXd>& y,
                          const GaussianNoise& noise, const Eigen::VectorXd* const* x, Eigen::VectorXd& r,

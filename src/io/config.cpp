@@ -6,6 +6,9 @@
 #include "gssm/models/range_beacon2d.h"
 
 #include <cmath>
+#include <limits>
+
+#include "gssm/estimator/option_keys.h"
 
 namespace gssm::io {
 
@@ -13,42 +16,87 @@ namespace {
 // Each method's own INI section, from the method table.
 std::string sectionOf(Method m) { return methodInfo(m).ini_section; }
 
+// Reads, from one section, every key that optionKeys names for an options
+// struct (docs/DESIGN.md §4); absent keys keep the value given.
+class IniOptionReader {
+ public:
+  IniOptionReader(const IniDocument& ini, std::string section) : ini_(ini), section_(std::move(section)) {}
+  void operator()(const char* key, bool& v) const { v = ini_.getBool(section_, key, v); }
+  void operator()(const char* key, double& v) const { v = ini_.getDouble(section_, key, v); }
+  void operator()(const char* key, Eigen::VectorXd& v) const {
+    if (ini_.has(section_, key)) v = ini_.getVector(section_, key);
+  }
+  void operator()(const char* key, int& v) const {
+    const long long n = ini_.getInt(section_, key, v);
+    if (n < std::numeric_limits<int>::min() || n > std::numeric_limits<int>::max())
+      throw InputError(ini_.where(section_, key) + " = " + std::to_string(n) + ": out of range");
+    v = static_cast<int>(n);
+  }
+  template <class E>
+  void operator()(const char* key, Choice<E>& c) const {
+    const std::string text = ini_.getString(section_, key, c.name(c.value));
+    const auto named = c.named(text);
+    if (!named) throw InputError(ini_.where(section_, key) + " = '" + text + "': expected " + c.expected);
+    c.value = *named;
+  }
+
+ private:
+  const IniDocument& ini_;
+  std::string section_;
+};
+
+// Writes every key that optionKeys names for an options struct.
+class IniOptionWriter {
+ public:
+  IniOptionWriter(IniDocument& ini, std::string section) : ini_(ini), section_(std::move(section)) {}
+  void operator()(const char* key, bool& v) { ini_.set(section_, key, v ? "true" : "false"); }
+  void operator()(const char* key, int& v) { ini_.set(section_, key, std::to_string(v)); }
+  void operator()(const char* key, double& v) {
+    if (std::isfinite(v)) ini_.set(section_, key, v);  // ∞ (a wildfire threshold: none) is the default; not written
+  }
+  void operator()(const char* key, Eigen::VectorXd& v) {
+    if (v.size() > 0) ini_.set(section_, key, Eigen::MatrixXd(v.transpose()));
+  }
+  template <class E>
+  void operator()(const char* key, Choice<E>& c) { ini_.set(section_, key, c.name(c.value)); }
+
+ private:
+  IniDocument& ini_;
+  std::string section_;
+};
+
+// One method's section: its keys (and `extra` ones read by the caller) only.
+template <class Options>
+void readSection(const IniDocument& ini, const std::string& section, Options& o,
+                 std::vector<std::string> extra = {}) {
+  std::vector<std::string> keys = optionKeyNames<Options>();
+  keys.insert(keys.end(), extra.begin(), extra.end());
+  ini.requireOnlyKeys(section, keys);
+  IniOptionReader reader(ini, section);
+  optionKeys(reader, o);
+}
+
 ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& model) {
   const std::string ekf = sectionOf(Method::Ekf);
-  ini.requireOnlyKeys(ekf, {"constant_process_noise", "joseph_form"});
   ExtendedKalmanFilterOptions o;
-  if (ini.has(ekf, "constant_process_noise"))
-    o.constant_process_noise = ini.getVector(ekf, "constant_process_noise", model.dims().nb);
-  o.joseph_form = ini.getBool(ekf, "joseph_form", true);
+  readSection(ini, ekf, o);
   std::string why;
   if (!o.validate(model.dims().nb, &why)) throw InputError(ini.source() + ": [" + ekf + "] " + why);
   return o;
 }
 
+// [smoother]: the relinearization policy both smoothers share, and the
+// incremental smoother's ordering.
 void readSmoother(const IniDocument& ini, EstimatorOptions& eo) {
   const std::string smoother = sectionOf(Method::Incremental);  // the fixed lag reads it too
-  ini.requireOnlyKeys(smoother, {"relinearize", "relinearize_threshold", "constants_check_sigmas",
-                                   "max_local_iterations", "wildfire_threshold", "ordering",
-                                   "iterate_to_convergence", "convergence_tolerance", "max_iterations",
-                                   "newton_polish_steps"});
-  SmootherOptions& o = eo.smoother;
-  o.relinearize = ini.getBool(smoother, "relinearize", o.relinearize);
-  o.relinearize_threshold = ini.getDouble(smoother, "relinearize_threshold", o.relinearize_threshold);
-  o.constants_check_sigmas = ini.getDouble(smoother, "constants_check_sigmas", o.constants_check_sigmas);
-  o.max_local_iterations =
-      static_cast<int>(ini.getInt(smoother, "max_local_iterations", o.max_local_iterations));
-  o.wildfire_threshold = ini.getDouble(smoother, "wildfire_threshold", o.wildfire_threshold);
-  o.iterate_to_convergence = ini.getBool(smoother, "iterate_to_convergence", o.iterate_to_convergence);
-  o.convergence_tolerance = ini.getDouble(smoother, "convergence_tolerance", o.convergence_tolerance);
-  o.max_iterations = static_cast<int>(ini.getInt(smoother, "max_iterations", o.max_iterations));
-  o.newton_polish_steps = static_cast<int>(ini.getInt(smoother, "newton_polish_steps", o.newton_polish_steps));
+  readSection(ini, smoother, eo.smoother, {"ordering"});
   const std::string ordering = ini.getString(smoother, "ordering", orderingName(eo.incremental.ordering));
   const auto named = orderingNamed(ordering);
   if (!named)
     throw InputError(ini.source() + ": [" + smoother + "] ordering = '" + ordering + "': expected colamd or time");
   eo.incremental.ordering = *named;
   std::string why;
-  if (!o.validate(&why)) throw InputError(ini.source() + ": [" + smoother + "] " + why);
+  if (!eo.smoother.validate(&why)) throw InputError(ini.source() + ": [" + smoother + "] " + why);
 }
 
 int readWindow(const IniDocument& ini, const std::string& section, int fallback) {
@@ -61,16 +109,7 @@ int readWindow(const IniDocument& ini, const std::string& section, int fallback)
 
 void readBatch(const IniDocument& ini, BatchSolverOptions& o) {
   const std::string batch = sectionOf(Method::Batch);
-  ini.requireOnlyKeys(batch, {"algorithm", "max_iterations", "newton_polish_steps", "initial_lambda"});
-  const std::string algorithm = ini.getString(batch, "algorithm", BatchSolverOptions::methodName(o.method));
-  const auto named = BatchSolverOptions::methodNamed(algorithm);
-  if (!named)
-    throw InputError(ini.source() + ": [" + batch + "] algorithm = '" + algorithm +
-                     "': expected levenberg-marquardt or gauss-newton");
-  o.method = *named;
-  o.max_iterations = static_cast<int>(ini.getInt(batch, "max_iterations", o.max_iterations));
-  o.newton_polish_steps = static_cast<int>(ini.getInt(batch, "newton_polish_steps", o.newton_polish_steps));
-  o.initial_lambda = ini.getDouble(batch, "initial_lambda", o.initial_lambda);
+  readSection(ini, batch, o);
   std::string why;
   if (!o.validate(&why)) throw InputError(ini.source() + ": [" + batch + "] " + why);
 }
@@ -89,6 +128,28 @@ EstimatorOptions estimatorOptions(const IniDocument& ini, const Model& model, Me
   o.paper_window.window = readWindow(ini, sectionOf(Method::PaperWindow), o.paper_window.window);
   readBatch(ini, o.batch);
   return o;
+}
+
+void writeEstimatorOptions(const EstimatorOptions& options, IniDocument& ini) {
+  EstimatorOptions o = options;  // visitors take references
+  IniOptionWriter ekf(ini, sectionOf(Method::Ekf)), smoother(ini, sectionOf(Method::Incremental)),
+      batch(ini, sectionOf(Method::Batch));
+  optionKeys(ekf, o.ekf);
+  optionKeys(smoother, o.smoother);
+  ini.set(sectionOf(Method::Incremental), "ordering", orderingName(o.incremental.ordering));
+  ini.set(sectionOf(Method::FixedLag), "window", std::to_string(o.fixed_lag.window));
+  ini.set(sectionOf(Method::PaperWindow), "window", std::to_string(o.paper_window.window));
+  optionKeys(batch, o.batch);
+}
+
+std::vector<std::pair<std::string, std::vector<std::string>>> estimatorIniKeys() {
+  std::vector<std::string> smoother = optionKeyNames<SmootherOptions>();
+  smoother.push_back("ordering");
+  return {{sectionOf(Method::Ekf), optionKeyNames<ExtendedKalmanFilterOptions>()},
+          {sectionOf(Method::Incremental), smoother},
+          {sectionOf(Method::FixedLag), {"window"}},
+          {sectionOf(Method::PaperWindow), {"window"}},
+          {sectionOf(Method::Batch), optionKeyNames<BatchSolverOptions>()}};
 }
 
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {

@@ -41,14 +41,11 @@ std::string stripComment(const std::string& line) {
   return line.substr(0, cut);
 }
 
-// Parses a full string as a finite double.
+// Parses a full string as a finite double, whatever the C locale says a
+// decimal point is (std::from_chars: "0.5" is a half under de_DE too).
 bool parseDouble(const std::string& text, double& out) {
   const std::string t = trim(text);
-  if (t.empty()) return false;
-  errno = 0;
-  char* end = nullptr;
-  out = std::strtod(t.c_str(), &end);
-  return end == t.c_str() + t.size() && errno != ERANGE && std::isfinite(out);
+  return io::parseDouble(t.data(), t.data() + t.size(), out) && std::isfinite(out);
 }
 
 // "[1 2; 3 4]" → rows of numbers. Returns false on a bad token.

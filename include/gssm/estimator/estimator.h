@@ -45,7 +45,7 @@ struct EstimatorReport {
   /// the elimination ordering (the fixed lag always orders by time).
   int window = 0;
   std::optional<EliminationOrdering> ordering;
-  std::int64_t steps = 0;     ///< measurements processed
+  std::int64_t measurements = 0;  ///< measurements processed
   double seconds = 0;         ///< wall time of the last addMeasurement
   int iterations = 0;         ///< solver iterations of the last update (1 for the EKF)
   /// Measurements rejected by their channel's EKF gate so far (EKF only;

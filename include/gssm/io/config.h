@@ -11,6 +11,8 @@
 //   [smoother], [fixed_lag], [paper_window], [batch]  estimator settings (below)
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "gssm/estimator/estimator.h"
 #include "gssm/io/ini.h"
@@ -48,6 +50,12 @@ Method parseMethod(const std::string& text, const std::string& where);
 /// bad value is an InputError naming file, section and key.
 EstimatorOptions estimatorOptions(const IniDocument& ini, const Model& model,
                                   Method method = Method::FixedLag);
+/// Writes every method's settings into its section (the keys estimatorOptions
+/// reads; a wildfire threshold of ∞, the default, is left out).
+void writeEstimatorOptions(const EstimatorOptions& options, IniDocument& ini);
+/// Each estimator section and the keys it takes, in order (the INI side of
+/// the Python options objects: docs/DESIGN.md §4).
+std::vector<std::pair<std::string, std::vector<std::string>>> estimatorIniKeys();
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model);
 
 /// A Monte Carlo scenario from INI documents, with the models it points to.

@@ -76,9 +76,10 @@ struct SmootherOptions {
   /// change of xdot moves every old smoothed state by more than 1e-3; lazy it
   /// stays at 14–21 µs (bench/history_probe).
   double wildfire_threshold = std::numeric_limits<double>::infinity();
-  /// Iterate each update to convergence over ALL factors (Gauss–Newton on
-  /// the whole graph; O(n) per iteration, equals the batch solution). GN
-  /// converges only linearly where the problem is nearly singular (the radar
+  /// Iterate each update to convergence over ALL factors (Levenberg–Marquardt
+  /// on the whole graph, the batch solver's damping policy; O(n) per
+  /// iteration, equals the batch solution). It converges only linearly where
+  /// the problem is nearly singular (the radar
   /// start-up needs up to ~2000 iterations in its first 15 steps), so the
   /// stopping rule is the change of the estimate, not the linearization error.
   bool iterate_to_convergence = false;
