@@ -32,57 +32,87 @@ const Truth& requireTruth(const PyDataset& d, const char* fn) {
   return *d.data.truth;
 }
 
+py::dict runErrorsDict(const PyRun& run, const PyDataset& truth, const std::shared_ptr<Model>& model) {
+  const std::vector<int> angles = model ? model->angleStates()
+                                        : (truth.model ? truth.model->angleStates() : std::vector<int>{});
+  const RunErrors e = runErrors(run.run, requireTruth(truth, "errors"), angles);
+  MatrixXd err(static_cast<Eigen::Index>(e.error.size()), static_cast<Eigen::Index>(e.components.size()));
+  for (std::size_t i = 0; i < e.error.size(); ++i) err.row(static_cast<Eigen::Index>(i)) = e.error[i].transpose();
+  py::dict d;
+  d["t"] = toArray(e.times);
+  d["error"] = err;
+  d["nees"] = toArray(e.nees);
+  d["rmse"] = e.error.empty() ? VectorXd() : e.rmse();
+  d["components"] = e.components;
+  return d;
+}
+
+py::dict metricsDict(const std::shared_ptr<Model>& model, const PyRun& run, const PyDataset* truth) {
+  const Truth* t = truth && truth->data.truth ? &*truth->data.truth : nullptr;
+  const RunMetrics m = computeMetrics(*model, run.run, t);
+  py::dict d;
+  d["method"] = methodName(m.method);
+  d["names"] = m.names;
+  d["rows"] = m.rows;
+  d["has_truth"] = m.has_truth;
+  d["rmse"] = m.rmse;
+  d["max_abs_error"] = m.max_abs_error;
+  d["final_error"] = m.final_error;
+  d["mean_nees"] = m.mean_nees;
+  d["position_rmse"] = m.position_rmse;
+  d["position_max"] = m.position_max;
+  d["position_final"] = m.position_final;
+  d["constant_names"] = m.constant_names;
+  d["constants"] = m.constants;
+  d["constants_sd"] = m.constants_sd;
+  d["downweighted"] = m.downweighted;
+  d["rejected"] = m.rejected;
+  d["latency_median"] = m.latency_median;
+  d["latency_p99"] = m.latency_p99;
+  d["total_seconds"] = m.total_seconds;
+  d["iterations"] = m.iterations;
+  return d;
+}
+
+py::dict cramerRaoDict(const std::shared_ptr<Model>& model, const PyDataset& data, int stride) {
+  SimulatedRun run;
+  if (data.simulated) run = *data.simulated;
+  else run = io::recordedRun(*model, data.data);
+  CramerRaoBound b;
+  if (callsPython(*model)) {
+    b = posteriorCramerRao(*model, run, stride);
+  } else {
+    py::gil_scoped_release release;
+    b = posteriorCramerRao(*model, run, stride);
+  }
+  py::dict d;
+  d["t"] = toArray(b.times);
+  d["filtering"] = cube(b.filtering);
+  d["smoothing"] = cube(b.smoothing);
+  return d;
+}
+
+py::dict identifiabilityDict(const std::shared_ptr<Model>& model, const MatrixXd& posterior_constants, double tolerance) {
+  const ConstantsIdentifiability c = constantsIdentifiability(*model, posterior_constants, tolerance);
+  py::dict d;
+  d["eigenvalues"] = c.eigenvalues;
+  d["directions"] = c.directions;
+  d["rank"] = c.rank;
+  d["condition"] = c.condition;
+  d["weakest"] = c.weakest;
+  d["determined"] = c.determined(tolerance);
+  return d;
+}
+
 }  // namespace
 
 void bindAnalysis(py::module_& a) {
-  a.def(
-      "errors",
-      [](const PyRun& run, const PyDataset& truth, const std::shared_ptr<Model>& model) {
-        const std::vector<int> angles = model ? model->angleStates()
-                                              : (truth.model ? truth.model->angleStates() : std::vector<int>{});
-        const RunErrors e = runErrors(run.run, requireTruth(truth, "errors"), angles);
-        MatrixXd err(static_cast<Eigen::Index>(e.error.size()), static_cast<Eigen::Index>(e.components.size()));
-        for (std::size_t i = 0; i < e.error.size(); ++i) err.row(static_cast<Eigen::Index>(i)) = e.error[i].transpose();
-        py::dict d;
-        d["t"] = toArray(e.times);
-        d["error"] = err;
-        d["nees"] = toArray(e.nees);
-        d["rmse"] = e.error.empty() ? VectorXd() : e.rmse();
-        d["components"] = e.components;
-        return d;
-      },
+  a.def("errors", &runErrorsDict,
       py::arg("run"), py::arg("truth"), py::arg("model") = nullptr,
       "Estimate − truth per row on the truth's components (angles wrapped), the NEES of each row and the RMSE: "
       "dict t, error (N, m), nees (N,), rmse (m,), components.");
 
-  a.def(
-      "metrics",
-      [](const std::shared_ptr<Model>& model, const PyRun& run, const PyDataset* truth) {
-        const Truth* t = truth && truth->data.truth ? &*truth->data.truth : nullptr;
-        const RunMetrics m = computeMetrics(*model, run.run, t);
-        py::dict d;
-        d["method"] = methodName(m.method);
-        d["names"] = m.names;
-        d["rows"] = m.rows;
-        d["has_truth"] = m.has_truth;
-        d["rmse"] = m.rmse;
-        d["max_abs_error"] = m.max_abs_error;
-        d["final_error"] = m.final_error;
-        d["mean_nees"] = m.mean_nees;
-        d["position_rmse"] = m.position_rmse;
-        d["position_max"] = m.position_max;
-        d["position_final"] = m.position_final;
-        d["constant_names"] = m.constant_names;
-        d["constants"] = m.constants;
-        d["constants_sd"] = m.constants_sd;
-        d["downweighted"] = m.downweighted;
-        d["rejected"] = m.rejected;
-        d["latency_median"] = m.latency_median;
-        d["latency_p99"] = m.latency_p99;
-        d["total_seconds"] = m.total_seconds;
-        d["iterations"] = m.iterations;
-        return d;
-      },
+  a.def("metrics", &metricsDict,
       py::arg("model"), py::arg("run"), py::arg("truth") = nullptr,
       "The numbers gssm-process writes to metrics.json for one run, as a dict of arrays.");
 
@@ -98,42 +128,12 @@ void bindAnalysis(py::module_& a) {
       py::arg("model"), py::arg("runs"), py::arg("truth") = nullptr, py::arg("dataset") = "",
       "metrics.json text for several runs of one dataset, as gssm-process writes it.");
 
-  a.def(
-      "cramer_rao",
-      [](const std::shared_ptr<Model>& model, const PyDataset& data, int stride) {
-        SimulatedRun run;
-        if (data.simulated) run = *data.simulated;
-        else run = io::recordedRun(*model, data.data);
-        CramerRaoBound b;
-        if (callsPython(*model)) {
-          b = posteriorCramerRao(*model, run, stride);
-        } else {
-          py::gil_scoped_release release;
-          b = posteriorCramerRao(*model, run, stride);
-        }
-        py::dict d;
-        d["t"] = toArray(b.times);
-        d["filtering"] = cube(b.filtering);
-        d["smoothing"] = cube(b.smoothing);
-        return d;
-      },
+  a.def("cramer_rao", &cramerRaoDict,
       py::arg("model"), py::arg("data"), py::arg("stride") = 1,
       "Posterior Cramér–Rao bound on cov [x_c(k); x_b] along the dataset's true trajectory: dict t, filtering "
       "(N, n, n) (data up to t_k), smoothing (N, n, n) (all data).");
 
-  a.def(
-      "identifiability",
-      [](const std::shared_ptr<Model>& model, const MatrixXd& posterior_constants, double tolerance) {
-        const ConstantsIdentifiability c = constantsIdentifiability(*model, posterior_constants, tolerance);
-        py::dict d;
-        d["eigenvalues"] = c.eigenvalues;
-        d["directions"] = c.directions;
-        d["rank"] = c.rank;
-        d["condition"] = c.condition;
-        d["weakest"] = c.weakest;
-        d["determined"] = c.determined(tolerance);
-        return d;
-      },
+  a.def("identifiability", &identifiabilityDict,
       py::arg("model"), py::arg("posterior_constants"), py::arg("tolerance") = 1e-9,
       "What the data determine about x_b, from its posterior covariance and the model's prior.");
 

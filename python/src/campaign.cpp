@@ -78,9 +78,20 @@ MatrixXd rowsOf(const std::vector<VectorXd>& v) {
   return m;
 }
 
-}  // namespace
+bool sameSeedResult(const MonteCarloSeedResult& a, const MonteCarloSeedResult& b) {
+  if (a.seed != b.seed || a.times != b.times || a.methods.size() != b.methods.size()) return false;
+  for (std::size_t i = 0; i < a.methods.size(); ++i) {
+    const auto &x = a.methods[i], &y = b.methods[i];
+    if (x.method != y.method || x.ok != y.ok || x.error != y.error || x.sq != y.sq || x.nees != y.nees ||
+        x.rmse != y.rmse || x.final_error != y.final_error || x.nis.size() != y.nis.size())
+      return false;
+    for (std::size_t k = 0; k < x.nis.size(); ++k)  // NaN-aware, bit for bit
+      if (!(x.nis[k] == y.nis[k] || (std::isnan(x.nis[k]) && std::isnan(y.nis[k])))) return false;
+  }
+  return true;
+}
 
-void bindCampaign(py::module_& c) {
+void bindSeedResult(py::module_& c) {
   py::class_<MonteCarloSeedResult>(c, "SeedResult", "One seed's run estimated by every method (picklable).")
       .def_readonly("seed", &MonteCarloSeedResult::seed)
       .def_property_readonly("times", [](const MonteCarloSeedResult& r) { return toArray(r.times); })
@@ -107,19 +118,10 @@ void bindCampaign(py::module_& c) {
           },
           py::arg("method"), "what the method threw on this seed ('' if it ran)")
       .def(py::pickle(&seedState, &seedFromState))
-      .def("__eq__", [](const MonteCarloSeedResult& a, const MonteCarloSeedResult& b) {
-        if (a.seed != b.seed || a.times != b.times || a.methods.size() != b.methods.size()) return false;
-        for (std::size_t i = 0; i < a.methods.size(); ++i) {
-          const auto &x = a.methods[i], &y = b.methods[i];
-          if (x.method != y.method || x.ok != y.ok || x.error != y.error || x.sq != y.sq || x.nees != y.nees ||
-              x.rmse != y.rmse || x.final_error != y.final_error || x.nis.size() != y.nis.size())
-            return false;
-          for (std::size_t k = 0; k < x.nis.size(); ++k)  // NaN-aware, bit for bit
-            if (!(x.nis[k] == y.nis[k] || (std::isnan(x.nis[k]) && std::isnan(y.nis[k])))) return false;
-        }
-        return true;
-      });
+      .def("__eq__", &sameSeedResult);
+}
 
+void bindSummaries(py::module_& c) {
   py::class_<MethodSummary>(c, "MethodSummary", "One method's row of the Monte Carlo table, with its curves.")
       .def_property_readonly("method", [](const MethodSummary& m) { return std::string(methodName(m.method)); })
       .def_readonly("mean_rmse", &MethodSummary::mean_rmse)
@@ -151,7 +153,9 @@ void bindCampaign(py::module_& c) {
       .def_readonly("methods", &MonteCarloResult::methods)
       .def_readwrite("seconds", &MonteCarloResult::seconds)
       .def("markdown", &MonteCarloResult::markdown, "the Markdown table gssm-montecarlo writes");
+}
 
+void bindScenario(py::module_& c) {
   py::class_<PyScenario, std::shared_ptr<PyScenario>>(c, "Scenario",
                                                       "A Monte Carlo scenario from scenario.ini text (picklable).")
       .def(py::init<std::string, std::string, std::vector<std::string>, int>(), py::arg("scenario_ini"),
@@ -200,6 +204,13 @@ void bindCampaign(py::module_& c) {
             return std::make_shared<PyScenario>(t[0].cast<std::string>(), t[1].cast<std::string>(),
                                                 t[2].cast<std::vector<std::string>>(), t[3].cast<int>());
           }));
+}
+}  // namespace
+
+void bindCampaign(py::module_& c) {
+  bindSeedResult(c);
+  bindSummaries(c);
+  bindScenario(c);
 }
 
 }  // namespace gssm::python

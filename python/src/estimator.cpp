@@ -142,8 +142,8 @@ void bindOptionFields(py::class_<Options> cls) {
 }
 }  // namespace
 
-void bindEstimator(py::module_& m) {
-  // ---- options ------------------------------------------------------------
+namespace {
+void bindOptionGroups(py::module_& m) {
   bindOptionFields(py::class_<ExtendedKalmanFilterOptions>(m, "EkfOptions", "Settings of the EKF baseline ([ekf]).")
                        .def(py::init<>()));
   bindOptionFields(py::class_<SmootherOptions>(m, "SmootherOptions",
@@ -152,7 +152,28 @@ void bindEstimator(py::module_& m) {
                        .def(py::init<>()));
   bindOptionFields(py::class_<BatchSolverOptions>(m, "BatchOptions", "Settings of the batch MAP solver ([batch]).")
                        .def(py::init<>()));
+}
 
+py::tuple pickledOptions(const EstimatorOptions& o) {
+  return py::make_tuple(std::string(methodName(o.method)), o.t0, o.compute_nis, optionDict(o.ekf), optionDict(o.smoother),
+                        orderingName(o.incremental.ordering), o.fixed_lag.window, o.paper_window.window,
+                        optionDict(o.batch));
+}
+
+EstimatorOptions unpickledOptions(const py::tuple& t) {
+  EstimatorOptions o(methodFromName(t[0].cast<std::string>()));
+  o.t0 = t[1].cast<double>();
+  o.compute_nis = t[2].cast<bool>();
+  setOptions(o.ekf, t[3]);
+  setOptions(o.smoother, t[4]);
+  o.incremental.ordering = orderingFromName(t[5].cast<std::string>());
+  o.fixed_lag.window = t[6].cast<int>();
+  o.paper_window.window = t[7].cast<int>();
+  setOptions(o.batch, t[8]);
+  return o;
+}
+
+void bindEstimatorOptions(py::module_& m) {
   py::class_<EstimatorOptions>(m, "EstimatorOptions",
                                "Every method's settings; `method` says which run. gssm.make_estimator and gssm.run "
                                "build one from keyword arguments.")
@@ -184,24 +205,7 @@ void bindEstimator(py::module_& m) {
             if (!o.validate(model, &why)) throw InvalidArgument(why);
           },
           py::arg("model"), "raises gssm.InvalidArgument naming the option at fault")
-      .def(py::pickle(
-          [](const EstimatorOptions& o) {
-            return py::make_tuple(std::string(methodName(o.method)), o.t0, o.compute_nis, optionDict(o.ekf),
-                                  optionDict(o.smoother), orderingName(o.incremental.ordering), o.fixed_lag.window,
-                                  o.paper_window.window, optionDict(o.batch));
-          },
-          [](const py::tuple& t) {
-            EstimatorOptions o(methodFromName(t[0].cast<std::string>()));
-            o.t0 = t[1].cast<double>();
-            o.compute_nis = t[2].cast<bool>();
-            setOptions(o.ekf, t[3]);
-            setOptions(o.smoother, t[4]);
-            o.incremental.ordering = orderingFromName(t[5].cast<std::string>());
-            o.fixed_lag.window = t[6].cast<int>();
-            o.paper_window.window = t[7].cast<int>();
-            setOptions(o.batch, t[8]);
-            return o;
-          }));
+      .def(py::pickle(&pickledOptions, &unpickledOptions));
 
   m.def("methods", [](bool streaming_only) {
     std::vector<std::string> out;
@@ -209,8 +213,9 @@ void bindEstimator(py::module_& m) {
       if (info.streaming || !streaming_only) out.push_back(info.name);
     return out;
   }, py::arg("streaming_only") = false, "every method name, in the order gssm-process 'all' runs them");
+}
 
-  // ---- estimates and reports ----------------------------------------------
+void bindEstimates(py::module_& m) {
   py::class_<StateEstimate>(m, "StateEstimate", "The stacked state [x_c(k); x_b] at step k with its covariance.")
       .def_readonly("t", &StateEstimate::t)
       .def_readonly("step", &StateEstimate::step)
@@ -243,7 +248,23 @@ void bindEstimator(py::module_& m) {
       .def_readonly("seconds", &UpdateReport::seconds)
       .def_readonly("note", &UpdateReport::note)
       .def("__repr__", [](const UpdateReport& r) { return "UpdateReport(" + r.toString() + ")"; });
+}
 
+py::dict reportDict(const EstimatorReport& r) {
+  py::dict d;
+  d["method"] = methodName(r.method);
+  d["window"] = r.window;
+  d["ordering"] = r.ordering ? py::object(py::str(orderingName(*r.ordering))) : py::object(py::none());
+  d["measurements"] = r.measurements;
+  d["seconds"] = r.seconds;
+  d["iterations"] = r.iterations;
+  d["rejected"] = r.rejected;
+  d["detail"] = r.detail;
+  d["nis"] = r.nis;
+  return d;
+}
+
+void bindEstimatorReport(py::module_& m) {
   py::class_<EstimatorReport>(m, "EstimatorReport", "The last call's report (a snapshot).")
       .def_property_readonly("method", [](const EstimatorReport& r) { return std::string(methodName(r.method)); })
       .def_readonly("window", &EstimatorReport::window)
@@ -259,23 +280,13 @@ void bindEstimator(py::module_& m) {
       .def_readonly("smoother", &EstimatorReport::smoother)
       .def_readonly("detail", &EstimatorReport::detail)
       .def_readonly("nis", &EstimatorReport::nis)
-      .def("to_dict", [](const EstimatorReport& r) {
-        py::dict d;
-        d["method"] = methodName(r.method);
-        d["window"] = r.window;
-        d["ordering"] = r.ordering ? py::object(py::str(orderingName(*r.ordering))) : py::object(py::none());
-        d["measurements"] = r.measurements;
-        d["seconds"] = r.seconds;
-        d["iterations"] = r.iterations;
-        d["rejected"] = r.rejected;
-        d["detail"] = r.detail;
-        d["nis"] = r.nis;
-        return d;
-      })
+      .def("to_dict", &reportDict)
       .def("__repr__", &reportRepr);
+}
 
-  // ---- the streaming estimator --------------------------------------------
-  py::class_<PyEstimator>(m, "Estimator",
+// The streaming estimator: feeding it, reading it.
+py::class_<PyEstimator> bindStreamingEstimator(py::module_& m) {
+  return py::class_<PyEstimator>(m, "Estimator",
                           "A streaming estimator (gssm.make_estimator). Every call that raises leaves it as it was.")
       .def_property_readonly("method", [](const PyEstimator& e) { return std::string(e.est->methodName()); })
       .def_property_readonly("model", [](const PyEstimator& e) { return std::const_pointer_cast<Model>(e.model); })
@@ -314,8 +325,12 @@ void bindEstimator(py::module_& m) {
           py::arg("states") = std::vector<std::int64_t>{}, py::arg("constants") = true,
           "joint marginal covariance of the states x_c(k) for k in `states` and (if constants) x_b, blocks in that "
           "order; None where the method does not hold them all")
-      .def("report", [](const PyEstimator& e) { return e.est->report(); }, "the last call's report")
-      .def(
+      .def("report", [](const PyEstimator& e) { return e.est->report(); }, "the last call's report");
+}
+
+// Its checkpoints and pickling.
+void bindEstimatorCheckpoints(py::class_<PyEstimator>& cls) {
+  cls.def(
           "to_bytes",
           [](const PyEstimator& e, const py::bytes& user_data) {
             return py::bytes(checkpointBytes(*e.est, std::string(user_data)));
@@ -336,7 +351,21 @@ void bindEstimator(py::module_& m) {
         return "<gssm.Estimator " + std::string(e.est->methodName()) + " on " + e.model->name() +
                ", step " + std::to_string(e.est->step()) + ", t = " + std::to_string(e.est->time()) + ">";
       });
+}
 
+py::dict checkpointInfoDict(const CheckpointInfo& info) {
+  py::dict d;
+  d["version"] = info.version;
+  d["method"] = methodName(info.method);
+  d["model"] = info.model;
+  d["step"] = info.step;
+  d["time"] = info.time;
+  d["user_data"] = py::bytes(info.user_data);
+  return d;
+}
+
+// Making and restoring estimators.
+void bindEstimatorFactories(py::module_& m) {
   m.def(
       "make_estimator_from_options",
       [](std::shared_ptr<Model> model, const EstimatorOptions& options) {
@@ -344,16 +373,6 @@ void bindEstimator(py::module_& m) {
       },
       py::arg("model"), py::arg("options"), "gssm.make_estimator without keyword conveniences");
 
-  auto restoreInfo = [](const CheckpointInfo& info) {
-    py::dict d;
-    d["version"] = info.version;
-    d["method"] = methodName(info.method);
-    d["model"] = info.model;
-    d["step"] = info.step;
-    d["time"] = info.time;
-    d["user_data"] = py::bytes(info.user_data);
-    return d;
-  };
   m.def(
       "restore_bytes",
       [](std::shared_ptr<Model> model, const py::bytes& bytes) {
@@ -368,14 +387,41 @@ void bindEstimator(py::module_& m) {
       py::arg("model"), py::arg("path"), "the estimator a checkpoint file holds, on `model`");
   m.def(
       "checkpoint_info",
-      [restoreInfo](std::shared_ptr<Model> model, const py::bytes& bytes) {
+      [](std::shared_ptr<Model> model, const py::bytes& bytes) {
         CheckpointInfo info;
         restoreCheckpointBytes(*model, std::string(bytes), "checkpoint", &info);
-        return restoreInfo(info);
+        return checkpointInfoDict(info);
       },
       py::arg("model"), py::arg("data"), "version, method, model, step, time and user_data of a checkpoint");
+}
 
-  // ---- offline runs -------------------------------------------------------
+py::array_t<double> runCovariances(const PyRun& r) {
+  const auto n = static_cast<py::ssize_t>(r.names.size());
+  py::array_t<double> a({static_cast<py::ssize_t>(r.run.rows.size()), n, n});
+  auto v = a.mutable_unchecked<3>();
+  for (std::size_t k = 0; k < r.run.rows.size(); ++k)
+    for (py::ssize_t i = 0; i < n; ++i)
+      for (py::ssize_t j = 0; j < n; ++j) v(static_cast<py::ssize_t>(k), i, j) = r.run.rows[k].covariance(i, j);
+  return a;
+}
+
+PyRun runDataset(std::shared_ptr<Model> model, const PyDataset& data, const EstimatorOptions& options,
+                 const std::optional<bool> rows_at_inputs, const std::function<void(std::size_t, std::size_t)>& progress) {
+  const RowTimes rows = rows_at_inputs.value_or(data.data.rows_at_inputs) ? RowTimes::Inputs : RowTimes::Measurements;
+  PyRun out;
+  out.names = model->stackedStateNames();
+  if (callsPython(*model) || progress) {
+    // Python code runs inside the loop: keep the GIL.
+    out.run = runOffline(*model, options, data.data.measurements, data.data.inputs, progress, {}, rows);
+  } else {
+    py::gil_scoped_release release;
+    out.run = runOffline(*model, options, data.data.measurements, data.data.inputs, {}, {}, rows);
+  }
+  return out;
+}
+
+// Offline runs.
+void bindRuns(py::module_& m) {
   py::class_<PyRun>(m, "Run", "An offline run: one row per measurement (or per input for input-driven logs).")
       .def_property_readonly("method", [](const PyRun& r) { return std::string(methodName(r.run.method)); })
       .def_property_readonly("names", [](const PyRun& r) { return r.names; }, "names of the columns of mean and sd")
@@ -386,17 +432,7 @@ void bindEstimator(py::module_& m) {
       .def_property_readonly("sd", [](const PyRun& r) {
         return stack(r.run.rows, static_cast<Eigen::Index>(r.names.size()), true);
       }, "(N, n) marginal standard deviations")
-      .def_property_readonly("covariance",
-                             [](const PyRun& r) {
-                               const auto n = static_cast<py::ssize_t>(r.names.size());
-                               py::array_t<double> a({static_cast<py::ssize_t>(r.run.rows.size()), n, n});
-                               auto v = a.mutable_unchecked<3>();
-                               for (std::size_t k = 0; k < r.run.rows.size(); ++k)
-                                 for (py::ssize_t i = 0; i < n; ++i)
-                                   for (py::ssize_t j = 0; j < n; ++j)
-                                     v(static_cast<py::ssize_t>(k), i, j) = r.run.rows[k].covariance(i, j);
-                               return a;
-                             }, "(N, n, n)")
+      .def_property_readonly("covariance", &runCovariances, "(N, n, n)")
       .def_property_readonly("nis", [](const PyRun& r) { return toArray(r.run.nis); }, "NIS per measurement (compute_nis)")
       .def_property_readonly("update_seconds", [](const PyRun& r) { return toArray(r.run.update_seconds); })
       .def_property_readonly("total_seconds", [](const PyRun& r) { return r.run.total_seconds; },
@@ -411,25 +447,20 @@ void bindEstimator(py::module_& m) {
                " rows, " + std::to_string(r.run.total_seconds) + " s>";
       });
 
-  m.def(
-      "run_dataset",
-      [](std::shared_ptr<Model> model, const PyDataset& data, const EstimatorOptions& options,
-         const std::optional<bool> rows_at_inputs, const std::function<void(std::size_t, std::size_t)>& progress) {
-        const RowTimes rows = rows_at_inputs.value_or(data.data.rows_at_inputs) ? RowTimes::Inputs
-                                                                                 : RowTimes::Measurements;
-        PyRun out;
-        out.names = model->stackedStateNames();
-        if (callsPython(*model) || progress) {
-          // Python code runs inside the loop: keep the GIL.
-          out.run = runOffline(*model, options, data.data.measurements, data.data.inputs, progress, {}, rows);
-        } else {
-          py::gil_scoped_release release;
-          out.run = runOffline(*model, options, data.data.measurements, data.data.inputs, {}, {}, rows);
-        }
-        return out;
-      },
-      py::arg("model"), py::arg("data"), py::arg("options"), py::arg("rows_at_inputs") = py::none(),
+  m.def("run_dataset", &runDataset, py::arg("model"), py::arg("data"), py::arg("options"), py::arg("rows_at_inputs") = py::none(),
       py::arg("progress") = nullptr, "gssm.run without keyword conveniences");
+}
+}  // namespace
+
+void bindEstimator(py::module_& m) {
+  bindOptionGroups(m);
+  bindEstimatorOptions(m);
+  bindEstimates(m);
+  bindEstimatorReport(m);
+  auto estimator = bindStreamingEstimator(m);
+  bindEstimatorCheckpoints(estimator);
+  bindEstimatorFactories(m);
+  bindRuns(m);
 }
 
 }  // namespace gssm::python

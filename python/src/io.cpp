@@ -8,6 +8,7 @@
 #include "gssm/core/error.h"
 #include "gssm/io/config.h"
 #include "gssm/io/ini.h"
+#include "gssm/model/registry.h"
 #include "gssm/model/simulation.h"
 
 namespace gssm::python {
@@ -48,6 +49,88 @@ void fillFromSimulation(PyDataset& d) {
   d.data.rows_at_inputs = d.data.scenario.getString("dataset", "rows", "measurements") == "inputs";
 }
 
+PyDataset datasetFromArrays(const VectorXd& t, const MatrixXd& y, const std::optional<Eigen::VectorXi>& channel,
+                            const std::optional<VectorXd>& input_t, const std::optional<MatrixXd>& u,
+                            const std::optional<VectorXd>& truth_t, const std::optional<MatrixXd>& truth_x,
+                            const std::vector<int>& truth_components, double t0, bool rows_at_inputs,
+                            std::shared_ptr<Model> model) {
+  PyDataset d;
+  const Eigen::Index N = t.size();
+  // A 1-D y of N values is N scalar measurements.
+  MatrixXd Y = (y.cols() == N && y.rows() == 1 && N != 1) ? MatrixXd(y.transpose()) : y;
+  if (Y.rows() != N)
+    throw InvalidArgument("from_arrays: t has " + std::to_string(N) + " entries but y has " + std::to_string(Y.rows()) +
+                          " rows");
+  if (channel && channel->size() != N)
+    throw InvalidArgument("from_arrays: channel has " + std::to_string(channel->size()) + " entries, t has " +
+                          std::to_string(N));
+  for (Eigen::Index i = 0; i < N; ++i)
+    d.data.measurements.emplace_back(t[i], VectorXd(Y.row(i).transpose()), channel ? (*channel)[i] : 0);
+  if (input_t || u) {
+    if (!input_t || !u || u->rows() != input_t->size())
+      throw InvalidArgument("from_arrays: input_t (M,) and u (M, n_u) go together");
+    for (Eigen::Index i = 0; i < input_t->size(); ++i) d.data.inputs.push_back({(*input_t)[i], VectorXd(u->row(i).transpose())});
+  }
+  if (truth_t || truth_x) {
+    if (!truth_t || !truth_x || truth_x->rows() != truth_t->size())
+      throw InvalidArgument("from_arrays: truth_t (K,) and truth_x (K, m) go together");
+    Truth tr;
+    for (Eigen::Index i = 0; i < truth_t->size(); ++i) {
+      tr.times.push_back((*truth_t)[i]);
+      tr.states.emplace_back(truth_x->row(i).transpose());
+    }
+    tr.components = truth_components;
+    d.data.truth = std::move(tr);
+  }
+  d.data.t0 = t0;
+  d.data.rows_at_inputs = rows_at_inputs;
+  d.model = std::move(model);
+  return d;
+}
+
+PyDataset readDatasetFolder(const std::string& dir, const std::string& config, const std::string& bad_rows) {
+  io::BadRows mode = io::BadRows::Throw;
+  if (bad_rows == "stop") mode = io::BadRows::Stop;
+  else if (bad_rows == "skip") mode = io::BadRows::Skip;
+  else if (bad_rows != "raise")
+    throw InvalidArgument("read_dataset: bad_rows '" + bad_rows + "': expected raise, stop or skip");
+  PyDataset d;
+  const io::IniDocument ini = io::readScenario(dir, config);
+  d.model = std::shared_ptr<Model>(io::makeModel(ini, dir));
+  io::readDatasetData(dir, *d.model, d.data, mode, &ini);
+  d.data.scenario = ini;
+  return d;
+}
+
+PyDataset simulateModel(std::shared_ptr<Model> model, unsigned seed, int steps, const std::optional<VectorXd>& x0,
+                        const std::optional<VectorXd>& xb, int measure_every, const std::vector<py::object>& channels) {
+  if (steps < 1) throw InvalidArgument("simulate: steps must be >= 1");
+  PyDataset d;
+  d.model = model;
+  SimulationSpec spec;
+  spec.steps = steps;
+  spec.x0 = x0;
+  spec.xb = xb;
+  spec.measure_every = measure_every;
+  if (!channels.empty()) {
+    spec.channels.clear();
+    for (const auto& c : channels)
+      spec.channels.push_back(py::isinstance<py::str>(c) ? model->channelIndex(c.cast<std::string>()) : c.cast<int>());
+  }
+  d.simulated = std::make_shared<SimulatedRun>(simulate(*model, spec, simulationSampler(seed)));
+  if (modelTypeOf(*model)) io::writeModel(*model, d.data.scenario);  // a registered type has an INI form
+  fillFromSimulation(d);
+  return d;
+}
+
+EstimatorOptions datasetOptions(const PyDataset& d, const std::string& method, std::shared_ptr<Model> model) {
+  if (!model) model = d.model;
+  if (!model) throw InvalidArgument("Dataset.options: the dataset has no model; pass model=");
+  EstimatorOptions o = io::estimatorOptions(d.data.scenario, *model, methodFromName(method));
+  o.t0 = d.data.t0;
+  return o;
+}
+
 }  // namespace
 
 NormalSampler simulationSampler(unsigned seed) {
@@ -55,9 +138,8 @@ NormalSampler simulationSampler(unsigned seed) {
   return [rng] { return rng->drawGaussian1D_normalized(); };
 }
 
-void bindIo(py::module_& io) {
-  io.def("ini_option_keys", &io::estimatorIniKeys,
-         "[(section, [keys])] of every estimator section of a scenario.ini, as the INI reader takes them");
+namespace {
+void bindDataset(py::module_& io) {
   py::class_<PyDataset>(io, "Dataset",
                         "Measurements (with channels), inputs and optional truth of one run, with the model and "
                         "settings of its scenario.ini when it came from a folder or a simulation.")
@@ -121,16 +203,7 @@ void bindIo(py::module_& io) {
                              "its scenario.ini text")
       .def_property_readonly("row_errors", [](const PyDataset& d) { return d.data.row_errors; },
                              "bad rows skipped or stopped at (bad_rows='skip' or 'stop')")
-      .def(
-          "options",
-          [](const PyDataset& d, const std::string& method, std::shared_ptr<Model> model) {
-            if (!model) model = d.model;
-            if (!model) throw InvalidArgument("Dataset.options: the dataset has no model; pass model=");
-            EstimatorOptions o = io::estimatorOptions(d.data.scenario, *model, methodFromName(method));
-            o.t0 = d.data.t0;
-            return o;
-          },
-          py::arg("method") = "fixed-lag", py::arg("model") = nullptr,
+      .def("options", &datasetOptions, py::arg("method") = "fixed-lag", py::arg("model") = nullptr,
           "the settings gssm-process uses on this dataset for `method` (its INI sections, its t0)")
       .def("__len__", [](const PyDataset& d) { return d.data.measurements.size(); })
       .def("__repr__", [](const PyDataset& d) {
@@ -139,67 +212,17 @@ void bindIo(py::module_& io) {
                " inputs" + (d.data.truth ? ", truth" : "") + (d.model ? ", model " + d.model->name() : "") + ">";
       });
 
-  io.def(
-      "from_arrays",
-      [](const VectorXd& t, const MatrixXd& y, const std::optional<Eigen::VectorXi>& channel,
-         const std::optional<VectorXd>& input_t, const std::optional<MatrixXd>& u,
-         const std::optional<VectorXd>& truth_t, const std::optional<MatrixXd>& truth_x,
-         const std::vector<int>& truth_components, double t0, bool rows_at_inputs, std::shared_ptr<Model> model) {
-        PyDataset d;
-        const Eigen::Index N = t.size();
-        // A 1-D y of N values is N scalar measurements.
-        MatrixXd Y = (y.cols() == N && y.rows() == 1 && N != 1) ? MatrixXd(y.transpose()) : y;
-        if (Y.rows() != N)
-          throw InvalidArgument("from_arrays: t has " + std::to_string(N) + " entries but y has " +
-                                std::to_string(Y.rows()) + " rows");
-        if (channel && channel->size() != N)
-          throw InvalidArgument("from_arrays: channel has " + std::to_string(channel->size()) + " entries, t has " +
-                                std::to_string(N));
-        for (Eigen::Index i = 0; i < N; ++i)
-          d.data.measurements.emplace_back(t[i], VectorXd(Y.row(i).transpose()), channel ? (*channel)[i] : 0);
-        if (input_t || u) {
-          if (!input_t || !u || u->rows() != input_t->size())
-            throw InvalidArgument("from_arrays: input_t (M,) and u (M, n_u) go together");
-          for (Eigen::Index i = 0; i < input_t->size(); ++i)
-            d.data.inputs.push_back({(*input_t)[i], VectorXd(u->row(i).transpose())});
-        }
-        if (truth_t || truth_x) {
-          if (!truth_t || !truth_x || truth_x->rows() != truth_t->size())
-            throw InvalidArgument("from_arrays: truth_t (K,) and truth_x (K, m) go together");
-          Truth tr;
-          for (Eigen::Index i = 0; i < truth_t->size(); ++i) {
-            tr.times.push_back((*truth_t)[i]);
-            tr.states.emplace_back(truth_x->row(i).transpose());
-          }
-          tr.components = truth_components;
-          d.data.truth = std::move(tr);
-        }
-        d.data.t0 = t0;
-        d.data.rows_at_inputs = rows_at_inputs;
-        d.model = std::move(model);
-        return d;
-      },
+}
+
+void bindDatasetFiles(py::module_& io) {
+  io.def("from_arrays", &datasetFromArrays,
       py::arg("t"), py::arg("y"), py::arg("channel") = py::none(), py::arg("input_t") = py::none(),
       py::arg("u") = py::none(), py::arg("truth_t") = py::none(), py::arg("truth_x") = py::none(),
       py::arg("truth_components") = std::vector<int>{}, py::arg("t0") = 0.0, py::arg("rows_at_inputs") = false,
       py::arg("model") = nullptr,
       "A dataset from arrays: t (N,), y (N, n_y) or (N,), optional channel (N,), inputs, truth.");
 
-  io.def(
-      "read_dataset",
-      [](const std::string& dir, const std::string& config, const std::string& bad_rows) {
-        io::BadRows mode = io::BadRows::Throw;
-        if (bad_rows == "stop") mode = io::BadRows::Stop;
-        else if (bad_rows == "skip") mode = io::BadRows::Skip;
-        else if (bad_rows != "raise")
-          throw InvalidArgument("read_dataset: bad_rows '" + bad_rows + "': expected raise, stop or skip");
-        PyDataset d;
-        const io::IniDocument ini = io::readScenario(dir, config);
-        d.model = std::shared_ptr<Model>(io::makeModel(ini, dir));
-        io::readDatasetData(dir, *d.model, d.data, mode, &ini);
-        d.data.scenario = ini;
-        return d;
-      },
+  io.def("read_dataset", &readDatasetFolder,
       py::arg("dir"), py::arg("config") = "", py::arg("bad_rows") = "raise",
       "A dataset folder (scenario.ini, measurements, optional inputs and truth; every layout gssm-process "
       "reads). config: an INI file to use instead of its scenario.ini. bad_rows: 'raise' (gssm.InputError "
@@ -215,6 +238,11 @@ void bindIo(py::module_& io) {
       py::arg("dir"), py::arg("data"),
       "Writes measurements.csv, truth.csv, inputs.csv and scenario.ini as gssm-simulate does.");
 
+  io.def("ini_option_keys", &io::estimatorIniKeys,
+         "[(section, [keys])] of every estimator section of a scenario.ini, as the INI reader takes them");
+}
+
+void bindSimulation(py::module_& io) {
   io.def("scenarios", &io::scenarioNames, "the built-in scenario names");
   io.def(
       "scenario_ini", [](const std::string& name, unsigned seed, int steps) {
@@ -232,36 +260,18 @@ void bindIo(py::module_& io) {
       py::arg("scenario") = "paper", py::arg("seed") = 1, py::arg("steps") = 400,
       "A built-in scenario simulated with seed (the bytes gssm-simulate writes for the same arguments).");
 
-  io.def(
-      "simulate_model",
-      [](std::shared_ptr<Model> model, unsigned seed, int steps, const std::optional<VectorXd>& x0,
-         const std::optional<VectorXd>& xb, int measure_every, const std::vector<py::object>& channels) {
-        if (steps < 1) throw InvalidArgument("simulate: steps must be >= 1");
-        PyDataset d;
-        d.model = model;
-        SimulationSpec spec;
-        spec.steps = steps;
-        spec.x0 = x0;
-        spec.xb = xb;
-        spec.measure_every = measure_every;
-        if (!channels.empty()) {
-          spec.channels.clear();
-          for (const auto& c : channels)
-            spec.channels.push_back(py::isinstance<py::str>(c) ? model->channelIndex(c.cast<std::string>())
-                                                               : c.cast<int>());
-        }
-        d.simulated = std::make_shared<SimulatedRun>(simulate(*model, spec, simulationSampler(seed)));
-        try {
-          io::writeModel(*model, d.data.scenario);  // writable when the model has an INI form
-        } catch (const InvalidArgument&) {
-        }
-        fillFromSimulation(d);
-        return d;
-      },
+  io.def("simulate_model", &simulateModel,
       py::arg("model"), py::arg("seed") = 1, py::arg("steps") = 400, py::arg("x0") = py::none(),
       py::arg("xb") = py::none(), py::arg("measure_every") = 1, py::arg("channels") = std::vector<py::object>{},
       "A run of `model` simulated with seed (x0, xb drawn from the priors unless given); channels: the "
       "channels (names or indices) measured in turn (default: the first).");
+}
+}  // namespace
+
+void bindIo(py::module_& io) {
+  bindDataset(io);
+  bindDatasetFiles(io);
+  bindSimulation(io);
 }
 
 }  // namespace gssm::python
