@@ -69,6 +69,7 @@ std::string BatchSolverSummary::toString() const {
 // in H's compressed columns; every linearization then writes H in place
 // (no triplets, no key lookups, no re-sorting).
 struct BatchSolver::Impl {
+  struct Iteration;  // one solve's LM iteration (below)
   std::vector<Key> layout;               // the variables' keys in column order (Key order)
   std::vector<Eigen::Index> offset;      // first column of each, by Values position; then n
   Eigen::Index n = 0;
@@ -94,7 +95,15 @@ struct BatchSolver::Impl {
   mutable std::optional<internal::SparseCholesky::SelectedInverse> selected;
   mutable bool envelope_inverse = false;  // envelope.selectedInverse() done for this solution
 
+  // The variables' layout, each factor's variables and shape, then the
+  // linear solver for the graph's pattern.
   void setup(const FactorGraph& graph, const Values& values) {
+    layoutVariables(values);
+    indexFactors(graph, values);
+    if (!chooseEnvelope(graph)) assembleSparsePattern(graph);
+  }
+
+  void layoutVariables(const Values& values) {
     offset.clear();
     layout.clear();
     layout.reserve(values.size());
@@ -105,6 +114,9 @@ struct BatchSolver::Impl {
       n += kv.second.size();
     }
     offset.push_back(n);
+  }
+
+  void indexFactors(const FactorGraph& graph, const Values& values) {
     factor_vars.clear();
     factor_begin.assign(1, 0);
     factor_shape.clear();
@@ -136,34 +148,39 @@ struct BatchSolver::Impl {
     jacobians.resize(shapes.size());
     factor_offs.resize(max_keys);
     factor_x.resize(max_keys);
-    // The envelope: each column's first row reached by a factor. Compact
-    // (at most twice the entries factors add, plus the diagonal) for a chain
-    // in time order with the constants last, small or large (a paper window
-    // of 10 steps: 1.4× faster than the dense factorization of its 14
-    // unknowns); SparseCholesky for any other graph (dense up to 64
-    // unknowns, CHOLMOD beyond).
-    {
-      std::vector<int> first(static_cast<std::size_t>(n));
-      for (Eigen::Index j = 0; j < n; ++j) first[static_cast<std::size_t>(j)] = static_cast<int>(j);
-      std::size_t added = 0;
-      forEachFactorEntry(graph.size(), [&](Eigen::Index i, Eigen::Index j) {
-        int& f = first[static_cast<std::size_t>(j)];
-        f = std::min(f, static_cast<int>(i));
-        ++added;
-      });
-      std::size_t size = 0;
-      for (Eigen::Index j = 0; j < n; ++j) size += static_cast<std::size_t>(j - first[static_cast<std::size_t>(j)] + 1);
-      use_envelope = n > 0 && size <= 2 * added + static_cast<std::size_t>(n);
-      if (use_envelope) {
-        chol.reset(0, 0);  // a previous graph's pattern and factor go
-        envelope.setPattern(std::move(first));
-        entry_slot = diagonal_slot = nullptr;
-        return;
-      }
-      envelope = internal::EnvelopeCholesky();
+  }
+
+  // The envelope: each column's first row reached by a factor. Compact (at
+  // most twice the entries factors add, plus the diagonal) for a chain in
+  // time order with the constants last, small or large (a paper window of 10
+  // steps: 1.4× faster than the dense factorization of its 14 unknowns);
+  // SparseCholesky for any other graph (dense up to 64 unknowns, CHOLMOD
+  // beyond). True when the envelope is used.
+  bool chooseEnvelope(const FactorGraph& graph) {
+    std::vector<int> first(static_cast<std::size_t>(n));
+    for (Eigen::Index j = 0; j < n; ++j) first[static_cast<std::size_t>(j)] = static_cast<int>(j);
+    std::size_t added = 0;
+    forEachFactorEntry(graph.size(), [&](Eigen::Index i, Eigen::Index j) {
+      int& f = first[static_cast<std::size_t>(j)];
+      f = std::min(f, static_cast<int>(i));
+      ++added;
+    });
+    std::size_t size = 0;
+    for (Eigen::Index j = 0; j < n; ++j) size += static_cast<std::size_t>(j - first[static_cast<std::size_t>(j)] + 1);
+    use_envelope = n > 0 && size <= 2 * added + static_cast<std::size_t>(n);
+    if (use_envelope) {
+      chol.reset(0, 0);  // a previous graph's pattern and factor go
+      envelope.setPattern(std::move(first));
+      entry_slot = diagonal_slot = nullptr;
+      return true;
     }
-    // The pattern: every factor's upper JᵀJ entries, then the diagonal
-    // (which the damping needs even where no factor reaches).
+    envelope = internal::EnvelopeCholesky();
+    return false;
+  }
+
+  // The pattern: every factor's upper JᵀJ entries, then the diagonal (which
+  // the damping needs even where no factor reaches).
+  void assembleSparsePattern(const FactorGraph& graph) {
     std::size_t entries = 0;
     chol.assemblePattern(n, [&](auto&& emit) {
       entries = 0;
@@ -317,66 +334,64 @@ BatchSolver::~BatchSolver() = default;
 BatchSolver::BatchSolver(BatchSolver&&) noexcept = default;
 BatchSolver& BatchSolver::operator=(BatchSolver&&) noexcept = default;
 
-BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  using T = BatchSolverSummary::Termination;
-  Impl& s = *impl_;
-  s.has_solution = false;
-  s.selected.reset();
-  s.setup(graph, values);
+namespace {
+using Termination = BatchSolverSummary::Termination;
+bool isConverged(Termination t) {
+  return t == Termination::CostConverged || t == Termination::StepConverged || t == Termination::GradientConverged;
+}
+}  // namespace
 
-  BatchSolverSummary sum;
-  sum.num_factors = graph.size();
-  sum.num_variables = values.size();
-  sum.dimension = s.n;
-  sum.linear_solver = s.linearSolver();
-
-  // The iterate lives in `values` itself (a copy of a million-step run is
-  // 64 MB of fresh memory and a million small allocations); a flat copy of
-  // the start puts it back if the solve throws (strong guarantee).
-  Values& x = values;
-  Eigen::VectorXd start_flat;
-  internal::flatten(values, start_flat);
-  struct RestoreOnThrow {
-    Values& v;
-    const Eigen::VectorXd& flat;
-    bool armed = true;
-    ~RestoreOnThrow() {
-      if (armed) internal::unflatten(flat, v);  // same keys and sizes: no allocation
-    }
-  } restore{values, start_flat};
+// The Levenberg–Marquardt iteration (docs/DESIGN.md §5, eq. 6) of one solve:
+// its iterate (in the caller's Values), gradient, diagonal and cost.
+struct BatchSolver::Impl::Iteration {
+  Impl& s;
+  const BatchSolverOptions& options;
+  const FactorGraph& graph;
+  Values& x;
+  BatchSolverSummary& sum;
+  const bool lm = options.method == BatchSolverOptions::Method::LevenbergMarquardt;
+  internal::LevenbergMarquardtPolicy policy{options.initial_lambda, options.max_lambda, lm};
   Eigen::VectorXd g, diag;
-  double cost = s.linearize(graph, x, g, diag);
-  sum.initial_cost = cost;
-  const bool lm = options_.method == BatchSolverOptions::Method::LevenbergMarquardt;
-  internal::LevenbergMarquardtPolicy policy(options_.initial_lambda, options_.max_lambda, lm);
+  double cost = 0;
   Eigen::VectorXd delta;  // reused across iterations (8 MB at 10⁶ steps)
-
-  // The LM candidate x ⊕ δ is formed in x itself, and a flat copy of x
-  // (n doubles) puts it back if the step is rejected: a candidate copy of the
+  // The LM candidate x ⊕ δ is formed in x itself, and a flat copy of x (n
+  // doubles) puts it back if the step is rejected: a candidate copy of the
   // Values was 64 MB of fresh memory and a million small allocations at 10⁶
   // steps.
   Eigen::VectorXd x_before;
-  auto stepConverged = [&](const Eigen::VectorXd& d, const Values& at) {
-    return d.norm() <= options_.step_tolerance * (internal::norm(at) + options_.step_tolerance);
-  };
 
-  auto converge = [&](T reason) {
+  Iteration(Impl& impl, const BatchSolverOptions& o, const FactorGraph& gr, Values& values, BatchSolverSummary& summary)
+      : s(impl), options(o), graph(gr), x(values), sum(summary) {
+    cost = s.linearize(graph, x, g, diag);
+    sum.initial_cost = cost;
+  }
+
+  bool stepConverged(const Eigen::VectorXd& d, const Values& at) const {
+    return d.norm() <= options.step_tolerance * (internal::norm(at) + options.step_tolerance);
+  }
+  // Stops with `reason` once the policy has finished undamped.
+  bool converge(Termination reason) {
     if (!policy.converged()) return false;  // keep going, undamped
     sum.termination = reason;
     return true;
-  };
-  bool done = false;
-  if (g.lpNorm<Eigen::Infinity>() <= options_.gradient_tolerance) {
-    sum.termination = T::GradientConverged;
-    done = true;
   }
-  while (!done) {
-    if (sum.iterations >= options_.max_iterations) {
-      sum.termination = T::MaxIterations;
-      break;
+
+  void run() {
+    if (g.lpNorm<Eigen::Infinity>() <= options.gradient_tolerance) {
+      sum.termination = Termination::GradientConverged;
+      return;
     }
+    for (;;) {
+      if (sum.iterations >= options.max_iterations) {
+        sum.termination = Termination::MaxIterations;
+        return;
+      }
+      if (!dampedStep()) return;
+    }
+  }
+
+  // Factors H + λD, solves for δ and tries it; false when the solve is done.
+  bool dampedStep() {
     s.setDamping(diag, policy.lambda());
     ++sum.factorizations;
     const Eigen::Index bad = s.factorize();
@@ -387,7 +402,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       if (policy.undamped() || !policy.canDampMore()) s.throwSingular(bad);
       policy.singular();
       ++sum.rejected_steps;
-      continue;
+      return true;
     }
     delta = -g;
     s.solveInPlace(delta);  // −H⁻¹g, exactly the negated solution
@@ -396,9 +411,13 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
         internal::addStep(x, delta, x);
         cost = s.linearize(graph, x, g, diag);
       }
-      if (converge(T::StepConverged)) break;
-      continue;
+      return !converge(Termination::StepConverged);
     }
+    return tryStep();
+  }
+
+  // x ⊕ δ, kept if the policy accepts its cost; false when the solve is done.
+  bool tryStep() {
     internal::flatten(x, x_before);
     internal::addStep(x, delta, x);
     // Linearize at the candidate right away (its cost comes with it): one
@@ -413,31 +432,29 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
       internal::unflatten(x_before, x);
       cost = s.linearize(graph, x, g, diag);
       if (policy.undamped()) {  // the damped solution was already converged
-        sum.termination = T::CostConverged;
-        break;
+        sum.termination = Termination::CostConverged;
+        return false;
       }
       if (!policy.rejected()) {
-        sum.termination = T::NoProgress;
-        break;
+        sum.termination = Termination::NoProgress;
+        return false;
       }
-      continue;
+      return true;
     }
     ++sum.iterations;
     const double old_cost = cost;
     cost = new_cost;
     policy.accepted();
-    if (g.lpNorm<Eigen::Infinity>() <= options_.gradient_tolerance) {
-      if (converge(T::GradientConverged)) break;
-    } else if (old_cost - cost <= options_.relative_cost_tolerance * old_cost) {
-      if (converge(T::CostConverged)) break;
-    }
+    if (g.lpNorm<Eigen::Infinity>() <= options.gradient_tolerance) return !converge(Termination::GradientConverged);
+    if (old_cost - cost <= options.relative_cost_tolerance * old_cost) return !converge(Termination::CostConverged);
+    return true;
   }
-  const bool converged = sum.termination == T::CostConverged || sum.termination == T::StepConverged ||
-                         sum.termination == T::GradientConverged;
-  if (converged && options_.newton_polish_steps > 0) {
+
+  // Up to newton_polish_steps full Newton steps (second-order terms included).
+  void polish() {
     Values trial_x;
-    const internal::NewtonPolishResult polish = internal::newtonPolish(
-        x, cost, options_.newton_polish_steps,
+    const internal::NewtonPolishResult result = internal::newtonPolish(
+        x, cost, options.newton_polish_steps,
         [&](internal::NewtonSystem& sys, const Values& at) {
           Eigen::VectorXd r;
           std::vector<Eigen::MatrixXd> J;
@@ -455,23 +472,58 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
           if (keep) x = std::move(trial_x);
         },
         [&](const Values&, const Values& next, const Eigen::VectorXd& d) { return stepConverged(d, next); });
-    sum.newton_steps = polish.steps;
-    cost = polish.cost;
+    sum.newton_steps = result.steps;
+    cost = result.cost;
     if (sum.newton_steps > 0) cost = s.linearize(graph, x, g, diag);  // JᵀJ at the solution
   }
-  // Factor the undamped information matrix at the solution: it gives the
+
+  // Factors the undamped information matrix at the solution: it gives the
   // marginal covariances and tells whether the solution is determined.
-  s.setDamping(diag, 0.0);
-  ++sum.factorizations;
-  const Eigen::Index bad = s.factorize();
-  if (bad >= 0) s.throwSingular(bad);
+  void factorAtSolution() {
+    s.setDamping(diag, 0.0);
+    ++sum.factorizations;
+    const Eigen::Index bad = s.factorize();
+    if (bad >= 0) s.throwSingular(bad);
+  }
+};
+
+BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  Impl& s = *impl_;
+  s.has_solution = false;
+  s.selected.reset();
+  s.setup(graph, values);
+
+  BatchSolverSummary sum;
+  sum.num_factors = graph.size();
+  sum.num_variables = values.size();
+  sum.dimension = s.n;
+  sum.linear_solver = s.linearSolver();
+
+  // The iterate lives in `values` itself (a copy of a million-step run is
+  // 64 MB of fresh memory and a million small allocations); a flat copy of
+  // the start puts it back if the solve throws (strong guarantee).
+  Eigen::VectorXd start_flat;
+  internal::flatten(values, start_flat);
+  struct RestoreOnThrow {
+    Values& v;
+    const Eigen::VectorXd& flat;
+    bool armed = true;
+    ~RestoreOnThrow() {
+      if (armed) internal::unflatten(flat, v);  // same keys and sizes: no allocation
+    }
+  } restore{values, start_flat};
+  Impl::Iteration it(s, options_, graph, values, sum);
+  it.run();
+  if (isConverged(sum.termination) && options_.newton_polish_steps > 0) it.polish();
+  it.factorAtSolution();
   s.has_solution = true;
   restore.armed = false;
 
-  sum.final_cost = cost;
-  sum.gradient_norm = g.lpNorm<Eigen::Infinity>();
-  sum.converged = sum.termination == T::CostConverged || sum.termination == T::StepConverged ||
-                  sum.termination == T::GradientConverged;
+  sum.final_cost = it.cost;
+  sum.gradient_norm = it.g.lpNorm<Eigen::Infinity>();
+  sum.converged = isConverged(sum.termination);
   sum.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   sum.message = toString(sum.termination);
   return sum;

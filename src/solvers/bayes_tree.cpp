@@ -469,6 +469,26 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
   for (int c : p.removed_order) removed[static_cast<std::size_t>(c)] = 0;
 }
 
+// The factors waiting to be eliminated: each at the first of its variables
+// in the ordering; the marginal a clique leaves on its separator joins them.
+struct BayesTreeEngine::EliminationQueue {
+  const std::vector<Key>& ordering;
+  KeyTable<std::size_t> pos;      // a variable's place in the ordering
+  KeyTable<Eigen::Index> dims;    // its dimension
+  std::vector<std::vector<std::size_t>>& pending_of;
+  std::vector<LinearView>& pend;
+  std::vector<std::optional<InputSource>>& pend_source;  // nullopt: a marginal made here
+
+  void add(const LinearView& f, std::optional<InputSource> source) {
+    const std::size_t id = pend.size();
+    pend.push_back(f);
+    pend_source.push_back(source);
+    std::size_t first = ordering.size();
+    for (const auto& k : f.keys()) first = std::min(first, pos.at(k));
+    if (first < ordering.size()) pending_of[first].push_back(id);
+  }
+};
+
 // Phase 3: order the top's variables and eliminate them one at a time into
 // new cliques (still nothing modified). Dense elimination of one variable
 // at a time (the paper's window system A_w X_w = b_w, solved by QR clique by
@@ -476,155 +496,167 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
 // into the conditional on v and the marginal factor on its separator.
 void BayesTreeEngine::eliminateTop(UpdatePlan& p) const {
   order(p.keys, p.inputs, p.new_variables, p.ordering);
+  EliminationQueue q = queueInputs(p);
+  p.fresh.assign(p.ordering.size(), EliminatedClique{});  // empty: no allocation
+  p.fresh_owned.clear();
+  for (std::size_t vi = 0; vi < p.ordering.size(); ++vi) eliminateVariable(p, q, vi);
+}
+
+// The queue of the update's inputs, each at its first variable.
+BayesTreeEngine::EliminationQueue BayesTreeEngine::queueInputs(UpdatePlan& p) const {
   const std::vector<Key>& ordering = p.ordering;
-  KeyTable<std::size_t> pos;
-  for (std::size_t i = 0; i < ordering.size(); ++i) pos.set(ordering[i], i);
-  KeyTable<Eigen::Index> dims;
+  EliminationQueue q{ordering, {}, {}, scratch_.pending_of, scratch_.pend, scratch_.pend_source};
+  for (std::size_t i = 0; i < ordering.size(); ++i) q.pos.set(ordering[i], i);
   for (const auto& k : ordering) {
     const Var* var = vars_.find(k);
-    dims.set(k, var ? var->dim() : p.new_variables.at(k).size());
+    q.dims.set(k, var ? var->dim() : p.new_variables.at(k).size());
   }
-
-  // Each pending factor waits at the first of its variables in the ordering;
-  // the marginal a clique leaves on its separator joins the queue.
-  std::vector<std::vector<std::size_t>>& pending_of = scratch_.pending_of;
   // After a whole-history update, its storage goes (`= {}` would keep the
   // capacity: the initializer-list assignment; 24 bytes a variable).
-  if (ordering.size() <= kKeepEntries && pending_of.size() > kKeepEntries)
-    std::vector<std::vector<std::size_t>>().swap(pending_of);
-  if (pending_of.size() < ordering.size()) pending_of.resize(ordering.size());
-  for (std::size_t i = 0; i < ordering.size(); ++i) pending_of[i].clear();
-  std::vector<LinearView>& pend = scratch_.pend;
-  std::vector<std::optional<InputSource>>& pend_source = scratch_.pend_source;  // nullopt: a marginal made here
-  clearKeepingSmall(pend);
-  clearKeepingSmall(pend_source);
-  auto addPending = [&](const LinearView& f, std::optional<InputSource> source) {
-    const std::size_t id = pend.size();
-    pend.push_back(f);
-    pend_source.push_back(source);
-    std::size_t first = ordering.size();
-    for (const auto& k : f.keys()) first = std::min(first, pos.at(k));
-    if (first < ordering.size()) pending_of[first].push_back(id);
-  };
+  if (ordering.size() <= kKeepEntries && q.pending_of.size() > kKeepEntries)
+    std::vector<std::vector<std::size_t>>().swap(q.pending_of);
+  if (q.pending_of.size() < ordering.size()) q.pending_of.resize(ordering.size());
+  for (std::size_t i = 0; i < ordering.size(); ++i) q.pending_of[i].clear();
+  clearKeepingSmall(q.pend);
+  clearKeepingSmall(q.pend_source);
   for (const auto& in : p.inputs) {
     bool empty = true;
-    for (const auto& k : in.first.keys()) empty = empty && !pos.count(k);
+    for (const auto& k : in.first.keys()) empty = empty && !q.pos.count(k);
     if (empty) continue;  // cannot happen for a consistent tree
-    addPending(in.first, in.second.kind == InputSource::Kind::Orphan ? std::nullopt
-                                                                      : std::optional<InputSource>(in.second));
+    q.add(in.first, in.second.kind == InputSource::Kind::Orphan ? std::nullopt : std::optional<InputSource>(in.second));
   }
-  p.fresh.assign(ordering.size(), EliminatedClique{});  // empty: no allocation
-  p.fresh_owned.clear();
-  // A pooled clique of the same shape (one an earlier update made), if any,
-  // whose storage the new one then overwrites without allocating.
-  auto reuse = [&](EliminatedClique& cl, Eigen::Index dv, Eigen::Index sep_cols) {
-    auto& spare = pool_.spare;
-    for (std::size_t i = spare.size(); i-- > 0;) {
-      const EliminatedClique& c = spare[i];
-      if (c.conditional.rows() != dv || c.conditional.cols() != dv + sep_cols + 1) continue;
-      cl = std::move(spare[i]);
-      spare[i] = std::move(spare.back());
-      spare.pop_back();
-      cl.owned.clear();
-      return;
-    }
-  };
+  return q;
+}
+
+// A pooled clique of the same shape (one an earlier update made), if any,
+// whose storage the new one then overwrites without allocating.
+void BayesTreeEngine::reusePooledClique(EliminatedClique& cl, Eigen::Index dv, Eigen::Index sep_cols) const {
+  auto& spare = pool_.spare;
+  for (std::size_t i = spare.size(); i-- > 0;) {
+    const EliminatedClique& c = spare[i];
+    if (c.conditional.rows() != dv || c.conditional.cols() != dv + sep_cols + 1) continue;
+    cl = std::move(spare[i]);
+    spare[i] = std::move(spare.back());
+    spare.pop_back();
+    cl.owned.clear();
+    return;
+  }
+}
+
+// Eliminates ordering[vi]: its clique's conditional [R S d] and the marginal
+// factor it leaves on its separator (queued for a later variable).
+void BayesTreeEngine::eliminateVariable(UpdatePlan& p, EliminationQueue& q, std::size_t vi) const {
+  const Key& v = p.ordering[vi];
+  EliminatedClique& cl = p.fresh[vi];
+  const std::vector<Key>& sep = separatorOf(q, vi);
+  const Eigen::Index dv = q.dims.at(v);
+  KeyTable<Eigen::Index> colOf;  // each variable's first column: v, then the separator
+  Eigen::Index ncols = dv;
+  colOf.set(v, 0);
+  for (const auto& k : sep) {
+    colOf.set(k, ncols);
+    ncols += q.dims.at(k);
+  }
+  if (ncols - dv > kMaxRecordDim)
+    throw InvalidArgument("eliminating " + v.toString() + " makes a clique " + std::to_string(ncols) +
+                          " wide; the engine holds at most " + std::to_string(kMaxRecordDim));
+  reusePooledClique(cl, dv, ncols - dv);
+  cl.frontal = v;
+  Eigen::MatrixXd& M = scratch_.stacked;
+  const Eigen::Index rows = stackFactors(p, q, vi, colOf, ncols, M);
+  if (rows < dv) {
+    std::ostringstream os;
+    os << "cannot determine " << v.toString() << (v.isConstants() ? " (constants)" : " (a time-series state)")
+       << ": the factors on it have " << rows << " rows for " << dv
+       << " unknowns (unobserved; add a prior or a measurement of it)";
+    throw NumericalError(os.str());
+  }
+  const double scale = std::max(1e-300, M.leftCols(dv).cwiseAbs().maxCoeff());
+  // In place: M becomes R (upper triangle) and the Householder vectors.
+  triangularize(M);
+  const Eigen::Index rk = std::min(rows, ncols + 1);
+  M.topRows(rk).triangularView<Eigen::StrictlyLower>().setZero();
+  const auto Rfull = M.topRows(rk);
+  for (Eigen::Index i = 0; i < dv; ++i)
+    if (!(std::abs(Rfull(i, i)) > 1e-10 * scale)) throwRankDeficient(v, i, sep);
+  cl.conditional = Rfull.topRows(dv);  // [R S d]
+  // The remaining rows are the marginal factor on the separator, whose
+  // columns follow v's in separator order: [A | b] as they stand.
+  LinearFactor& m = cl.marginal;
+  const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
+  m.Ab = Rfull.block(dv, dv, mrows, ncols - dv + 1);
+  m.setKeys(sep);
+  if (!sep.empty() && mrows > 0) q.add(m.view(), std::nullopt);
+}
+
+// The variables the factors waiting at ordering[vi] share with it, in
+// elimination order (scratch_.separator).
+const std::vector<Key>& BayesTreeEngine::separatorOf(const EliminationQueue& q, std::size_t vi) const {
+  const Key& v = q.ordering[vi];
+  std::vector<Key>& sep = scratch_.separator;
+  sep.clear();
+  for (std::size_t id : q.pending_of[vi])
+    for (const auto& k : q.pend[id].keys())
+      if (k != v && std::find(sep.begin(), sep.end(), k) == sep.end()) sep.push_back(k);
+  std::sort(sep.begin(), sep.end(), [&](const Key& a, const Key& b) { return q.pos.at(a) < q.pos.at(b); });
+  if (static_cast<Eigen::Index>(sep.size()) > kMaxRecordDim || q.dims.at(v) > kMaxRecordDim)
+    throw InvalidArgument("eliminating " + v.toString() + " makes a clique on " + std::to_string(sep.size()) +
+                          " variables; the engine holds at most " + std::to_string(kMaxRecordDim));
+  return sep;
+}
+
+// M = the factors waiting at ordering[vi], stacked as [A | b] in the
+// clique's columns, and under LM damping Marquardt rows on v; its row count.
+template <class ColumnTable>
+Eigen::Index BayesTreeEngine::stackFactors(UpdatePlan& p, const EliminationQueue& q, std::size_t vi,
+                                           const ColumnTable& colOf, Eigen::Index ncols, Eigen::MatrixXd& M) const {
+  const Key& v = q.ordering[vi];
+  const Eigen::Index dv = q.dims.at(v);
+  Eigen::Index rows = 0;
+  for (std::size_t id : q.pending_of[vi]) rows += q.pend[id].rows();
   const double damping = p.update.damping;
-  for (std::size_t vi = 0; vi < ordering.size(); ++vi) {
-    const Key& v = ordering[vi];
-    EliminatedClique& cl = p.fresh[vi];
-    // Union of keys, v first then by position.
-    std::vector<Key>& sep = scratch_.separator;
-    sep.clear();
-    Eigen::Index rows = 0;
-    for (std::size_t id : pending_of[vi]) {
-      rows += pend[id].rows();
-      for (const auto& k : pend[id].keys())
-        if (k != v && std::find(sep.begin(), sep.end(), k) == sep.end()) sep.push_back(k);
+  const Eigen::Index damp_rows = damping > 0 ? dv : 0;
+  M.setZero(rows + damp_rows, ncols + 1);
+  Eigen::Index r0 = 0;
+  for (std::size_t id : q.pending_of[vi]) {
+    const LinearView& f = q.pend[id];
+    // Column by column (a packed marginal holds none of its zeros; M's are set).
+    auto copyCol = [&](Eigen::Index from, Eigen::Index to) { copyDoubles(f.col(from), f.colLength(from), &M(r0, to)); };
+    Eigen::Index col = 0;
+    for (const auto& k : f.keys()) {
+      const Eigen::Index w = q.dims.at(k), to = colOf.at(k);
+      for (Eigen::Index j = 0; j < w; ++j) copyCol(col + j, to + j);
+      col += w;
     }
-    std::sort(sep.begin(), sep.end(), [&](const Key& a, const Key& b) { return pos.at(a) < pos.at(b); });
-    const Eigen::Index dv = dims.at(v);
-    if (static_cast<Eigen::Index>(sep.size()) > kMaxRecordDim || dv > kMaxRecordDim)
-      throw InvalidArgument("eliminating " + v.toString() + " makes a clique on " + std::to_string(sep.size()) +
-                            " variables; the engine holds at most " + std::to_string(kMaxRecordDim));
-    KeyTable<Eigen::Index> colOf;
-    Eigen::Index ncols = dv;
-    colOf.set(v, 0);
-    for (const auto& k : sep) {
-      colOf.set(k, ncols);
-      ncols += dims.at(k);
-    }
-    if (ncols - dv > kMaxRecordDim)
-      throw InvalidArgument("eliminating " + v.toString() + " makes a clique " + std::to_string(ncols) +
-                            " wide; the engine holds at most " + std::to_string(kMaxRecordDim));
-    reuse(cl, dv, ncols - dv);
-    cl.frontal = v;
-    const Eigen::Index damp_rows = damping > 0 ? dv : 0;
-    Eigen::MatrixXd& M = scratch_.stacked;
-    M.setZero(rows + damp_rows, ncols + 1);
-    Eigen::Index r0 = 0;
-    for (std::size_t id : pending_of[vi]) {
-      const LinearView& f = pend[id];
-      // Column by column (a packed marginal holds none of its zeros; M's are set).
-      auto copyCol = [&](Eigen::Index from, Eigen::Index to) { copyDoubles(f.col(from), f.colLength(from), &M(r0, to)); };
-      Eigen::Index col = 0;
-      for (const auto& k : f.keys()) {
-        const Eigen::Index w = dims.at(k), to = colOf.at(k);
-        for (Eigen::Index j = 0; j < w; ++j) copyCol(col + j, to + j);
-        col += w;
-      }
-      copyCol(col, ncols);
-      r0 += f.rows();
-      if (pend_source[id]) p.fresh_owned.emplace_back(vi, *pend_source[id]);
-    }
-    if (damp_rows > 0) {
-      // Marquardt rows pull δ_v toward its current value: √λ·D (δ_v − δ̂_v) = 0.
-      const Var* var = vars_.find(v);
-      const Eigen::VectorXd dhat = var ? Eigen::VectorXd(var->delta()) : Eigen::VectorXd(Eigen::VectorXd::Zero(dv));
-      for (Eigen::Index i = 0; i < dv; ++i) {
-        const double w = std::sqrt(damping) * std::max(M.col(i).head(rows).norm(), 1e-12);
-        M(rows + i, i) = w;
-        M(rows + i, ncols) = w * dhat[i];
-      }
-      rows += damp_rows;
-    }
-    if (rows < dv) {
-      std::ostringstream os;
-      os << "cannot determine " << v.toString() << (v.isConstants() ? " (constants)" : " (a time-series state)")
-         << ": the factors on it have " << rows << " rows for " << dv
-         << " unknowns (unobserved; add a prior or a measurement of it)";
-      throw NumericalError(os.str());
-    }
-    const double scale = std::max(1e-300, M.leftCols(dv).cwiseAbs().maxCoeff());
-    // In place: M becomes R (upper triangle) and the Householder vectors.
-    triangularize(M);
-    const Eigen::Index rk = std::min(rows, ncols + 1);
-    M.topRows(rk).triangularView<Eigen::StrictlyLower>().setZero();
-    const auto Rfull = M.topRows(rk);
-    for (Eigen::Index i = 0; i < dv; ++i)
-      if (!(std::abs(Rfull(i, i)) > 1e-10 * scale)) {
-        std::ostringstream os;
-        os << "the information on " << v.toString()
-           << (v.isConstants() ? " (constants)" : " (a time-series state)") << " component " << i
-           << " is zero or rank-deficient given the variables eliminated after it";
-        if (!sep.empty()) {
-          os << " (";
-          for (std::size_t j = 0; j < sep.size(); ++j) os << (j ? ", " : "") << sep[j].toString();
-          os << ")";
-        }
-        os << ": the data do not determine it (e.g. a range at x = h = 0, a constant nothing "
-              "observes); add a prior or check the model";
-        throw NumericalError(os.str());
-      }
-    cl.conditional = Rfull.topRows(dv);  // [R S d]
-    // The remaining rows are the marginal factor on the separator, whose
-    // columns follow v's in separator order: [A | b] as they stand.
-    LinearFactor& m = cl.marginal;
-    const Eigen::Index mrows = std::max<Eigen::Index>(0, std::min(rk, ncols) - dv);
-    m.Ab = Rfull.block(dv, dv, mrows, ncols - dv + 1);
-    m.setKeys(sep);
-    if (!sep.empty() && mrows > 0) addPending(m.view(), std::nullopt);
+    copyCol(col, ncols);
+    r0 += f.rows();
+    if (q.pend_source[id]) p.fresh_owned.emplace_back(vi, *q.pend_source[id]);
   }
+  if (damp_rows == 0) return rows;
+  // Marquardt rows pull δ_v toward its current value: √λ·D (δ_v − δ̂_v) = 0.
+  const Var* var = vars_.find(v);
+  const Eigen::VectorXd dhat = var ? Eigen::VectorXd(var->delta()) : Eigen::VectorXd(Eigen::VectorXd::Zero(dv));
+  for (Eigen::Index i = 0; i < dv; ++i) {
+    const double w = std::sqrt(damping) * std::max(M.col(i).head(rows).norm(), 1e-12);
+    M(rows + i, i) = w;
+    M(rows + i, ncols) = w * dhat[i];
+  }
+  return rows + damp_rows;
+}
+
+[[noreturn]] void BayesTreeEngine::throwRankDeficient(const Key& v, Eigen::Index component,
+                                                      const std::vector<Key>& sep) {
+  std::ostringstream os;
+  os << "the information on " << v.toString() << (v.isConstants() ? " (constants)" : " (a time-series state)")
+     << " component " << component << " is zero or rank-deficient given the variables eliminated after it";
+  if (!sep.empty()) {
+    os << " (";
+    for (std::size_t j = 0; j < sep.size(); ++j) os << (j ? ", " : "") << sep[j].toString();
+    os << ")";
+  }
+  os << ": the data do not determine it (e.g. a range at x = h = 0, a constant nothing "
+        "observes); add a prior or check the model";
+  throw NumericalError(os.str());
 }
 
 // Phase 4: replace the top by the new cliques, give new factors their

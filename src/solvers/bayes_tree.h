@@ -381,6 +381,16 @@ class BayesTreeEngine {
   void linearizeInputs(UpdatePlan& plan) const;
   void detachTop(UpdatePlan& plan) const;
   void eliminateTop(UpdatePlan& plan) const;
+  // eliminateTop's steps (bayes_tree.cpp).
+  struct EliminationQueue;
+  EliminationQueue queueInputs(UpdatePlan& plan) const;
+  void reusePooledClique(EliminatedClique& cl, Eigen::Index dv, Eigen::Index sep_cols) const;
+  void eliminateVariable(UpdatePlan& plan, EliminationQueue& q, std::size_t vi) const;
+  const std::vector<Key>& separatorOf(const EliminationQueue& q, std::size_t vi) const;
+  template <class ColumnTable>
+  Eigen::Index stackFactors(UpdatePlan& plan, const EliminationQueue& q, std::size_t vi, const ColumnTable& colOf,
+                            Eigen::Index ncols, Eigen::MatrixXd& M) const;
+  [[noreturn]] static void throwRankDeficient(const Key& v, Eigen::Index component, const std::vector<Key>& sep);
   void commit(UpdatePlan& plan, EngineCounts& counts);
   void backSubstituteTop(const UpdatePlan& plan, EngineCounts& counts);
 
