@@ -664,6 +664,17 @@ Eigen::Index BayesTreeEngine::stackFactors(UpdatePlan& p, const EliminationQueue
 // cliques. Nothing here throws short of memory.
 void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   model_ = p.model;
+  commitFactors(p, counts);
+  commitCliques(p);
+  reattachOrphans(p);
+  counts.cliques_reeliminated += static_cast<int>(p.ordering.size());
+  counts.top.assign(p.ordering.begin(), p.ordering.end());
+  counts.orphans += static_cast<int>(p.orphans.size());
+}
+
+// The relinearized factors' new linearizations, the top's cliques released,
+// the new variables, and a slot for each new factor.
+void BayesTreeEngine::commitFactors(UpdatePlan& p, EngineCounts& counts) {
   for (auto& kv : p.relinearized) {
     storeLinearization(slots_[static_cast<std::size_t>(kv.first)], kv.second.view());  // same size: in place
     pool_.keep(std::move(kv.second));
@@ -696,6 +707,11 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     pool_.keep(std::move(p.linearized_new[i]));
   }
   for (std::size_t i = 0; i < p.new_linear.size(); ++i) new_lin_slot_of[i] = addSlot(SlotFactor(), p.new_linear[i]);
+}
+
+// The eliminated cliques stored, each owning the factors it consumed, and
+// linked to their parents (the clique of their separator's first variable).
+void BayesTreeEngine::commitCliques(UpdatePlan& p) {
   const std::vector<Key>& ordering = p.ordering;
   p.fresh_id.resize(ordering.size());
   auto owned = p.fresh_owned.begin();
@@ -706,8 +722,8 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
       const InputSource& src = owned->second;
       using Kind = InputSource::Kind;
       const int s = src.kind == Kind::Slot        ? src.index
-                    : src.kind == Kind::NewFactor ? new_slot_of[static_cast<std::size_t>(src.index)]
-                                                  : new_lin_slot_of[static_cast<std::size_t>(src.index)];
+                    : src.kind == Kind::NewFactor ? p.new_slot_of[static_cast<std::size_t>(src.index)]
+                                                  : p.new_lin_slot_of[static_cast<std::size_t>(src.index)];
       p.fresh[vi].owned.push_back(s);
       slots_[static_cast<std::size_t>(s)].owner = c;
     }
@@ -729,6 +745,10 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
     if (parent >= 0) cliques_[static_cast<std::size_t>(parent)].children.push_back(c);
     else root_ = c;
   }
+}
+
+// Each orphan under the lowest clique of its separator's variables.
+void BayesTreeEngine::reattachOrphans(const UpdatePlan& p) {
   for (int o : p.orphans) {
     Clique& oc = cliques_[static_cast<std::size_t>(o)];
     int best = -1;
@@ -746,9 +766,6 @@ void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   if (root_ < 0)
     for (std::size_t c = 0; c < cliques_.size(); ++c)
       if (clique_alive_[c] && cliques_[c].parent < 0) root_ = static_cast<int>(c);
-  counts.cliques_reeliminated += static_cast<int>(ordering.size());
-  counts.top.assign(ordering.begin(), ordering.end());
-  counts.orphans += static_cast<int>(p.orphans.size());
 }
 
 // Phase 5: back-substitution of the new top, then wildfire into orphans
@@ -848,45 +865,49 @@ void BayesTreeEngine::solvePath(const Key& k) {
 }
 
 Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& keys) const {
-  // The union of the requested keys' root paths is closed under parents, so
-  // its conditionals form a Bayes net on its frontal variables (every
-  // separator lies above): Σ = (RᵀR)⁻¹ with R block upper triangular in
-  // elimination order.
   for (const auto& k : keys)
     if (!vars_.contains(k)) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
   const int root_of_one = keys.size() == 1 ? vars_.at(keys[0]).clique : -1;
-  if (root_of_one >= 0 && cliques_[static_cast<std::size_t>(root_of_one)].parent < 0) {
-    // One clique, the root (the constants, checked after every update):
-    // Σ = R⁻¹R⁻ᵀ of its own conditional, densely, without assembling a
-    // sparse system (8k instructions per fixed-lag update before) or even
-    // listing the path.
-    // Y = R⁻ᵀ by forward substitution, column by column; Σ = YᵀY is
-    // symmetric as computed (entry (i, j) and (j, i) sum the same products).
-    const Clique& root = cliques_[static_cast<std::size_t>(root_of_one)];
-    const auto R = conditional(root).leftCols(root.dv);
-    const Eigen::Index n = R.rows();
-    Eigen::MatrixXd& Y = scratch_.stacked;
-    Y.setIdentity(n, n);
-    for (Eigen::Index c = 0; c < n; ++c)
-      for (Eigen::Index i = c; i < n; ++i) {
-        double v = Y(i, c);
-        for (Eigen::Index k = c; k < i; ++k) v -= R(k, i) * Y(k, c);
-        Y(i, c) = v / R(i, i);
-      }
-    Eigen::MatrixXd S(n, n);
-    for (Eigen::Index j = 0; j < n; ++j)
-      for (Eigen::Index i = 0; i < n; ++i) {
-        double v = 0;
-        for (Eigen::Index k = std::max(i, j); k < n; ++k) v += Y(k, i) * Y(k, j);  // Y is lower triangular
-        S(i, j) = v;
-      }
-    return S;
-  }
+  if (root_of_one >= 0 && cliques_[static_cast<std::size_t>(root_of_one)].parent < 0)
+    return rootCovariance(cliques_[static_cast<std::size_t>(root_of_one)]);
+  return bayesNetCovariance(keys);
+}
+
+// One clique, the root (the constants, checked after every update): Σ =
+// R⁻¹R⁻ᵀ of its own conditional, densely, without assembling a sparse
+// system (8k instructions per fixed-lag update before) or even listing the
+// path. Y = R⁻ᵀ by forward substitution, column by column; Σ = YᵀY is
+// symmetric as computed (entry (i, j) and (j, i) sum the same products).
+Eigen::MatrixXd BayesTreeEngine::rootCovariance(const Clique& root) const {
+  const auto R = conditional(root).leftCols(root.dv);
+  const Eigen::Index n = R.rows();
+  Eigen::MatrixXd& Y = scratch_.stacked;
+  Y.setIdentity(n, n);
+  for (Eigen::Index c = 0; c < n; ++c)
+    for (Eigen::Index i = c; i < n; ++i) {
+      double v = Y(i, c);
+      for (Eigen::Index k = c; k < i; ++k) v -= R(k, i) * Y(k, c);
+      Y(i, c) = v / R(i, i);
+    }
+  Eigen::MatrixXd S(n, n);
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double v = 0;
+      for (Eigen::Index k = std::max(i, j); k < n; ++k) v += Y(k, i) * Y(k, j);  // Y is lower triangular
+      S(i, j) = v;
+    }
+  return S;
+}
+
+// The union of the requested keys' root paths is closed under parents, so
+// its conditionals form a Bayes net on its frontal variables (every
+// separator lies above): Σ = (RᵀR)⁻¹ with R block upper triangular in
+// elimination order.
+Eigen::MatrixXd BayesTreeEngine::bayesNetCovariance(const std::vector<Key>& keys) const {
   std::unordered_set<int> on_path;
   std::vector<int> path;
   for (const auto& k : keys)
-    for (int c = vars_.at(k).clique; c >= 0 && on_path.insert(c).second;
-         c = cliques_[static_cast<std::size_t>(c)].parent)
+    for (int c = vars_.at(k).clique; c >= 0 && on_path.insert(c).second; c = cliques_[static_cast<std::size_t>(c)].parent)
       path.push_back(c);
   std::sort(path.begin(), path.end(), [&](int a, int b) {
     return vars_.at(cliques_[static_cast<std::size_t>(a)].frontal).rank <
@@ -899,6 +920,24 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
     off[f] = n;
     n += vars_.at(f).dim();
   }
+  const Eigen::SparseMatrix<double> R = pathConditionals(path, off, n);
+  Eigen::Index m = 0;
+  for (const auto& k : keys) m += vars_.at(k).dim();
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, m);
+  Eigen::Index c = 0;
+  for (const auto& k : keys)
+    for (Eigen::Index j = 0; j < vars_.at(k).dim(); ++j) E(off.at(k) + j, c++) = 1.0;
+  // Σ = R⁻¹ R⁻ᵀ, so Σ_req = Yᵀ Y with Y = R⁻ᵀ E.
+  const Eigen::MatrixXd Y = Eigen::SparseMatrix<double>(R.transpose()).triangularView<Eigen::Lower>().solve(E);
+  const Eigen::MatrixXd S = Y.transpose() * Y;
+  return 0.5 * (S + S.transpose());
+}
+
+// The path's conditionals [R S] as one sparse upper-triangular R (n × n),
+// each clique's rows at its frontal variable's offset.
+template <class Offsets>
+Eigen::SparseMatrix<double> BayesTreeEngine::pathConditionals(const std::vector<int>& path, const Offsets& off,
+                                                              Eigen::Index n) const {
   std::vector<Eigen::Triplet<double>> trip;
   for (int c : path) {
     const Clique& cl = cliques_[static_cast<std::size_t>(c)];
@@ -919,16 +958,7 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   }
   Eigen::SparseMatrix<double> R(n, n);
   R.setFromTriplets(trip.begin(), trip.end());
-  Eigen::Index m = 0;
-  for (const auto& k : keys) m += vars_.at(k).dim();
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, m);
-  Eigen::Index c = 0;
-  for (const auto& k : keys)
-    for (Eigen::Index j = 0; j < vars_.at(k).dim(); ++j) E(off.at(k) + j, c++) = 1.0;
-  // Σ = R⁻¹ R⁻ᵀ, so Σ_req = Yᵀ Y with Y = R⁻ᵀ E.
-  const Eigen::MatrixXd Y = Eigen::SparseMatrix<double>(R.transpose()).triangularView<Eigen::Lower>().solve(E);
-  const Eigen::MatrixXd S = Y.transpose() * Y;
-  return 0.5 * (S + S.transpose());
+  return R;
 }
 
 double BayesTreeEngine::linearizationError(int slot) const {

@@ -13,6 +13,7 @@
 // cliques hold besides ids — keys and matrices — is one record each in the
 // engine's RecordStore.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -392,6 +393,14 @@ class BayesTreeEngine {
                             Eigen::Index ncols, Eigen::MatrixXd& M) const;
   [[noreturn]] static void throwRankDeficient(const Key& v, Eigen::Index component, const std::vector<Key>& sep);
   void commit(UpdatePlan& plan, EngineCounts& counts);
+  // pathMarginalCovariance's two cases (bayes_tree.cpp).
+  Eigen::MatrixXd rootCovariance(const Clique& root) const;
+  Eigen::MatrixXd bayesNetCovariance(const std::vector<Key>& keys) const;
+  template <class Offsets>
+  Eigen::SparseMatrix<double> pathConditionals(const std::vector<int>& path, const Offsets& off, Eigen::Index n) const;
+  void commitFactors(UpdatePlan& plan, EngineCounts& counts);
+  void commitCliques(UpdatePlan& plan);
+  void reattachOrphans(const UpdatePlan& plan);
   void backSubstituteTop(const UpdatePlan& plan, EngineCounts& counts);
 
   /// f on `keys` linearized at the current estimate (`extra`: values of
