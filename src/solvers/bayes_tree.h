@@ -378,6 +378,22 @@ class BayesTreeEngine {
   void storeClique(const EliminatedClique& e, Clique& into);
   void releaseRecord(Clique& c);
 
+  // invariantViolation()'s parts (bayes_tree_io.cpp).
+  bool isLiveClique(int c) const;
+  bool isLiveSlot(int s) const;
+  Eigen::Index varDim(const Key& k) const;
+  std::string linearViolation(const LinearView& f, const std::string& what) const;
+  std::string variableViolation() const;
+  std::string slotViolation() const;
+  std::string cliqueViolation() const;
+  std::string structureViolation() const;
+  // load()'s steps (bayes_tree_io.cpp), each on a fresh engine.
+  void loadVariables(ByteReader& in, const Model& model);
+  void loadSlots(ByteReader& in, const Model& model);
+  void loadCliques(ByteReader& in, const Model& model);
+  static EliminatedClique readClique(ByteReader& in, const Model& model, const std::string& name);
+  void loadSlotIndex(ByteReader& in);
+
   struct UpdatePlan;  // the work of one update before it is committed (bayes_tree.cpp)
   void linearizeInputs(UpdatePlan& plan) const;
   void detachTop(UpdatePlan& plan) const;
