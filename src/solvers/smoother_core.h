@@ -27,6 +27,9 @@ class SmootherCore {
   void relinearize(const std::vector<int>& candidates, double threshold, UpdateReport& rep,
                    internal::EngineCounts& counts);
   void iterateToConvergence(UpdateReport& rep, internal::EngineCounts& counts);
+  double levenbergMarquardt(UpdateReport& rep, internal::EngineCounts& counts, double& tree_lambda);
+  double reEliminateUndamped(UpdateReport& rep, internal::EngineCounts& counts, double cost);
+  void newtonPolishTree(UpdateReport& rep, internal::EngineCounts& counts, double cost);
   Eigen::VectorXd constants_at_last_check_;
   // Per-update buffers kept for their capacity (not state: not saved).
   internal::EngineCounts counts_;

@@ -100,27 +100,38 @@ void SmootherCore::relinearize(const std::vector<int>& candidates, double thresh
   }
 }
 
+namespace {
+// The largest change between two estimates, relative to 1 + |b|.
+double relChange(const Values& a, const Values& b) {
+  double change = 0;
+  for (const auto& kv : a) {
+    const Eigen::VectorXd& old = b.at(kv.first);
+    change = std::max(change, ((kv.second - old).array().abs() / (1.0 + old.array().abs())).maxCoeff());
+  }
+  return change;
+}
+}  // namespace
+
+void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCounts& counts) {
+  counts.variables_backsubstituted += engine.solveAll();
+  double tree_lambda = 0;  // the damping in the tree as it stands
+  double cost = levenbergMarquardt(rep, counts, tree_lambda);
+  if (tree_lambda > 0) cost = reEliminateUndamped(rep, counts, cost);
+  newtonPolishTree(rep, counts, cost);
+}
+
 // Levenberg–Marquardt over the whole tree, as the batch solver does: every
 // iteration relinearizes every nonlinear factor at the current estimate
 // (not only those with a large residual error: that error is O(Δ²) while the
 // Jacobian, which sets the fixed point, changes O(Δ)) and re-eliminates with
 // Marquardt damping; a step that raises the cost is undone from a snapshot.
 // Undamped Gauss–Newton cycles on the radar start-up (prior 143σ off), where
-// x is determined only to ±5 m along a flat valley.
-void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCounts& counts) {
-  auto relChange = [](const Values& a, const Values& b) {
-    double change = 0;
-    for (const auto& kv : a) {
-      const Eigen::VectorXd& old = b.at(kv.first);
-      change = std::max(change, ((kv.second - old).array().abs() / (1.0 + old.array().abs())).maxCoeff());
-    }
-    return change;
-  };
-  counts.variables_backsubstituted += engine.solveAll();
+// x is determined only to ±5 m along a flat valley. Returns the cost reached;
+// tree_lambda is the damping the tree holds then.
+double SmootherCore::levenbergMarquardt(UpdateReport& rep, internal::EngineCounts& counts, double& tree_lambda) {
   Values previous = engine.allEstimates();
   double previous_cost = engine.cost();
   internal::LevenbergMarquardtPolicy policy;  // the batch solver's policy and defaults
-  double tree_lambda = 0;  // the damping in the tree as it stands
   for (int it = 0; it < options.max_iterations; ++it) {
     const std::vector<int> all = engine.nonlinearSlots();
     if (all.empty()) break;
@@ -155,32 +166,38 @@ void SmootherCore::iterateToConvergence(UpdateReport& rep, internal::EngineCount
     policy.accepted();
     if (change <= options.convergence_tolerance && policy.converged()) break;
   }
-  if (tree_lambda > 0) {
-    // The tree still holds Marquardt rows from its last kept step (the
-    // undamped finish was rejected, or the iteration stopped damped), which
-    // make every covariance read from it too small (~100× on the robust
-    // beacon test when λ₀ was 1e-4). Re-eliminate it undamped at the estimate reached: the
-    // estimate becomes that tree's solution, one Gauss–Newton step on
-    // (negligible where the iteration had converged).
-    internal::BayesTreeEngine snapshot = engine;
-    internal::EngineCounts trial = counts;
-    try {
-      engine.update(internal::EngineUpdate::relinearizing(engine.nonlinearSlots(), 0.0), trial);
-      trial.variables_backsubstituted += engine.solveAll();
-      counts = trial;
-      ++rep.iterations;
-      previous_cost = engine.cost();
-    } catch (const NumericalError& e) {
-      engine = std::move(snapshot);
-      rep.note = std::string("covariances keep the last damping (the undamped system did not factor: ") + e.what() + ")";
-    }
+  return previous_cost;
+}
+
+// The tree still holds Marquardt rows from its last kept step (the undamped
+// finish was rejected, or the iteration stopped damped), which make every
+// covariance read from it too small (~100× on the robust beacon test when
+// λ₀ was 1e-4). Re-eliminate it undamped at the estimate reached: the
+// estimate becomes that tree's solution, one Gauss–Newton step on
+// (negligible where the iteration had converged). Returns the cost.
+double SmootherCore::reEliminateUndamped(UpdateReport& rep, internal::EngineCounts& counts, double cost) {
+  internal::BayesTreeEngine snapshot = engine;
+  internal::EngineCounts trial = counts;
+  try {
+    engine.update(internal::EngineUpdate::relinearizing(engine.nonlinearSlots(), 0.0), trial);
+    trial.variables_backsubstituted += engine.solveAll();
+    counts = trial;
+    ++rep.iterations;
+    return engine.cost();
+  } catch (const NumericalError& e) {
+    engine = std::move(snapshot);
+    rep.note = std::string("covariances keep the last damping (the undamped system did not factor: ") + e.what() + ")";
+    return cost;
   }
-  // Newton polish: quadratic convergence where the iteration above crawls.
+}
+
+// Newton polish: quadratic convergence where the iteration above crawls.
+void SmootherCore::newtonPolishTree(UpdateReport& rep, internal::EngineCounts& counts, double cost) {
   internal::BayesTreeEngine snapshot = engine;
   internal::EngineCounts trial = counts;
   std::string failure;
   const internal::NewtonPolishResult polish = internal::newtonPolish(
-      engine.allEstimates(), previous_cost, options.newton_polish_steps,
+      engine.allEstimates(), cost, options.newton_polish_steps,
       [&](internal::NewtonSystem& sys, const Values& x) { engine.addToNewton(sys, x); },
       [&](Values& next) {
         snapshot = engine;
