@@ -238,21 +238,85 @@ bool SparseCholesky::SelectedInverse::lookup(Eigen::Index i, Eigen::Index j, dou
   return true;
 }
 
-SparseCholesky::SelectedInverse SparseCholesky::selectedInverse() const {
-  if (dense_) {  // the whole inverse: every entry is "on the pattern"
-    if (!factored_) throw NumericalError("selectedInverse: nothing factored");
-    const Eigen::MatrixXd Linv = L_.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(n_, n_));
-    const Eigen::MatrixXd Hinv = Linv.transpose() * Linv;
-    SelectedInverse S;
-    S.colptr.assign(static_cast<std::size_t>(n_) + 1, 0);
-    for (Eigen::Index j = 0; j < n_; ++j) {
-      S.colptr[static_cast<std::size_t>(j) + 1] = S.colptr[static_cast<std::size_t>(j)] + static_cast<int>(n_ - j);
-      for (Eigen::Index i = j; i < n_; ++i) {
-        S.rows.push_back(static_cast<int>(i));
-        S.values.push_back(Hinv(i, j));
-      }
+namespace {
+using SelectedInverse = SparseCholesky::SelectedInverse;
+
+// The whole inverse of LLᵀ (a dense factor): every entry is "on the pattern".
+SelectedInverse denseSelectedInverse(const Eigen::MatrixXd& L) {
+  const Eigen::Index n = L.rows();
+  const Eigen::MatrixXd Linv = L.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(n, n));
+  const Eigen::MatrixXd Hinv = Linv.transpose() * Linv;
+  SelectedInverse S;
+  S.colptr.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    S.colptr[static_cast<std::size_t>(j) + 1] = S.colptr[static_cast<std::size_t>(j)] + static_cast<int>(n - j);
+    for (Eigen::Index i = j; i < n; ++i) {
+      S.rows.push_back(static_cast<int>(i));
+      S.values.push_back(Hinv(i, j));
     }
-    return S;
+  }
+  return S;
+}
+
+// S on the simplicial factor F's pattern, each column's rows sorted with the
+// diagonal first; l holds L's entries in the same places (l_jj at the
+// diagonal's).
+void patternOfFactor(const cholmod_factor* F, Eigen::Index n, SelectedInverse& S, std::vector<double>& l) {
+  const int* Lp = static_cast<const int*>(F->p);
+  const int* Li = static_cast<const int*>(F->i);
+  const int* Lnz = static_cast<const int*>(F->nz);
+  const double* Lx = static_cast<const double*>(F->x);
+  S.colptr.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (Eigen::Index j = 0; j < n; ++j) S.colptr[j + 1] = S.colptr[j] + Lnz[j];
+  S.rows.resize(static_cast<std::size_t>(S.colptr.back()));
+  S.values.assign(S.rows.size(), 0.0);
+  l.resize(S.rows.size());
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const int q0 = S.colptr[j];
+    for (int p = Lp[j], q = q0; p < Lp[j] + Lnz[j]; ++p, ++q) {
+      S.rows[static_cast<std::size_t>(q)] = Li[p];
+      l[static_cast<std::size_t>(q)] = Lx[p];
+    }
+    // CHOLMOD keeps the diagonal first and the rows increasing; sort anyway
+    // (insertion: a column has a few entries) so nothing rests on that.
+    auto rank = [&](int q) { return S.rows[q] == j ? -1 : S.rows[q]; };
+    for (int q = q0 + 1; q < S.colptr[j + 1]; ++q)
+      for (int t = q; t > q0 && rank(t - 1) > rank(t); --t) {
+        std::swap(S.rows[t], S.rows[t - 1]);
+        std::swap(l[t], l[t - 1]);
+      }
+    if (S.rows[q0] != j) throw NumericalError("selectedInverse: the factor has no diagonal entry (internal error)");
+  }
+}
+
+// Backward sweep with L = LLᵀ's factor (Takahashi):
+//   Σ_ij = −(1/l_jj) Σ_k Σ_ik l_kj  (i > j),   Σ_jj = (1/l_jj − Σ_k l_kj Σ_kj) / l_jj,
+// k over column j's rows below the diagonal.
+void takahashiSweep(Eigen::Index n, SelectedInverse& S, const std::vector<double>& l) {
+  for (Eigen::Index j = n - 1; j >= 0; --j) {
+    const int base = S.colptr[j], end = S.colptr[j + 1];
+    const double ljj = l[static_cast<std::size_t>(base)];
+    for (int a = base + 1; a < end; ++a) {
+      double sum = 0;
+      for (int b = base + 1; b < end; ++b) {
+        double sik;
+        if (!S.lookup(S.rows[a], S.rows[b], sik))
+          throw NumericalError("selectedInverse: pattern is not closed (internal error)");
+        sum += sik * l[static_cast<std::size_t>(b)];
+      }
+      S.values[static_cast<std::size_t>(a)] = -sum / ljj;
+    }
+    double diag = 1.0 / ljj;
+    for (int a = base + 1; a < end; ++a) diag -= l[static_cast<std::size_t>(a)] * S.values[static_cast<std::size_t>(a)];
+    S.values[static_cast<std::size_t>(base)] = diag / ljj;
+  }
+}
+}  // namespace
+
+SparseCholesky::SelectedInverse SparseCholesky::selectedInverse() const {
+  if (dense_) {
+    if (!factored_) throw NumericalError("selectedInverse: nothing factored");
+    return denseSelectedInverse(L_);
   }
   if (!factor_) throw NumericalError("selectedInverse: nothing factored");
   cholmod_common& c = const_cast<cholmod_common&>(common_);
@@ -278,54 +342,10 @@ SparseCholesky::SelectedInverse SparseCholesky::selectedInverse() const {
   const int* perm = static_cast<const int*>(F->Perm);
   for (Eigen::Index k = 0; k < n_; ++k)
     if (perm && perm[k] != k) throw NumericalError("selectedInverse: expected the natural ordering");
-  const int* Lp = static_cast<const int*>(F->p);
-  const int* Li = static_cast<const int*>(F->i);
-  const int* Lnz = static_cast<const int*>(F->nz);
-  const double* Lx = static_cast<const double*>(F->x);
-  // S on L's pattern, each column's rows sorted with the diagonal first; l
-  // holds L's entries in the same places (l_jj at the diagonal's).
   SelectedInverse S;
-  S.colptr.assign(static_cast<std::size_t>(n_) + 1, 0);
-  for (Eigen::Index j = 0; j < n_; ++j) S.colptr[j + 1] = S.colptr[j] + Lnz[j];
-  S.rows.resize(static_cast<std::size_t>(S.colptr.back()));
-  S.values.assign(S.rows.size(), 0.0);
-  std::vector<double> l(S.rows.size());
-  for (Eigen::Index j = 0; j < n_; ++j) {
-    const int q0 = S.colptr[j];
-    for (int p = Lp[j], q = q0; p < Lp[j] + Lnz[j]; ++p, ++q) {
-      S.rows[static_cast<std::size_t>(q)] = Li[p];
-      l[static_cast<std::size_t>(q)] = Lx[p];
-    }
-    // CHOLMOD keeps the diagonal first and the rows increasing; sort anyway
-    // (insertion: a column has a few entries) so nothing rests on that.
-    auto rank = [&](int q) { return S.rows[q] == j ? -1 : S.rows[q]; };
-    for (int q = q0 + 1; q < S.colptr[j + 1]; ++q)
-      for (int t = q; t > q0 && rank(t - 1) > rank(t); --t) {
-        std::swap(S.rows[t], S.rows[t - 1]);
-        std::swap(l[t], l[t - 1]);
-      }
-    if (S.rows[q0] != j) throw NumericalError("selectedInverse: the factor has no diagonal entry (internal error)");
-  }
-  // Backward sweep with L = LLᵀ's factor (Takahashi):
-  //   Σ_ij = −(1/l_jj) Σ_k Σ_ik l_kj  (i > j),   Σ_jj = (1/l_jj − Σ_k l_kj Σ_kj) / l_jj,
-  // k over column j's rows below the diagonal.
-  for (Eigen::Index j = n_ - 1; j >= 0; --j) {
-    const int base = S.colptr[j], end = S.colptr[j + 1];
-    const double ljj = l[static_cast<std::size_t>(base)];
-    for (int a = base + 1; a < end; ++a) {
-      double sum = 0;
-      for (int b = base + 1; b < end; ++b) {
-        double sik;
-        if (!S.lookup(S.rows[a], S.rows[b], sik))
-          throw NumericalError("selectedInverse: pattern is not closed (internal error)");
-        sum += sik * l[static_cast<std::size_t>(b)];
-      }
-      S.values[static_cast<std::size_t>(a)] = -sum / ljj;
-    }
-    double diag = 1.0 / ljj;
-    for (int a = base + 1; a < end; ++a) diag -= l[static_cast<std::size_t>(a)] * S.values[static_cast<std::size_t>(a)];
-    S.values[static_cast<std::size_t>(base)] = diag / ljj;
-  }
+  std::vector<double> l;
+  patternOfFactor(F, n_, S, l);
+  takahashiSweep(n_, S, l);
   return S;
 }
 
