@@ -214,68 +214,67 @@ std::vector<std::string> scenarioNames() {
   return {"paper", "consistent", "nav-paper-like", "nav-consistent", "beacons-plaza-like", "beacons-consistent"};
 }
 
-IniDocument builtinScenario(const std::string& name, unsigned seed, int steps) {
-  IniDocument ini;
-  ini.set("scenario", "name", name);
-  ini.set("scenario", "seed", std::to_string(seed));
-  ini.set("scenario", "steps", std::to_string(steps));
-  if (name.rfind("beacons-", 0) == 0) {
-    // The Plaza logs' kind, simulated: a vehicle circling (3 m/s, 0.1 rad/s)
-    // inside four beacons, odometry at 10 Hz, a range every 2nd step, the
-    // beacons in turn, ranges 7% long.
-    models::RangeBeacon2D::Params p;
-    p.beacon_ids = {0, 1, 5, 6};
-    p.beacons = {{-33.6, 27.0}, {-68.9, 18.4}, {1.7, -5.8}, {-37.6, 69.2}};
-    p.start = Eigen::Vector3d(-34, 55, 0);
-    p.start_sd = Eigen::Vector3d(1, 1, 0.5);
-    p.range_sd = 0.5;
-    const models::RangeBeacon2D rb(p);
-    writeModel(rb, ini);
-    ini.set("scenario", "measure_every", "2");
-    ini.set("scenario", "channels", "cycle");
-    ini.set("truth", "input", Eigen::MatrixXd(Eigen::RowVector2d(3.0, 0.1)));
-    ini.set("truth", "measurement_noise", "true");
-    if (name == "beacons-plaza-like") {
-      ini.setComment("scenario",
-                     "RangeBeacon2D like the CMU Plaza logs: ranges 7% long (range scale 1.07, 0.7 prior sd\n"
-                     "from its mean 1), heading 0.3 rad off the prior mean; no process noise in the truth.");
-      ini.set("truth", "state0", Eigen::MatrixXd(Eigen::RowVector3d(-34, 55, 0.3)));
-      ini.set("truth", "constants", Eigen::MatrixXd::Constant(1, 1, 1.07));
-      ini.set("truth", "process_noise", "false");
-    } else if (name == "beacons-consistent") {
-      ini.setComment("scenario", "RangeBeacon2D with the truth drawn from the estimators' own prior and noise models.");
-      ini.set("truth", "process_noise", "true");
-    } else {
-      throw InvalidArgument("unknown scenario '" + name + "'");
-    }
-    return ini;
+namespace {
+// beacons-*: the Plaza logs' kind, simulated: a vehicle circling (3 m/s,
+// 0.1 rad/s) inside four beacons, odometry at 10 Hz, a range every 2nd step,
+// the beacons in turn, ranges 7% long.
+void beaconScenario(const std::string& name, IniDocument& ini) {
+  models::RangeBeacon2D::Params p;
+  p.beacon_ids = {0, 1, 5, 6};
+  p.beacons = {{-33.6, 27.0}, {-68.9, 18.4}, {1.7, -5.8}, {-37.6, 69.2}};
+  p.start = Eigen::Vector3d(-34, 55, 0);
+  p.start_sd = Eigen::Vector3d(1, 1, 0.5);
+  p.range_sd = 0.5;
+  const models::RangeBeacon2D rb(p);
+  writeModel(rb, ini);
+  ini.set("scenario", "measure_every", "2");
+  ini.set("scenario", "channels", "cycle");
+  ini.set("truth", "input", Eigen::MatrixXd(Eigen::RowVector2d(3.0, 0.1)));
+  ini.set("truth", "measurement_noise", "true");
+  if (name == "beacons-plaza-like") {
+    ini.setComment("scenario",
+                   "RangeBeacon2D like the CMU Plaza logs: ranges 7% long (range scale 1.07, 0.7 prior sd\n"
+                   "from its mean 1), heading 0.3 rad off the prior mean; no process noise in the truth.");
+    ini.set("truth", "state0", Eigen::MatrixXd(Eigen::RowVector3d(-34, 55, 0.3)));
+    ini.set("truth", "constants", Eigen::MatrixXd::Constant(1, 1, 1.07));
+    ini.set("truth", "process_noise", "false");
+  } else if (name == "beacons-consistent") {
+    ini.setComment("scenario", "RangeBeacon2D with the truth drawn from the estimators' own prior and noise models.");
+    ini.set("truth", "process_noise", "true");
+  } else {
+    throw InvalidArgument("unknown scenario '" + name + "'");
   }
-  if (name.rfind("nav-", 0) == 0) {
-    const models::Nav2D nav;
-    writeModel(nav, ini);
-    ini.set("scenario", "measure_every", "5");  // ranges at 2 Hz, accelerometer at 10 Hz
-    // Centripetal acceleration of a 50 m circle at 0.1 rad/s about (100, 100).
-    ini.set("truth", "input_amplitude", -0.5);
-    ini.set("truth", "input_omega", 0.1);
-    ini.set(sectionOf(Method::Ekf), "constant_process_noise", Eigen::MatrixXd(Eigen::RowVector3d::Zero()));
-    if (name == "nav-paper-like") {
-      ini.setComment("scenario",
-                     "Nav2D with priors several sigmas from the truth, as in the radar paper scenario:\n"
-                     "position 10 m (2 sd) and velocity 3 m/s (3 sd) off, accelerometer bias 2.5 sd,\n"
-                     "range bias 4 sd; no process noise in the truth.");
-      ini.set("prior", "state_mean", Eigen::MatrixXd(Eigen::RowVector4d(140, 110, 3, 2)));
-      ini.set("truth", "state0", Eigen::MatrixXd(Eigen::RowVector4d(150, 100, 0, 5)));
-      ini.set("truth", "constants", Eigen::MatrixXd(Eigen::RowVector3d(0.25, -0.15, 20)));
-      ini.set("truth", "process_noise", "false");
-    } else if (name == "nav-consistent") {
-      ini.setComment("scenario", "Nav2D with the truth drawn from the estimators' own prior and noise models.");
-      ini.set("truth", "process_noise", "true");
-    } else {
-      throw InvalidArgument("unknown scenario '" + name + "'");
-    }
-    ini.set("truth", "measurement_noise", "true");
-    return ini;
+}
+
+// nav-*: Nav2D, an accelerometer with a bias and ranges with a bias.
+void navScenario(const std::string& name, IniDocument& ini) {
+  const models::Nav2D nav;
+  writeModel(nav, ini);
+  ini.set("scenario", "measure_every", "5");  // ranges at 2 Hz, accelerometer at 10 Hz
+  // Centripetal acceleration of a 50 m circle at 0.1 rad/s about (100, 100).
+  ini.set("truth", "input_amplitude", -0.5);
+  ini.set("truth", "input_omega", 0.1);
+  ini.set(sectionOf(Method::Ekf), "constant_process_noise", Eigen::MatrixXd(Eigen::RowVector3d::Zero()));
+  if (name == "nav-paper-like") {
+    ini.setComment("scenario",
+                   "Nav2D with priors several sigmas from the truth, as in the radar paper scenario:\n"
+                   "position 10 m (2 sd) and velocity 3 m/s (3 sd) off, accelerometer bias 2.5 sd,\n"
+                   "range bias 4 sd; no process noise in the truth.");
+    ini.set("prior", "state_mean", Eigen::MatrixXd(Eigen::RowVector4d(140, 110, 3, 2)));
+    ini.set("truth", "state0", Eigen::MatrixXd(Eigen::RowVector4d(150, 100, 0, 5)));
+    ini.set("truth", "constants", Eigen::MatrixXd(Eigen::RowVector3d(0.25, -0.15, 20)));
+    ini.set("truth", "process_noise", "false");
+  } else if (name == "nav-consistent") {
+    ini.setComment("scenario", "Nav2D with the truth drawn from the estimators' own prior and noise models.");
+    ini.set("truth", "process_noise", "true");
+  } else {
+    throw InvalidArgument("unknown scenario '" + name + "'");
   }
+  ini.set("truth", "measurement_noise", "true");
+}
+
+// paper, consistent: the paper's radar.
+void radarScenario(const std::string& name, IniDocument& ini) {
   const models::Radar2D radar;  // the paper's settings
   writeModel(radar, ini);
   if (name == "paper") {
@@ -302,6 +301,17 @@ IniDocument builtinScenario(const std::string& name, unsigned seed, int steps) {
     for (const auto& n : scenarioNames()) known += (known.empty() ? "" : ", ") + n;
     throw InvalidArgument("unknown scenario '" + name + "' (known: " + known + ")");
   }
+}
+}  // namespace
+
+IniDocument builtinScenario(const std::string& name, unsigned seed, int steps) {
+  IniDocument ini;
+  ini.set("scenario", "name", name);
+  ini.set("scenario", "seed", std::to_string(seed));
+  ini.set("scenario", "steps", std::to_string(steps));
+  if (name.rfind("beacons-", 0) == 0) beaconScenario(name, ini);
+  else if (name.rfind("nav-", 0) == 0) navScenario(name, ini);
+  else radarScenario(name, ini);
   return ini;
 }
 
