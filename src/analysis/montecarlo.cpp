@@ -100,9 +100,9 @@ MonteCarloResult runMonteCarlo(const MonteCarloScenario& scenario, const MonteCa
   return res;
 }
 
-MonteCarloResult summarizeMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
-                                     const std::vector<MonteCarloSeedResult>& results) {
-  validateMonteCarlo(scenario, options);
+namespace {
+// Results in seed order, each with every method of the options.
+void requireSeedOrder(const MonteCarloOptions& options, const std::vector<MonteCarloSeedResult>& results) {
   const std::size_t M = options.methods.size(), S = static_cast<std::size_t>(options.seeds);
   if (results.size() != S)
     throw InvalidArgument("summarizeMonteCarlo: " + std::to_string(results.size()) + " seed results for " +
@@ -116,10 +116,78 @@ MonteCarloResult summarizeMonteCarlo(const MonteCarloScenario& scenario, const M
                             " (results in seed order, every method of the options)");
     for (std::size_t mi = 0; mi < M; ++mi)
       if (results[s].methods[mi].method != options.methods[mi])
-        throw InvalidArgument("summarizeMonteCarlo: seed " + std::to_string(want) + ": method " +
-                              std::to_string(mi) + " is " + methodName(results[s].methods[mi].method) +
-                              ", the options say " + methodName(options.methods[mi]));
+        throw InvalidArgument("summarizeMonteCarlo: seed " + std::to_string(want) + ": method " + std::to_string(mi) +
+                              " is " + methodName(results[s].methods[mi].method) + ", the options say " +
+                              methodName(options.methods[mi]));
   }
+}
+
+const char* verdict(double mean, double lo, double hi) {
+  return mean > hi ? "over-confident" : mean < lo ? "under-confident" : "consistent";
+}
+
+// One method's sums over the seeds that ran it, per step and in all.
+struct MethodSums {
+  std::vector<Eigen::VectorXd> sq_t;
+  std::vector<double> nees_t, nis_t;
+  int ok = 0;
+};
+
+MethodSums sumSeeds(MethodSummary& m, std::size_t mi, std::size_t ekf, int n, std::size_t rows,
+                    const std::vector<MonteCarloSeedResult>& results) {
+  MethodSums sums{std::vector<Eigen::VectorXd>(rows, Eigen::VectorXd::Zero(n)), std::vector<double>(rows, 0.0),
+                  std::vector<double>(rows, 0.0), 0};
+  for (const auto& seed : results) {
+    const auto& r = seed.methods[mi];
+    if (!r.ok) {
+      if (m.failures++ == 0) m.first_failure = "seed " + std::to_string(seed.seed) + ": " + r.error;
+      continue;
+    }
+    ++sums.ok;
+    m.mean_rmse += r.rmse;
+    m.rms_final_error += r.final_error.cwiseAbs2();
+    const auto& base = seed.methods[ekf];
+    if (base.ok)
+      for (int i = 0; i < n; ++i) m.beats_ekf[i] += r.rmse[i] < base.rmse[i] ? 1.0 : 0.0;
+    for (std::size_t k = 0; k < r.sq.size() && k < sums.sq_t.size(); ++k) {
+      sums.sq_t[k] += r.sq[k];
+      sums.nees_t[k] += r.nees[k];
+      sums.nis_t[k] += k < r.nis.size() ? r.nis[k] : std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+  return sums;
+}
+
+// Averages, the RMSE over time, NEES and NIS against their intervals.
+void averageSeeds(MethodSummary& m, const MethodSums& sums, const MonteCarloResult& res) {
+  const int ok = sums.ok;
+  m.mean_rmse /= ok;
+  m.rms_final_error = (m.rms_final_error / ok).cwiseSqrt();
+  m.beats_ekf /= ok;
+  int inside = 0;
+  for (std::size_t k = 0; k < sums.sq_t.size(); ++k) {
+    m.rmse_over_time.push_back((sums.sq_t[k] / ok).cwiseSqrt());
+    const double avg = sums.nees_t[k] / ok;
+    m.mean_nees += avg / static_cast<double>(sums.sq_t.size());
+    inside += (avg >= res.nees_lo && avg <= res.nees_hi) ? 1 : 0;
+  }
+  m.nees_step_in_interval = static_cast<double>(inside) / static_cast<double>(sums.sq_t.size());
+  m.consistency = verdict(m.mean_nees, res.nees_lo, res.nees_hi);
+  m.mean_nis = 0;
+  int nis_inside = 0;
+  for (double v : sums.nis_t) {
+    m.mean_nis += v / ok / static_cast<double>(sums.nis_t.size());
+    nis_inside += (v / ok >= res.nis_lo && v / ok <= res.nis_hi) ? 1 : 0;
+  }
+  m.nis_step_in_interval = static_cast<double>(nis_inside) / static_cast<double>(sums.nis_t.size());
+  if (std::isfinite(m.mean_nis)) m.nis_consistency = verdict(m.mean_nis, res.nis_lo, res.nis_hi);
+}
+}  // namespace
+
+MonteCarloResult summarizeMonteCarlo(const MonteCarloScenario& scenario, const MonteCarloOptions& options,
+                                     const std::vector<MonteCarloSeedResult>& results) {
+  validateMonteCarlo(scenario, options);
+  requireSeedOrder(options, results);
   const Model* model = scenario.truth;
   const SimulationSpec& spec = scenario.spec;
   const int n = model->dims().nc + model->dims().nb;
@@ -136,58 +204,14 @@ MonteCarloResult summarizeMonteCarlo(const MonteCarloScenario& scenario, const M
   res.nis_hi = chiSquareQuantile(0.975, res.nis_dof * options.seeds) / options.seeds;
   const std::size_t ekf = static_cast<std::size_t>(
       std::find(options.methods.begin(), options.methods.end(), Method::Ekf) - options.methods.begin());
-  for (std::size_t mi = 0; mi < M; ++mi) {
+  const std::size_t rows = static_cast<std::size_t>(spec.steps / spec.measure_every);
+  for (std::size_t mi = 0; mi < options.methods.size(); ++mi) {
     MethodSummary m;
     m.method = options.methods[mi];
     m.times = results.front().times;
     m.mean_rmse = m.rms_final_error = m.beats_ekf = Eigen::VectorXd::Zero(n);
-    const std::size_t rows = static_cast<std::size_t>(spec.steps / spec.measure_every);
-    std::vector<Eigen::VectorXd> sq_t(rows, Eigen::VectorXd::Zero(n));
-    std::vector<double> nees_t(rows, 0.0), nis_t(rows, 0.0);
-    int ok = 0;
-    for (std::size_t s = 0; s < S; ++s) {
-      const auto& r = results[s].methods[mi];
-      if (!r.ok) {
-        if (m.failures++ == 0) m.first_failure = "seed " + std::to_string(results[s].seed) + ": " + r.error;
-        continue;
-      }
-      ++ok;
-      m.mean_rmse += r.rmse;
-      m.rms_final_error += r.final_error.cwiseAbs2();
-      const auto& base = results[s].methods[ekf];
-      if (base.ok)
-        for (int i = 0; i < n; ++i) m.beats_ekf[i] += r.rmse[i] < base.rmse[i] ? 1.0 : 0.0;
-      for (std::size_t k = 0; k < r.sq.size() && k < sq_t.size(); ++k) {
-        sq_t[k] += r.sq[k];
-        nees_t[k] += r.nees[k];
-        nis_t[k] += k < r.nis.size() ? r.nis[k] : std::numeric_limits<double>::quiet_NaN();
-      }
-    }
-    if (ok > 0) {
-      m.mean_rmse /= ok;
-      m.rms_final_error = (m.rms_final_error / ok).cwiseSqrt();
-      m.beats_ekf /= ok;
-      int inside = 0;
-      for (std::size_t k = 0; k < sq_t.size(); ++k) {
-        m.rmse_over_time.push_back((sq_t[k] / ok).cwiseSqrt());
-        const double avg = nees_t[k] / ok;
-        m.mean_nees += avg / static_cast<double>(sq_t.size());
-        inside += (avg >= res.nees_lo && avg <= res.nees_hi) ? 1 : 0;
-      }
-      m.nees_step_in_interval = static_cast<double>(inside) / static_cast<double>(sq_t.size());
-      m.consistency = m.mean_nees > res.nees_hi ? "over-confident"
-                      : m.mean_nees < res.nees_lo ? "under-confident" : "consistent";
-      m.mean_nis = 0;
-      int nis_inside = 0;
-      for (double v : nis_t) {
-        m.mean_nis += v / ok / static_cast<double>(nis_t.size());
-        nis_inside += (v / ok >= res.nis_lo && v / ok <= res.nis_hi) ? 1 : 0;
-      }
-      m.nis_step_in_interval = static_cast<double>(nis_inside) / static_cast<double>(nis_t.size());
-      if (std::isfinite(m.mean_nis))
-        m.nis_consistency = m.mean_nis > res.nis_hi ? "over-confident"
-                            : m.mean_nis < res.nis_lo ? "under-confident" : "consistent";
-    }
+    const MethodSums sums = sumSeeds(m, mi, ekf, n, rows, results);
+    if (sums.ok > 0) averageSeeds(m, sums, res);
     res.methods.push_back(std::move(m));
   }
   return res;
