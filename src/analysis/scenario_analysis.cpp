@@ -46,15 +46,11 @@ ScenarioAnalysis analyzeScenario(const MonteCarloScenario& scenario, const Simul
   return a;
 }
 
-std::string ScenarioAnalysis::markdown() const {
-  std::ostringstream os;
-  os << std::setprecision(3);
-  const auto& mc = montecarlo;
+namespace {
+void boundSection(const ScenarioAnalysis& a, std::ostream& os) {
+  const auto& mc = a.montecarlo;
+  const auto& state_names = a.state_names;
   const std::size_t n = state_names.size();
-  os << "# Analysis of `" << scenario << "`\n\n";
-  os << "Monte Carlo: " << mc.seeds << " runs × " << mc.steps << " steps. Bound: posterior Cramér–Rao at the "
-     << "dataset's true states (filtering = data up to t; smoothing = all data).\n\n";
-
   os << "## 1. How close each estimator gets to the bound (end of run)\n\n";
   os << "Final-step RMS error over the runs vs the bound's standard deviation; efficiency = bound / RMS "
      << "(1 = attains the bound; the filters are compared with the filtering bound, batch with the smoothing bound). "
@@ -65,8 +61,8 @@ std::string ScenarioAnalysis::markdown() const {
   os << "\n| --- | --- | --- |";
   for (std::size_t i = 0; i < mc.methods.size(); ++i) os << " --- |";
   os << "\n";
-  const auto& fb = bound.filtering.back();
-  const auto& sb = bound.smoothing.back();
+  const auto& fb = a.bound.filtering.back();
+  const auto& sb = a.bound.smoothing.back();
   for (std::size_t i = 0; i < n; ++i) {
     const auto ii = static_cast<Eigen::Index>(i);
     const double f = std::sqrt(fb(ii, ii)), s = std::sqrt(sb(ii, ii));
@@ -78,7 +74,9 @@ std::string ScenarioAnalysis::markdown() const {
     }
     os << "\n";
   }
+}
 
+void consistencySection(const MonteCarloResult& mc, std::ostream& os) {
   os << "\n## 2. Consistency (NEES, " << mc.dof << " dof; 95% interval of a " << mc.seeds
      << "-run average: [" << mc.nees_lo << ", " << mc.nees_hi << "])\n\n";
   os << "| method | mean NEES | steps inside the interval | verdict | mean NIS (" << mc.nis_dof
@@ -92,7 +90,10 @@ std::string ScenarioAnalysis::markdown() const {
     else
       os << "— (no innovations: uses all data) | — | — |\n";
   }
+}
 
+void identifiabilitySection(const ScenarioAnalysis& a, std::ostream& os) {
+  const auto& identifiability = a.identifiability;
   os << "\n## 3. Identifiability of the constants (filtering bound, data information only)\n\n";
   if (identifiability.empty()) {
     os << "The model has no constants.\n";
@@ -108,47 +109,65 @@ std::string ScenarioAnalysis::markdown() const {
     os << "\n";
     if (!last.id.determined())
       os << "**Not identifiable**: the data never determine " << last.id.weakest << "; only the prior does.\n";
-    else if (determined_from >= 0)
+    else if (a.determined_from >= 0)
       os << "All constants are determined by the data (more than by the prior in every direction) from t = "
-         << determined_from << ".\n";
+         << a.determined_from << ".\n";
     else
       os << "The constants are observable but the prior still dominates in the weakest direction at the end: "
          << last.id.weakest << ".\n";
   }
+}
 
+std::string commaList(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+// One GSSM method against the EKF, state by state, and why.
+void comparisonLine(const ScenarioAnalysis& a, const MethodSummary& ekf, const MethodSummary& m, std::ostream& os) {
+  const bool smoother = !methodInfo(m.method).streaming;  // uses future data
+  const std::size_t n = a.state_names.size();
+  os << "* **" << methodName(m.method) << "**: ";
+  std::vector<std::string> better, same, worse;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    const double r = m.mean_rmse[ii] / ekf.mean_rmse[ii];
+    std::ostringstream item;
+    item << std::setprecision(2) << a.state_names[i] << " (RMSE ×" << r << ", better in "
+         << std::lround(100 * m.beats_ekf[ii]) << "% of runs)";
+    (r < 0.95 ? better : r > 1.05 ? worse : same).push_back(item.str());
+  }
+  if (!better.empty()) os << "better on " << commaList(better) << ". ";
+  if (!same.empty()) os << "same as the EKF (within 5%) on " << commaList(same) << ". ";
+  if (!worse.empty()) os << "worse on " << commaList(worse) << ". ";
+  if (smoother && !better.empty())
+    os << "Why: smoothing — every state uses the later measurements too (not available online).";
+  else if (!smoother && !better.empty())
+    os << "Why: the window's factors are relinearized at the current estimate (the EKF linearizes each "
+          "measurement once, at its prediction), which matters where the model is nonlinear for the "
+          "prior's error (e.g. a start-up).";
+  else if (!smoother)
+    os << "Why: the EKF's linearization is adequate here; both are the same Bayesian filter.";
+  os << "\n";
+}
+}  // namespace
+
+std::string ScenarioAnalysis::markdown() const {
+  std::ostringstream os;
+  os << std::setprecision(3);
+  os << "# Analysis of `" << scenario << "`\n\n";
+  os << "Monte Carlo: " << montecarlo.seeds << " runs × " << montecarlo.steps
+     << " steps. Bound: posterior Cramér–Rao at the dataset's true states (filtering = data up to t; smoothing = "
+        "all data).\n\n";
+  boundSection(*this, os);
+  consistencySection(montecarlo, os);
+  identifiabilitySection(*this, os);
   os << "\n## 4. Does the GSSM improve on the EKF here?\n\n";
-  const MethodSummary* ekf = find(mc, Method::Ekf);
+  const MethodSummary* ekf = find(montecarlo, Method::Ekf);
   for (const Method g : {Method::FixedLag, Method::Incremental, Method::Batch}) {
-    const MethodSummary* m = find(mc, g);
-    const bool smoother = !methodInfo(g).streaming;  // uses future data
-    if (!ekf || !m) continue;
-    os << "* **" << methodName(g) << "**: ";
-    std::vector<std::string> better, same, worse;
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto ii = static_cast<Eigen::Index>(i);
-      const double r = m->mean_rmse[ii] / ekf->mean_rmse[ii];
-      std::ostringstream item;
-      item << std::setprecision(2) << state_names[i] << " (RMSE ×" << r << ", better in "
-           << std::lround(100 * m->beats_ekf[ii]) << "% of runs)";
-      (r < 0.95 ? better : r > 1.05 ? worse : same).push_back(item.str());
-    }
-    auto list = [](const std::vector<std::string>& v) {
-      std::string s;
-      for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-      return s;
-    };
-    if (!better.empty()) os << "better on " << list(better) << ". ";
-    if (!same.empty()) os << "same as the EKF (within 5%) on " << list(same) << ". ";
-    if (!worse.empty()) os << "worse on " << list(worse) << ". ";
-    if (smoother && !better.empty())
-      os << "Why: smoothing — every state uses the later measurements too (not available online).";
-    else if (!smoother && !better.empty())
-      os << "Why: the window's factors are relinearized at the current estimate (the EKF linearizes each "
-            "measurement once, at its prediction), which matters where the model is nonlinear for the "
-            "prior's error (e.g. a start-up).";
-    else if (!smoother)
-      os << "Why: the EKF's linearization is adequate here; both are the same Bayesian filter.";
-    os << "\n";
+    const MethodSummary* m = find(montecarlo, g);
+    if (ekf && m) comparisonLine(*this, *ekf, *m, os);
   }
   return os.str();
 }
