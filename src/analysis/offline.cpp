@@ -126,6 +126,151 @@ class InlineRecorder final : public RunRecorder {
 };
 }  // namespace
 
+namespace {
+// One streaming run over a dataset: the estimator, where the run is (what a
+// checkpoint stores) and the records it has made.
+class StreamingRun {
+ public:
+  StreamingRun(const Model& model, const EstimatorOptions& options, const std::vector<Measurement>& measurements,
+               const std::vector<Input>& inputs, const StreamingCheckpoints& checkpoints, RowTimes rows)
+      : model_(model), options_(options), measurements_(measurements), inputs_(inputs), checkpoints_(checkpoints),
+        inline_recorder_(out_), recorder_(checkpoints.recorder ? *checkpoints.recorder : inline_recorder_),
+        at_inputs_(rows == RowTimes::Inputs) {
+    out_.method = options.method;
+    at_.data_fingerprint = internal::kFnv1a64Basis;
+    if (!checkpoints.resume_from.empty()) resume();
+    else est_ = makeEstimator(model, options);
+    out_.rows.reserve(measurements.size());
+    out_.update_seconds.reserve(measurements.size());
+    rows_sent_ = out_.rows.size(), updates_sent_ = out_.update_seconds.size();  // resumed: already there
+  }
+
+  OfflineRun run(const std::function<void(std::size_t, std::size_t)>& progress) {
+    const std::size_t every = std::max<std::size_t>(1, measurements_.size() / 100);
+    for (std::size_t i = at_.next_measurement; i < measurements_.size(); ++i) {
+      update(measurements_[i]);
+      if (progress && ((i + 1) % every == 0 || i + 1 == measurements_.size())) progress(i + 1, measurements_.size());
+      if (!checkpoints_.path.empty() && (i + 1) % checkpoints_.every == 0) checkpoint(i + 1);
+    }
+    feedInputsBefore(std::numeric_limits<double>::infinity());  // inputs after the last measurement
+    if (at_inputs_ && at_.row_due) addRow(est_->current());
+    out_.total_seconds = seconds_before_ + since(start_) - recording_;
+    sendRecords();
+    out_.summary = est_->report().detail;
+    return std::move(out_);
+  }
+
+ private:
+  void resume();
+  void update(const Measurement& m);
+  void checkpoint(std::size_t next_measurement);
+  void addRow(const StateEstimate& e) { out_.rows.push_back({e.t, e.mean, e.covariance}); }
+  // Events in time order: an input at t makes the state at t (when after
+  // the newest), a measurement at t attaches to it or makes it. With rows at
+  // inputs, the row of a state an input made is taken just before the first
+  // later event, so it holds every measurement at its time (at_.row_due: the
+  // newest state, made by an input, has no row yet).
+  void feedInputsBefore(double t) {
+    for (; at_.next_input < inputs_.size() && inputs_[at_.next_input].t < t; ++at_.next_input) {
+      const double ti = std::max(inputs_[at_.next_input].t, est_->time());
+      if (at_inputs_ && at_.row_due && ti > est_->time()) addRow(est_->current());
+      const bool advances = ti > est_->time();
+      est_->addInput(ti, inputs_[at_.next_input].u);
+      if (at_inputs_ && advances) at_.row_due = true;
+    }
+  }
+  // The recorder gets the records at each checkpoint and at the end, not
+  // inside the loop: writing output files is not the estimator's time (left
+  // out of total_seconds) and costs the loop nothing.
+  void sendRecords() {
+    for (; rows_sent_ < out_.rows.size(); ++rows_sent_) recorder_.row(out_.rows[rows_sent_]);
+    for (; updates_sent_ < out_.update_seconds.size(); ++updates_sent_)
+      recorder_.update(out_.update_seconds[updates_sent_],
+                       options_.compute_nis ? std::optional<double>(out_.nis[updates_sent_]) : std::nullopt);
+  }
+
+  const Model& model_;
+  const EstimatorOptions& options_;
+  const std::vector<Measurement>& measurements_;
+  const std::vector<Input>& inputs_;
+  const StreamingCheckpoints& checkpoints_;
+  OfflineRun out_;
+  InlineRecorder inline_recorder_;
+  RunRecorder& recorder_;
+  const bool at_inputs_;
+  const Clock::time_point start_ = Clock::now();
+  std::unique_ptr<Estimator> est_;
+  RunProgress at_;  // where the run is (what a checkpoint stores)
+  double seconds_before_ = 0, recording_ = 0;
+  std::size_t rows_sent_ = 0, updates_sent_ = 0;
+};
+
+// Continues from checkpoints_.resume_from, after checking it was written by
+// this method and window on this dataset's first measurements.
+void StreamingRun::resume() {
+  const std::string& from = checkpoints_.resume_from;
+  CheckpointInfo info;
+  est_ = restoreCheckpoint(model_, from, &info);
+  RunProgress saved;
+  std::string mark;
+  out_ = decodeRun(info.user_data, from, saved, mark);
+  const auto fail = [&](const std::string& why) { throw CheckpointError(from + ": cannot resume this run: " + why); };
+  if (info.method != options_.method || out_.method != options_.method)
+    fail(std::string("it was written by method '") + methodName(info.method) + "', this run is '" +
+         methodName(options_.method) + "'");
+  if (est_->report().window != options_.window())
+    fail("it was written with window " + std::to_string(est_->report().window) + ", this run asks for " +
+         std::to_string(options_.window()));
+  if (saved.next_measurement <= measurements_.size())
+    for (std::size_t i = 0; i < saved.next_measurement; ++i)
+      at_.data_fingerprint = foldMeasurement(at_.data_fingerprint, measurements_[i]);
+  if (saved.next_measurement > measurements_.size() || saved.next_input > inputs_.size() ||
+      at_.data_fingerprint != saved.data_fingerprint)
+    fail("its first " + std::to_string(saved.next_measurement) +
+         " measurements differ from this dataset's (another dataset?)");
+  recorder_.resume(mark, out_);
+  if (out_.update_seconds.size() != saved.next_measurement)
+    fail("its records hold " + std::to_string(out_.update_seconds.size()) + " updates, its progress says " +
+         std::to_string(saved.next_measurement));
+  at_ = saved;
+  seconds_before_ = out_.total_seconds;
+}
+
+void StreamingRun::update(const Measurement& m) {
+  feedInputsBefore(m.t);
+  if (at_inputs_ && at_.row_due && m.t > est_->time()) {
+    addRow(est_->current());
+    at_.row_due = false;
+  }
+  const auto t0 = Clock::now();
+  est_->addMeasurement(m);
+  out_.update_seconds.push_back(since(t0));
+  at_.data_fingerprint = foldMeasurement(at_.data_fingerprint, m);
+  if (options_.compute_nis) out_.nis.push_back(est_->reportNumbers().nis);
+  // The EKF gates instead of weighting; the others' weight is the
+  // measurement factor's own, at the estimate after its update.
+  const bool weigh = model_.channel(m.channel).loss.robust() && options_.method != Method::Ekf;
+  if (!at_inputs_ || weigh) {
+    const StateEstimate e = est_->current();
+    if (!at_inputs_) addRow(e);
+    if (weigh && MeasurementFactor(model_, e.step, m).weight(stateValues(model_, e)) < 1.0) ++out_.downweighted;
+  }
+  out_.rejected = est_->reportNumbers().rejected;  // not report(): formatting its line costs ~15% of an EKF update
+  out_.iterations = std::max(out_.iterations, est_->reportNumbers().iterations);
+}
+
+void StreamingRun::checkpoint(std::size_t next_measurement) {
+  const auto c0 = Clock::now();
+  at_.next_measurement = next_measurement;
+  out_.total_seconds = seconds_before_ + since(start_) - recording_;
+  // The records first: a checkpoint never points past what is durable.
+  sendRecords();
+  const std::string mark = recorder_.mark();
+  saveCheckpoint(*est_, checkpoints_.path, encodeRun(out_, at_, mark));
+  recording_ += since(c0);
+}
+}  // namespace
+
 OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::vector<Measurement>& measurements,
                         const std::vector<Input>& inputs,
@@ -133,117 +278,7 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const StreamingCheckpoints& checkpoints, RowTimes rows) {
   if (!checkpoints.path.empty() && checkpoints.every == 0)
     throw InvalidArgument("runStreaming: a checkpoint path needs checkpoints.every >= 1");
-  OfflineRun out;
-  out.method = options.method;
-  const std::size_t every = std::max<std::size_t>(1, measurements.size() / 100);
-  const auto start = Clock::now();
-  InlineRecorder inline_recorder(out);
-  RunRecorder& recorder = checkpoints.recorder ? *checkpoints.recorder : inline_recorder;
-  std::unique_ptr<Estimator> est;
-  RunProgress at;  // where the run is (what a checkpoint stores)
-  at.data_fingerprint = internal::kFnv1a64Basis;
-  double seconds_before = 0;
-  if (!checkpoints.resume_from.empty()) {
-    CheckpointInfo info;
-    est = restoreCheckpoint(model, checkpoints.resume_from, &info);
-    RunProgress saved;
-    std::string mark;
-    out = decodeRun(info.user_data, checkpoints.resume_from, saved, mark);
-    const auto fail = [&](const std::string& why) {
-      throw CheckpointError(checkpoints.resume_from + ": cannot resume this run: " + why);
-    };
-    if (info.method != options.method || out.method != options.method)
-      fail(std::string("it was written by method '") + methodName(info.method) + "', this run is '" +
-           methodName(options.method) + "'");
-    if (est->report().window != options.window())
-      fail("it was written with window " + std::to_string(est->report().window) + ", this run asks for " +
-           std::to_string(options.window()));
-    if (saved.next_measurement <= measurements.size())
-      for (std::size_t i = 0; i < saved.next_measurement; ++i)
-        at.data_fingerprint = foldMeasurement(at.data_fingerprint, measurements[i]);
-    if (saved.next_measurement > measurements.size() || saved.next_input > inputs.size() ||
-        at.data_fingerprint != saved.data_fingerprint)
-      fail("its first " + std::to_string(saved.next_measurement) +
-           " measurements differ from this dataset's (another dataset?)");
-    recorder.resume(mark, out);
-    if (out.update_seconds.size() != saved.next_measurement)
-      fail("its records hold " + std::to_string(out.update_seconds.size()) + " updates, its progress says " +
-           std::to_string(saved.next_measurement));
-    at = saved;
-    seconds_before = out.total_seconds;
-  } else {
-    est = makeEstimator(model, options);
-  }
-  out.rows.reserve(measurements.size());
-  out.update_seconds.reserve(measurements.size());
-  // Events in time order: an input at t makes the state at t (when after
-  // the newest), a measurement at t attaches to it or makes it. With rows
-  // at inputs, the row of a state an input made is taken just before the
-  // first later event, so it holds every measurement at its time.
-  const bool at_inputs = rows == RowTimes::Inputs;
-  // The recorder gets the records at each checkpoint and at the end, not
-  // inside the loop: writing output files is not the estimator's time (left
-  // out of total_seconds) and costs the loop nothing.
-  double recording = 0;
-  std::size_t rows_sent = out.rows.size(), updates_sent = out.update_seconds.size();  // resumed: already there
-  const auto sendRecords = [&] {
-    for (; rows_sent < out.rows.size(); ++rows_sent) recorder.row(out.rows[rows_sent]);
-    for (; updates_sent < out.update_seconds.size(); ++updates_sent)
-      recorder.update(out.update_seconds[updates_sent],
-                      options.compute_nis ? std::optional<double>(out.nis[updates_sent]) : std::nullopt);
-  };
-  const auto addRow = [&](const StateEstimate& e) { out.rows.push_back({e.t, e.mean, e.covariance}); };
-  // at.row_due, with rows at inputs: the newest state, made by an input, has no row yet.
-  auto feedInputsBefore = [&](double t) {
-    for (; at.next_input < inputs.size() && inputs[at.next_input].t < t; ++at.next_input) {
-      const double ti = std::max(inputs[at.next_input].t, est->time());
-      if (at_inputs && at.row_due && ti > est->time()) addRow(est->current());
-      const bool advances = ti > est->time();
-      est->addInput(ti, inputs[at.next_input].u);
-      if (at_inputs && advances) at.row_due = true;
-    }
-  };
-  for (std::size_t i = at.next_measurement; i < measurements.size(); ++i) {
-    const Measurement& m = measurements[i];
-    feedInputsBefore(m.t);
-    if (at_inputs && at.row_due && m.t > est->time()) {
-      addRow(est->current());
-      at.row_due = false;
-    }
-    const auto t0 = Clock::now();
-    est->addMeasurement(m);
-    const double seconds = since(t0);
-    out.update_seconds.push_back(seconds);
-    at.data_fingerprint = foldMeasurement(at.data_fingerprint, m);
-    if (options.compute_nis) out.nis.push_back(est->reportNumbers().nis);
-    // The EKF gates instead of weighting; the others' weight is the
-    // measurement factor's own, at the estimate after its update.
-    const bool weigh = model.channel(m.channel).loss.robust() && options.method != Method::Ekf;
-    if (!at_inputs || weigh) {
-      const StateEstimate e = est->current();
-      if (!at_inputs) addRow(e);
-      if (weigh && MeasurementFactor(model, e.step, m).weight(stateValues(model, e)) < 1.0) ++out.downweighted;
-    }
-    out.rejected = est->reportNumbers().rejected;  // not report(): formatting its line costs ~15% of an EKF update
-    out.iterations = std::max(out.iterations, est->reportNumbers().iterations);
-    if (progress && ((i + 1) % every == 0 || i + 1 == measurements.size())) progress(i + 1, measurements.size());
-    if (!checkpoints.path.empty() && (i + 1) % checkpoints.every == 0) {
-      const auto c0 = Clock::now();
-      at.next_measurement = i + 1;
-      out.total_seconds = seconds_before + since(start) - recording;
-      // The records first: a checkpoint never points past what is durable.
-      sendRecords();
-      const std::string mark = recorder.mark();
-      saveCheckpoint(*est, checkpoints.path, encodeRun(out, at, mark));
-      recording += since(c0);
-    }
-  }
-  feedInputsBefore(std::numeric_limits<double>::infinity());  // inputs after the last measurement
-  if (at_inputs && at.row_due) addRow(est->current());
-  out.total_seconds = seconds_before + since(start) - recording;
-  sendRecords();
-  out.summary = est->report().detail;
-  return out;
+  return StreamingRun(model, options, measurements, inputs, checkpoints, rows).run(progress);
 }
 
 OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
