@@ -75,39 +75,34 @@ void requireIncreasing(const CsvTable& t, std::size_t r, double prev, double now
                                   : " is before the previous row's " + formatDouble(prev)));
 }
 
-// One CSV per sensor stream, as the config's [dataset] describes.
-void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
-  ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
-                                  "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
-                                  "start_time", "rows"});
-  const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
-  // Truth first: it may give t0.
-  out.truth.reset();
-  std::optional<CsvTable> truth;
-  if (ini.has("dataset", "truth")) {
-    truth = readCsv(file("truth"));
-    const int tc = requireColumn(*truth, "t", "the time");
-    Truth tr;
-    const auto names = model.stackedStateNames();
-    std::vector<int> cols;
-    for (const auto& n : words(ini.getString("dataset", "truth_columns"))) {
-      const auto it = std::find(names.begin(), names.end(), n);
-      if (it == names.end())
-        throw InputError(ini.source() + ": [dataset] truth_columns: '" + n + "' is not a state of model '" +
-                         model.name() + "'");
-      tr.components.push_back(static_cast<int>(it - names.begin()));
-      cols.push_back(requireColumn(*truth, n, "[dataset] truth_columns"));
-    }
-    for (std::size_t r = 0; r < truth->rows.size(); ++r) {
-      const double t = truth->rows[r][static_cast<std::size_t>(tc)];
-      if (r) requireIncreasing(*truth, r, tr.times.back(), t);
-      Eigen::VectorXd z(static_cast<Eigen::Index>(cols.size()));
-      for (std::size_t i = 0; i < cols.size(); ++i) z[static_cast<Eigen::Index>(i)] = truth->rows[r][static_cast<std::size_t>(cols[i])];
-      tr.times.push_back(t);
-      tr.states.push_back(std::move(z));
-    }
-    out.truth = std::move(tr);
+// [dataset] truth: the true values of the named states, by time.
+void readTruth(const std::string& path, const IniDocument& ini, const Model& model, Dataset& out) {
+  const CsvTable truth = readCsv(path);
+  const int tc = requireColumn(truth, "t", "the time");
+  Truth tr;
+  const auto names = model.stackedStateNames();
+  std::vector<int> cols;
+  for (const auto& n : words(ini.getString("dataset", "truth_columns"))) {
+    const auto it = std::find(names.begin(), names.end(), n);
+    if (it == names.end())
+      throw InputError(ini.source() + ": [dataset] truth_columns: '" + n + "' is not a state of model '" +
+                       model.name() + "'");
+    tr.components.push_back(static_cast<int>(it - names.begin()));
+    cols.push_back(requireColumn(truth, n, "[dataset] truth_columns"));
   }
+  for (std::size_t r = 0; r < truth.rows.size(); ++r) {
+    const double t = truth.rows[r][static_cast<std::size_t>(tc)];
+    if (r) requireIncreasing(truth, r, tr.times.back(), t);
+    Eigen::VectorXd z(static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t i = 0; i < cols.size(); ++i) z[static_cast<Eigen::Index>(i)] = truth.rows[r][static_cast<std::size_t>(cols[i])];
+    tr.times.push_back(t);
+    tr.states.push_back(std::move(z));
+  }
+  out.truth = std::move(tr);
+}
+
+// [dataset] start_time (a number, or the truth's first time) and rows.
+void readStartAndRows(const IniDocument& ini, Dataset& out) {
   const std::string start = ini.getString("dataset", "start_time", "0");
   if (start == "truth") {
     if (!out.truth || out.truth->times.empty())
@@ -120,104 +115,134 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   if (rows != "measurements" && rows != "inputs")
     throw InputError(ini.source() + ": [dataset] rows = '" + rows + "': expected measurements or inputs");
   out.rows_at_inputs = rows == "inputs";
+}
 
-  // Inputs: rates held from each row's time, or increments over the interval
-  // ending at each row (held from the previous row's time, t0 for the first).
-  out.inputs.clear();
-  if (ini.has("dataset", "inputs")) {
-    const CsvTable in = readCsv(file("inputs"));
-    const int tc = requireColumn(in, "t", "the time");
-    std::vector<int> cols;
-    for (const auto& n : words(ini.getString("dataset", "input_columns")))
-      cols.push_back(requireColumn(in, n, "[dataset] input_columns"));
-    if (static_cast<int>(cols.size()) != model.dims().nu)
-      throw InputError(ini.source() + ": [dataset] input_columns names " + std::to_string(cols.size()) +
-                       " columns; model '" + model.name() + "' has " + std::to_string(model.dims().nu) + " inputs");
-    const std::string kind = ini.getString("dataset", "input_kind", "rates");
-    if (kind != "rates" && kind != "increments")
-      throw InputError(ini.source() + ": [dataset] input_kind = '" + kind + "': expected rates or increments");
-    double prev = out.t0;
-    for (std::size_t r = 0; r < in.rows.size(); ++r) {
-      const double t = in.rows[r][static_cast<std::size_t>(tc)];
-      if (r > 0 || kind == "increments" || t < prev) requireIncreasing(in, r, prev, t);  // rates may start at t0
-      Eigen::VectorXd u(model.dims().nu);
-      for (std::size_t i = 0; i < cols.size(); ++i) u[static_cast<Eigen::Index>(i)] = in.rows[r][static_cast<std::size_t>(cols[i])];
-      if (kind == "increments") {
-        out.inputs.push_back({prev, u / (t - prev)});
-      } else {
-        out.inputs.push_back({t, u});
-      }
-      prev = t;
+// Inputs: rates held from each row's time, or increments over the interval
+// ending at each row (held from the previous row's time, t0 for the first).
+void readInputs(const std::string& path, const IniDocument& ini, const Model& model, Dataset& out) {
+  const CsvTable in = readCsv(path);
+  const int tc = requireColumn(in, "t", "the time");
+  std::vector<int> cols;
+  for (const auto& n : words(ini.getString("dataset", "input_columns")))
+    cols.push_back(requireColumn(in, n, "[dataset] input_columns"));
+  if (static_cast<int>(cols.size()) != model.dims().nu)
+    throw InputError(ini.source() + ": [dataset] input_columns names " + std::to_string(cols.size()) +
+                     " columns; model '" + model.name() + "' has " + std::to_string(model.dims().nu) + " inputs");
+  const std::string kind = ini.getString("dataset", "input_kind", "rates");
+  if (kind != "rates" && kind != "increments")
+    throw InputError(ini.source() + ": [dataset] input_kind = '" + kind + "': expected rates or increments");
+  double prev = out.t0;
+  for (std::size_t r = 0; r < in.rows.size(); ++r) {
+    const double t = in.rows[r][static_cast<std::size_t>(tc)];
+    if (r > 0 || kind == "increments" || t < prev) requireIncreasing(in, r, prev, t);  // rates may start at t0
+    Eigen::VectorXd u(model.dims().nu);
+    for (std::size_t i = 0; i < cols.size(); ++i) u[static_cast<Eigen::Index>(i)] = in.rows[r][static_cast<std::size_t>(cols[i])];
+    if (kind == "increments") {
+      out.inputs.push_back({prev, u / (t - prev)});
+    } else {
+      out.inputs.push_back({t, u});
     }
-    // Increments: a last zero input makes the state at the last row's time.
-    if (kind == "increments" && !out.inputs.empty()) out.inputs.push_back({prev, Eigen::VectorXd::Zero(model.dims().nu)});
+    prev = t;
   }
+  // Increments: a last zero input makes the state at the last row's time.
+  if (kind == "increments" && !out.inputs.empty()) out.inputs.push_back({prev, Eigen::VectorXd::Zero(model.dims().nu)});
+}
 
-  // Measurements: one channel per row, named by a column (or the default).
+// How a measurement row names its channel: [dataset] channel_column,
+// channel_prefix, channel_by.
+struct ChannelColumn {
+  int column = -1;  // none: every row is the default channel
+  std::string prefix, by;
+  // The row's channel, or −1 with `problem` set.
+  int of(const CsvTable& m, const CsvRows::Row& row, const Model& model, std::string& problem) const {
+    if (column < 0) return 0;
+    const double v = row[static_cast<std::size_t>(column)];
+    const std::string name =
+        by == "index" ? "number " + formatDouble(v)
+                      : prefix + (v == std::floor(v) ? std::to_string(static_cast<long long>(v)) : formatDouble(v));
+    int channel = -1;
+    for (int c = 0; c < model.numChannels(); ++c)
+      if (by == "index" ? v == c : model.channel(c).name == name) channel = c;
+    if (channel < 0)
+      problem = "column '" + m.header[static_cast<std::size_t>(column)] + "': '" + formatDouble(v) + "' names channel '" +
+                name + "', which model '" + model.name() + "' does not have";
+    return channel;
+  }
+};
+
+ChannelColumn channelColumn(const IniDocument& ini, const CsvTable& m) {
+  ChannelColumn cc;
+  if (ini.has("dataset", "channel_column"))
+    cc.column = requireColumn(m, ini.getString("dataset", "channel_column"), "[dataset] channel_column");
+  cc.prefix = ini.getString("dataset", "channel_prefix", "");
+  cc.by = ini.getString("dataset", "channel_by", "name");
+  if (cc.by != "name" && cc.by != "index")
+    throw InputError(ini.source() + ": [dataset] channel_by = '" + cc.by + "': expected name or index");
+  return cc;
+}
+
+// Measurements: one channel per row, named by a column (or the default).
+void readMeasurements(const std::string& path, const IniDocument& ini, const Model& model, Dataset& out,
+                      BadRows bad_rows) {
+  std::vector<CsvRowError> errors;
+  const CsvTable m = readCsv(path, bad_rows == BadRows::Throw ? nullptr : &errors);
+  const int tc = requireColumn(m, "t", "the time");
+  std::vector<int> cols;
+  for (const auto& n : words(ini.getString("dataset", "measurement_columns")))
+    cols.push_back(requireColumn(m, n, "[dataset] measurement_columns"));
+  const ChannelColumn channels = channelColumn(ini, m);
+  std::size_t next_error = 0;
+  out.measurements.reserve(m.rows.size());
+  for (std::size_t r = 0; r < m.rows.size(); ++r) {
+    const int line = m.line_of_row[r];
+    if (bad_rows == BadRows::Stop && next_error < errors.size() && errors[next_error].line < line) break;
+    while (next_error < errors.size() && errors[next_error].line < line) ++next_error;
+    const auto& row = m.rows[r];
+    const double t = row[static_cast<std::size_t>(tc)];
+    std::string problem;
+    const int channel = channels.of(m, row, model, problem);
+    if (problem.empty() && static_cast<int>(cols.size()) != model.channel(channel).dim())
+      throw InputError(ini.source() + ": [dataset] measurement_columns names " + std::to_string(cols.size()) +
+                       " columns; channel '" + model.channel(channel).name + "' has " +
+                       std::to_string(model.channel(channel).dim()) + " components");
+    if (problem.empty() && !out.measurements.empty() && t < out.measurements.back().t)
+      problem = "column 't': time " + formatDouble(t) + " is before the previous row's " +
+                formatDouble(out.measurements.back().t);
+    if (problem.empty() && !(t > out.t0))
+      problem = "column 't': time " + formatDouble(t) + " is not after the start " + formatDouble(out.t0);
+    if (!problem.empty()) {
+      const std::string msg = m.source + ":" + std::to_string(line) + ": " + problem;
+      if (bad_rows == BadRows::Throw) throw InputError(msg);
+      errors.insert(errors.begin() + static_cast<long>(next_error), {line, msg});
+      ++next_error;
+      if (bad_rows == BadRows::Stop) break;
+      continue;
+    }
+    Eigen::VectorXd y(static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t i = 0; i < cols.size(); ++i) y[static_cast<Eigen::Index>(i)] = row[static_cast<std::size_t>(cols[i])];
+    out.measurements.push_back({t, y, channel, {}});
+  }
+  std::sort(errors.begin(), errors.end(), [](const CsvRowError& a, const CsvRowError& b) { return a.line < b.line; });
+  for (const auto& e : errors) {
+    out.row_errors.push_back(e.message);
+    if (bad_rows == BadRows::Stop) break;
+  }
+}
+
+// One CSV per sensor stream, as the config's [dataset] describes.
+void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
+  ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
+                                  "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
+                                  "start_time", "rows"});
+  const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
+  out.truth.reset();
+  if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0
+  readStartAndRows(ini, out);
+  out.inputs.clear();
+  if (ini.has("dataset", "inputs")) readInputs(file("inputs"), ini, model, out);
   out.measurements.clear();
   out.row_errors.clear();
-  if (ini.has("dataset", "measurements")) {
-    std::vector<CsvRowError> errors;
-    const CsvTable m = readCsv(file("measurements"), bad_rows == BadRows::Throw ? nullptr : &errors);
-    const int tc = requireColumn(m, "t", "the time");
-    std::vector<int> cols;
-    for (const auto& n : words(ini.getString("dataset", "measurement_columns")))
-      cols.push_back(requireColumn(m, n, "[dataset] measurement_columns"));
-    const bool by_column = ini.has("dataset", "channel_column");
-    const int cc = by_column ? requireColumn(m, ini.getString("dataset", "channel_column"), "[dataset] channel_column") : -1;
-    const std::string prefix = ini.getString("dataset", "channel_prefix", "");
-    const std::string by = ini.getString("dataset", "channel_by", "name");
-    if (by != "name" && by != "index")
-      throw InputError(ini.source() + ": [dataset] channel_by = '" + by + "': expected name or index");
-    std::size_t next_error = 0;
-    out.measurements.reserve(m.rows.size());
-    for (std::size_t r = 0; r < m.rows.size(); ++r) {
-      const int line = m.line_of_row[r];
-      if (bad_rows == BadRows::Stop && next_error < errors.size() && errors[next_error].line < line) break;
-      while (next_error < errors.size() && errors[next_error].line < line) ++next_error;
-      const auto& row = m.rows[r];
-      const double t = row[static_cast<std::size_t>(tc)];
-      std::string problem;
-      int channel = 0;
-      if (by_column) {
-        const double v = row[static_cast<std::size_t>(cc)];
-        const std::string name =
-            by == "index" ? "number " + formatDouble(v)
-                          : prefix + (v == std::floor(v) ? std::to_string(static_cast<long long>(v)) : formatDouble(v));
-        channel = -1;
-        for (int c = 0; c < model.numChannels(); ++c)
-          if (by == "index" ? v == c : model.channel(c).name == name) channel = c;
-        if (channel < 0)
-          problem = "column '" + m.header[static_cast<std::size_t>(cc)] + "': '" + formatDouble(v) +
-                    "' names channel '" + name + "', which model '" + model.name() + "' does not have";
-      }
-      if (problem.empty() && static_cast<int>(cols.size()) != model.channel(channel).dim())
-        throw InputError(ini.source() + ": [dataset] measurement_columns names " + std::to_string(cols.size()) +
-                         " columns; channel '" + model.channel(channel).name + "' has " +
-                         std::to_string(model.channel(channel).dim()) + " components");
-      if (problem.empty() && !out.measurements.empty() && t < out.measurements.back().t)
-        problem = "column 't': time " + formatDouble(t) + " is before the previous row's " +
-                  formatDouble(out.measurements.back().t);
-      if (problem.empty() && !(t > out.t0))
-        problem = "column 't': time " + formatDouble(t) + " is not after the start " + formatDouble(out.t0);
-      if (!problem.empty()) {
-        const std::string msg = m.source + ":" + std::to_string(line) + ": " + problem;
-        if (bad_rows == BadRows::Throw) throw InputError(msg);
-        errors.insert(errors.begin() + static_cast<long>(next_error), {line, msg});
-        ++next_error;
-        if (bad_rows == BadRows::Stop) break;
-        continue;
-      }
-      Eigen::VectorXd y(static_cast<Eigen::Index>(cols.size()));
-      for (std::size_t i = 0; i < cols.size(); ++i) y[static_cast<Eigen::Index>(i)] = row[static_cast<std::size_t>(cols[i])];
-      out.measurements.push_back({t, y, channel, {}});
-    }
-    std::sort(errors.begin(), errors.end(), [](const CsvRowError& a, const CsvRowError& b) { return a.line < b.line; });
-    for (const auto& e : errors) {
-      out.row_errors.push_back(e.message);
-      if (bad_rows == BadRows::Stop) break;
-    }
-  }
+  if (ini.has("dataset", "measurements")) readMeasurements(file("measurements"), ini, model, out, bad_rows);
 }
 }  // namespace
 
