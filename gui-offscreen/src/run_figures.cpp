@@ -22,136 +22,136 @@ Eigen::Index truthColumn(const Truth* truth, Eigen::Index stacked) {
 }
 }  // namespace
 
-std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
-                                         const Truth* truth, const std::string& dir,
-                                         const std::string& scenario_label, const std::optional<PlanView>& plan) {
-  namespace fs = std::filesystem;
-  std::vector<std::string> written;
+namespace {
+// One run's estimate of stacked state idx (minus the truth, for a
+// time-series state) with its 3σ band.
+void addStateSeries(Figure& f, const OfflineRun& run, Color c, const Truth* truth, Eigen::Index idx,
+                    Eigen::Index tcol, bool constant, bool angle) {
+  Series s{display(run.method), {}, {}, c, 2, false};
+  Band b{{}, {}, {}, c, 0.15};
+  std::optional<TimeMatcher> match;
+  if (truth) match.emplace(truth->times);
+  for (auto* v : {&s.x, &s.y, &b.x, &b.lo, &b.hi}) v->reserve(run.rows.size());
+  for (const auto& row : run.rows) {
+    double ref = 0;
+    if (!constant) {
+      const auto j = match->find(row.t);
+      if (!j) continue;  // no truth at this time: no error to draw
+      ref = truth->states[*j][tcol];
+    }
+    double v = row.mean[idx] - ref;
+    if (angle) v = wrapAngle(v);
+    const double sd = std::sqrt(row.covariance(idx, idx));
+    s.x.push_back(row.t);
+    s.y.push_back(v);
+    b.x.push_back(row.t);
+    b.lo.push_back(v - 3 * sd);
+    b.hi.push_back(v + 3 * sd);
+  }
+  f.bands.push_back(std::move(b));
+  f.series.push_back(std::move(s));
+}
+
+// A constant's estimates (with its truth), or a time-series state's errors.
+Figure stateFigure(const Model& model, const std::vector<OfflineRun>& runs, const Truth* truth, std::size_t i,
+                   const std::string& label) {
   const auto names = model.stackedStateNames();
-  const int nc = model.dims().nc;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    const auto idx = static_cast<Eigen::Index>(i);
-    const bool constant = static_cast<int>(i) >= nc;
-    const Eigen::Index tcol = truthColumn(truth, idx);
-    if (!constant && tcol < 0) continue;  // an error needs the truth of this state
-    const auto& angles = model.angleStates();
-    const bool angle = std::find(angles.begin(), angles.end(), static_cast<int>(idx)) != angles.end();
-    Figure f;
-    f.title = constant ? names[i] + ": estimate and 3-sigma band (" + scenario_label + ")"
-                       : names[i] + " error: estimate - truth, with 3-sigma band (" + scenario_label + ")";
-    f.xlabel = "time t (s)";
-    f.ylabel = constant ? names[i] : names[i] + " error";
-    for (std::size_t r = 0; r < runs.size(); ++r) {
-      const Color c = paletteColor(r);
-      Series s{display(runs[r].method), {}, {}, c, 2, false};
-      Band b{{}, {}, {}, c, 0.15};
-      std::optional<TimeMatcher> match;
-      if (truth) match.emplace(truth->times);
-      for (auto* v : {&s.x, &s.y, &b.x, &b.lo, &b.hi}) v->reserve(runs[r].rows.size());
-      for (const auto& row : runs[r].rows) {
-        double ref = 0;
-        if (!constant) {
-          const auto j = match->find(row.t);
-          if (!j) continue;  // no truth at this time: no error to draw
-          ref = truth->states[*j][tcol];
-        }
-        double v = row.mean[idx] - ref;
-        if (angle) v = wrapAngle(v);
-        const double sd = std::sqrt(row.covariance(idx, idx));
-        s.x.push_back(row.t);
-        s.y.push_back(v);
-        b.x.push_back(row.t);
-        b.lo.push_back(v - 3 * sd);
-        b.hi.push_back(v + 3 * sd);
-      }
-      f.bands.push_back(std::move(b));
-      f.series.push_back(std::move(s));
-    }
-    if (constant && tcol >= 0) {
-      Series t{"truth", truth->times, {}, Color{0, 0, 0}, 1, true};
-      for (const auto& z : truth->states) t.y.push_back(z[tcol]);
-      f.series.push_back(std::move(t));
-    } else if (!constant) {
-      f.series.push_back({"zero error", {runs.front().rows.front().t, runs.front().rows.back().t}, {0, 0},
-                          Color{0, 0, 0}, 1, true});
-    }
-    const std::string path = (fs::path(dir) / ("fig-" + names[i] + (constant ? "" : "-error") + ".png")).string();
-    savePng(f, path);
-    written.push_back(path);
+  const auto idx = static_cast<Eigen::Index>(i);
+  const bool constant = static_cast<int>(i) >= model.dims().nc;
+  const Eigen::Index tcol = truthColumn(truth, idx);
+  const auto& angles = model.angleStates();
+  const bool angle = std::find(angles.begin(), angles.end(), static_cast<int>(idx)) != angles.end();
+  Figure f;
+  f.title = constant ? names[i] + ": estimate and 3-sigma band (" + label + ")"
+                     : names[i] + " error: estimate - truth, with 3-sigma band (" + label + ")";
+  f.xlabel = "time t (s)";
+  f.ylabel = constant ? names[i] : names[i] + " error";
+  for (std::size_t r = 0; r < runs.size(); ++r)
+    addStateSeries(f, runs[r], paletteColor(r), truth, idx, tcol, constant, angle);
+  if (constant && tcol >= 0) {
+    Series t{"truth", truth->times, {}, Color{0, 0, 0}, 1, true};
+    for (const auto& z : truth->states) t.y.push_back(z[tcol]);
+    f.series.push_back(std::move(t));
+  } else if (!constant) {
+    f.series.push_back(
+        {"zero error", {runs.front().rows.front().t, runs.front().rows.back().t}, {0, 0}, Color{0, 0, 0}, 1, true});
   }
-  // The plan view: truth, estimates, landmarks.
-  if (plan) {
-    const Eigen::Index ix = plan->x, iy = plan->y;
-    Figure f;
-    f.equal_aspect = true;
-    f.title = "trajectory, plan view (" + scenario_label + ")";
-    f.xlabel = names.at(static_cast<std::size_t>(ix)) + " (m)";
-    f.ylabel = names.at(static_cast<std::size_t>(iy)) + " (m)";
-    f.robust_quantile = 0.0;
-    for (std::size_t r = 0; r < runs.size(); ++r) {
-      Series s{display(runs[r].method), {}, {}, paletteColor(r), 2, false};
-      for (const auto& row : runs[r].rows) {
-        s.x.push_back(row.mean[ix]);
-        s.y.push_back(row.mean[iy]);
-      }
-      f.series.push_back(std::move(s));
+  return f;
+}
+
+// The plan view: truth, estimates, other paths, landmarks.
+Figure planFigure(const std::vector<std::string>& names, const std::vector<OfflineRun>& runs, const Truth* truth,
+                  const PlanView& plan, const std::string& label) {
+  const Eigen::Index ix = plan.x, iy = plan.y;
+  Figure f;
+  f.equal_aspect = true;
+  f.title = "trajectory, plan view (" + label + ")";
+  f.xlabel = names.at(static_cast<std::size_t>(ix)) + " (m)";
+  f.ylabel = names.at(static_cast<std::size_t>(iy)) + " (m)";
+  f.robust_quantile = 0.0;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    Series s{display(runs[r].method), {}, {}, paletteColor(r), 2, false};
+    for (const auto& row : runs[r].rows) {
+      s.x.push_back(row.mean[ix]);
+      s.y.push_back(row.mean[iy]);
     }
-    const Eigen::Index tx = truthColumn(truth, ix), ty = truthColumn(truth, iy);
-    if (tx >= 0 && ty >= 0) {
-      Series t{"truth", {}, {}, Color{0, 0, 0}, 1, true};
-      for (const auto& z : truth->states) {
-        t.x.push_back(z[tx]);
-        t.y.push_back(z[ty]);
-      }
-      f.series.push_back(std::move(t));
-    }
-    for (const auto& [label, path] : plan->paths) {
-      Series p{label, {}, {}, Color{150, 150, 150}, 1, false};
-      for (const auto& q : path) {
-        p.x.push_back(q.x());
-        p.y.push_back(q.y());
-      }
-      f.series.push_back(std::move(p));
-    }
-    {
-      for (std::size_t b = 0; b < plan->landmarks.size(); ++b) {
-        // a small square marker per landmark, drawn as a closed series
-        const Eigen::Vector2d c = plan->landmarks[b];
-        Series m{b == 0 ? plan->landmark_label : "", {c.x() - 3, c.x() + 3, c.x() + 3, c.x() - 3, c.x() - 3},
-                 {c.y() - 3, c.y() - 3, c.y() + 3, c.y() + 3, c.y() - 3}, Color{200, 0, 0}, 3, false};
-        f.series.push_back(std::move(m));
-      }
-    }
-    // Headroom above the data for the legend (it would hide a beacon).
-    double lo = INFINITY, hi = -INFINITY;
-    for (const auto& s : f.series)
-      for (double y : s.y) lo = std::min(lo, y), hi = std::max(hi, y);
-    if (hi > lo) f.ylim = std::make_pair(lo - 0.05 * (hi - lo), hi + 0.55 * (hi - lo));
-    const std::string path = (fs::path(dir) / "fig-trajectory.png").string();
-    savePng(f, path);
-    written.push_back(path);
-    // The planar position error over time, when the truth has the position.
-    if (tx >= 0 && ty >= 0) {
-      Figure e;
-      e.title = "position error |estimate - truth| (" + scenario_label + ")";
-      e.xlabel = "time t (s)";
-      e.ylabel = "position error (m)";
-      for (std::size_t r = 0; r < runs.size(); ++r) {
-        Series s{display(runs[r].method), {}, {}, paletteColor(r), 2, false};
-        TimeMatcher match(truth->times);
-        for (const auto& row : runs[r].rows) {
-          const auto j = match.find(row.t);
-          if (!j) continue;
-          s.x.push_back(row.t);
-          s.y.push_back(std::hypot(row.mean[ix] - truth->states[*j][tx], row.mean[iy] - truth->states[*j][ty]));
-        }
-        e.series.push_back(std::move(s));
-      }
-      const std::string epath = (fs::path(dir) / "fig-position-error.png").string();
-      savePng(e, epath);
-      written.push_back(epath);
-    }
+    f.series.push_back(std::move(s));
   }
+  const Eigen::Index tx = truthColumn(truth, ix), ty = truthColumn(truth, iy);
+  if (tx >= 0 && ty >= 0) {
+    Series t{"truth", {}, {}, Color{0, 0, 0}, 1, true};
+    for (const auto& z : truth->states) {
+      t.x.push_back(z[tx]);
+      t.y.push_back(z[ty]);
+    }
+    f.series.push_back(std::move(t));
+  }
+  for (const auto& [path_label, path] : plan.paths) {
+    Series p{path_label, {}, {}, Color{150, 150, 150}, 1, false};
+    for (const auto& q : path) {
+      p.x.push_back(q.x());
+      p.y.push_back(q.y());
+    }
+    f.series.push_back(std::move(p));
+  }
+  for (std::size_t b = 0; b < plan.landmarks.size(); ++b) {
+    // a small square marker per landmark, drawn as a closed series
+    const Eigen::Vector2d c = plan.landmarks[b];
+    Series m{b == 0 ? plan.landmark_label : "", {c.x() - 3, c.x() + 3, c.x() + 3, c.x() - 3, c.x() - 3},
+             {c.y() - 3, c.y() - 3, c.y() + 3, c.y() + 3, c.y() - 3}, Color{200, 0, 0}, 3, false};
+    f.series.push_back(std::move(m));
+  }
+  // Headroom above the data for the legend (it would hide a beacon).
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& s : f.series)
+    for (double y : s.y) lo = std::min(lo, y), hi = std::max(hi, y);
+  if (hi > lo) f.ylim = std::make_pair(lo - 0.05 * (hi - lo), hi + 0.55 * (hi - lo));
+  return f;
+}
+
+// The planar position error over time (the truth has the position).
+Figure positionErrorFigure(const std::vector<OfflineRun>& runs, const Truth& truth, Eigen::Index ix, Eigen::Index iy,
+                           Eigen::Index tx, Eigen::Index ty, const std::string& label) {
+  Figure e;
+  e.title = "position error |estimate - truth| (" + label + ")";
+  e.xlabel = "time t (s)";
+  e.ylabel = "position error (m)";
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    Series s{display(runs[r].method), {}, {}, paletteColor(r), 2, false};
+    TimeMatcher match(truth.times);
+    for (const auto& row : runs[r].rows) {
+      const auto j = match.find(row.t);
+      if (!j) continue;
+      s.x.push_back(row.t);
+      s.y.push_back(std::hypot(row.mean[ix] - truth.states[*j][tx], row.mean[iy] - truth.states[*j][ty]));
+    }
+    e.series.push_back(std::move(s));
+  }
+  return e;
+}
+
+// Histograms of the per-update latency; none without two updates.
+std::optional<Figure> latencyFigure(const std::vector<OfflineRun>& runs, const std::string& label) {
   std::vector<std::pair<std::string, std::vector<double>>> lat;
   for (const auto& r : runs)
     if (r.update_seconds.size() > 1) {
@@ -159,13 +159,35 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
       for (double s : r.update_seconds) us.push_back(std::log10(std::max(s * 1e6, 1e-3)));
       lat.emplace_back(display(r.method), us);
     }
-  if (!lat.empty()) {
-    Figure h = histogram(lat, 40, "per-update latency (" + scenario_label + ")",
-                         "log10 of latency in microseconds (1 = 10 us, 2 = 100 us); slowest 1% not shown");
-    const std::string path = (fs::path(dir) / "fig-latency.png").string();
-    savePng(h, path);
+  if (lat.empty()) return std::nullopt;
+  return histogram(lat, 40, "per-update latency (" + label + ")",
+                   "log10 of latency in microseconds (1 = 10 us, 2 = 100 us); slowest 1% not shown");
+}
+}  // namespace
+
+std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
+                                         const Truth* truth, const std::string& dir,
+                                         const std::string& scenario_label, const std::optional<PlanView>& plan) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> written;
+  const auto save = [&](const Figure& f, const std::string& name) {
+    const std::string path = (fs::path(dir) / name).string();
+    savePng(f, path);
     written.push_back(path);
+  };
+  const auto names = model.stackedStateNames();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const bool constant = static_cast<int>(i) >= model.dims().nc;
+    if (!constant && truthColumn(truth, static_cast<Eigen::Index>(i)) < 0) continue;  // an error needs the truth
+    save(stateFigure(model, runs, truth, i, scenario_label), "fig-" + names[i] + (constant ? "" : "-error") + ".png");
   }
+  if (plan) {
+    save(planFigure(names, runs, truth, *plan, scenario_label), "fig-trajectory.png");
+    const Eigen::Index tx = truthColumn(truth, plan->x), ty = truthColumn(truth, plan->y);
+    if (tx >= 0 && ty >= 0)
+      save(positionErrorFigure(runs, *truth, plan->x, plan->y, tx, ty, scenario_label), "fig-position-error.png");
+  }
+  if (const auto latency = latencyFigure(runs, scenario_label)) save(*latency, "fig-latency.png");
   return written;
 }
 
