@@ -207,19 +207,15 @@ Color paletteColor(std::size_t i) {
   return p[i % 10];
 }
 
-void savePng(const Figure& fig, const std::string& path, int width, int height) {
-  // Long runs (10⁵ points and more) are decimated first to what `width`
-  // pixels can show: drawing cost and the axis quantiles then do not grow
-  // with the run.
-  std::vector<Series> series;
-  std::vector<Band> bands;
-  for (const auto& s : fig.series) series.push_back(decimated(s, 2 * width));
-  for (const auto& b : fig.bands) bands.push_back(decimated(b, 2 * width));
-  mrpt::img::CImage img(width, height, mrpt::img::CH_RGB);
-  img.filledRectangle(0, 0, width - 1, height - 1, TColor(255, 255, 255));
-  img.selectTextFont("6x13");
+namespace {
+// The axes of a figure: data ranges (robust quantiles unless bars or limits
+// say otherwise), nice ticks, the plot area in pixels, equal aspect.
+struct Layout {
+  Axes ax;
+  Ticks xt, yt;
+};
 
-  // ---- ranges --------------------------------------------------------------
+Layout layoutAxes(const Figure& fig, const std::vector<Series>& series, int width, int height) {
   double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
   std::vector<double> ys;
   for (const auto& s : series)
@@ -245,14 +241,13 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
   yhi += pad;
   if (fig.xlim) xmin = fig.xlim->first, xmax = fig.xlim->second;
   if (fig.ylim) ylo = fig.ylim->first, yhi = fig.ylim->second;
-  Ticks xt = niceTicks(xmin, xmax, 9), yt = niceTicks(ylo, yhi, 8);
+  Layout l{{}, niceTicks(xmin, xmax, 9), niceTicks(ylo, yhi, 8)};
   const bool x_tight = !fig.bars.empty() || fig.xlim.has_value();
-  Axes ax{0, 0, 0, 0, x_tight ? xmin : xt.lo, x_tight ? xmax : xt.hi, fig.ylim ? ylo : yt.lo,
-          fig.ylim ? yhi : yt.hi};
-
-  // ---- layout ---------------------------------------------------------------
+  l.ax = Axes{0, 0, 0, 0, x_tight ? xmin : l.xt.lo, x_tight ? xmax : l.xt.hi, fig.ylim ? ylo : l.yt.lo,
+              fig.ylim ? yhi : l.yt.hi};
   int label_w = 0;
-  for (double v : yt.values) label_w = std::max(label_w, static_cast<int>(formatTick(v, yt.step).size()));
+  for (double v : l.yt.values) label_w = std::max(label_w, static_cast<int>(formatTick(v, l.yt.step).size()));
+  Axes& ax = l.ax;
   ax.left = 24 + (label_w + 1) * kCharW;
   ax.top = 56;
   ax.right = width - 24;
@@ -265,29 +260,35 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
     ax.x1 = cx + 0.5 * u * (ax.right - ax.left);
     ax.y0 = cy - 0.5 * u * (ax.bottom - ax.top);
     ax.y1 = cy + 0.5 * u * (ax.bottom - ax.top);
-    xt = niceTicks(ax.x0, ax.x1, 9);
-    yt = niceTicks(ax.y0, ax.y1, 8);
+    l.xt = niceTicks(ax.x0, ax.x1, 9);
+    l.yt = niceTicks(ax.y0, ax.y1, 8);
   }
+  return l;
+}
 
-  // ---- grid and ticks -------------------------------------------------------
-  const TColor grid(225, 225, 225), axis(60, 60, 60), text(30, 30, 30);
-  for (double v : xt.values) {
+const TColor kGrid(225, 225, 225), kAxis(60, 60, 60), kText(30, 30, 30);
+
+void drawGrid(mrpt::img::CImage& img, const Layout& l) {
+  const Axes& ax = l.ax;
+  for (double v : l.xt.values) {
     if (v < ax.x0 - 1e-12 || v > ax.x1 + 1e-12) continue;
     const int x = static_cast<int>(std::lround(ax.px(v)));
-    img.line(x, ax.top, x, ax.bottom, grid);
-    img.line(x, ax.bottom, x, ax.bottom + 5, axis);
-    centeredText(img, x, ax.bottom + 9, formatTick(v, xt.step), text);
+    img.line(x, ax.top, x, ax.bottom, kGrid);
+    img.line(x, ax.bottom, x, ax.bottom + 5, kAxis);
+    centeredText(img, x, ax.bottom + 9, formatTick(v, l.xt.step), kText);
   }
-  for (double v : yt.values) {
+  for (double v : l.yt.values) {
     if (v < ax.y0 - 1e-12 || v > ax.y1 + 1e-12) continue;
     const int y = static_cast<int>(std::lround(ax.py(v)));
-    img.line(ax.left, y, ax.right, y, grid);
-    img.line(ax.left - 5, y, ax.left, y, axis);
-    const std::string s = formatTick(v, yt.step);
-    img.textOut(ax.left - 8 - static_cast<int>(s.size()) * kCharW, y - kCharH / 2, s, text);
+    img.line(ax.left, y, ax.right, y, kGrid);
+    img.line(ax.left - 5, y, ax.left, y, kAxis);
+    const std::string s = formatTick(v, l.yt.step);
+    img.textOut(ax.left - 8 - static_cast<int>(s.size()) * kCharW, y - kCharH / 2, s, kText);
   }
+}
 
-  // ---- data -----------------------------------------------------------------
+void drawData(mrpt::img::CImage& img, const Axes& ax, const Figure& fig, const std::vector<Series>& series,
+              const std::vector<Band>& bands) {
   for (const auto& b : bands) drawBand(img, ax, b);
   for (const auto& b : fig.bars) {
     const int x0 = static_cast<int>(std::lround(ax.px(b.x0))), x1 = static_cast<int>(std::lround(ax.px(b.x1)));
@@ -296,36 +297,55 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
       for (int row = y; row < ax.bottom; ++row) blend(img, col, row, b.color, 0.55);
   }
   for (const auto& s : series) drawSeries(img, ax, s);
-  img.rectangle(ax.left, ax.top, ax.right, ax.bottom, axis);
+  img.rectangle(ax.left, ax.top, ax.right, ax.bottom, kAxis);
+}
 
-  // ---- text -----------------------------------------------------------------
-  img.selectTextFont("10x20");
-  centeredText(img, (ax.left + ax.right) / 2, 8, fig.title, text, 10);
-  img.selectTextFont("6x13");
-  centeredText(img, (ax.left + ax.right) / 2, height - 26, fig.xlabel, text);
-  img.textOut(ax.left, ax.top - 20, fig.ylabel, text);
-
+// The legend, top right, a line sample and the label of each labelled series.
+void drawLegend(mrpt::img::CImage& img, const Axes& ax, const std::vector<Series>& series) {
   std::vector<const Series*> labelled;
   for (const auto& s : series)
     if (!s.label.empty()) labelled.push_back(&s);
-  if (fig.legend && !labelled.empty()) {
-    int w = 0;
-    for (const auto* s : labelled) w = std::max(w, static_cast<int>(s->label.size()));
-    const int lw = 44 + w * kCharW, lh = 8 + 18 * static_cast<int>(labelled.size());
-    const int x0 = ax.right - lw - 10, y0 = ax.top + 10;
-    img.filledRectangle(x0, y0, x0 + lw, y0 + lh, TColor(255, 255, 255));
-    img.rectangle(x0, y0, x0 + lw, y0 + lh, TColor(170, 170, 170));
-    for (std::size_t i = 0; i < labelled.size(); ++i) {
-      const int y = y0 + 12 + 18 * static_cast<int>(i);
-      Series sample = *labelled[i];
-      Axes lax{x0, y0, x0 + lw, y0 + lh, 0, 1, 0, 1};
-      sample.x = {static_cast<double>(x0 + 8 - x0) / lw, static_cast<double>(x0 + 34 - x0) / lw};
-      const double yy = 1.0 - static_cast<double>(y - y0) / lh;
-      sample.y = {yy, yy};
-      drawSeries(img, lax, sample);
-      img.textOut(x0 + 40, y - kCharH / 2, labelled[i]->label, text);
-    }
+  if (labelled.empty()) return;
+  int w = 0;
+  for (const auto* s : labelled) w = std::max(w, static_cast<int>(s->label.size()));
+  const int lw = 44 + w * kCharW, lh = 8 + 18 * static_cast<int>(labelled.size());
+  const int x0 = ax.right - lw - 10, y0 = ax.top + 10;
+  img.filledRectangle(x0, y0, x0 + lw, y0 + lh, TColor(255, 255, 255));
+  img.rectangle(x0, y0, x0 + lw, y0 + lh, TColor(170, 170, 170));
+  for (std::size_t i = 0; i < labelled.size(); ++i) {
+    const int y = y0 + 12 + 18 * static_cast<int>(i);
+    Series sample = *labelled[i];
+    Axes lax{x0, y0, x0 + lw, y0 + lh, 0, 1, 0, 1};
+    sample.x = {static_cast<double>(x0 + 8 - x0) / lw, static_cast<double>(x0 + 34 - x0) / lw};
+    const double yy = 1.0 - static_cast<double>(y - y0) / lh;
+    sample.y = {yy, yy};
+    drawSeries(img, lax, sample);
+    img.textOut(x0 + 40, y - kCharH / 2, labelled[i]->label, kText);
   }
+}
+}  // namespace
+
+void savePng(const Figure& fig, const std::string& path, int width, int height) {
+  // Long runs (10⁵ points and more) are decimated first to what `width`
+  // pixels can show: drawing cost and the axis quantiles then do not grow
+  // with the run.
+  std::vector<Series> series;
+  std::vector<Band> bands;
+  for (const auto& s : fig.series) series.push_back(decimated(s, 2 * width));
+  for (const auto& b : fig.bands) bands.push_back(decimated(b, 2 * width));
+  mrpt::img::CImage img(width, height, mrpt::img::CH_RGB);
+  img.filledRectangle(0, 0, width - 1, height - 1, TColor(255, 255, 255));
+  img.selectTextFont("6x13");
+  const Layout layout = layoutAxes(fig, series, width, height);
+  const Axes& ax = layout.ax;
+  drawGrid(img, layout);
+  drawData(img, ax, fig, series, bands);
+  img.selectTextFont("10x20");
+  centeredText(img, (ax.left + ax.right) / 2, 8, fig.title, kText, 10);
+  img.selectTextFont("6x13");
+  centeredText(img, (ax.left + ax.right) / 2, height - 26, fig.xlabel, kText);
+  img.textOut(ax.left, ax.top - 20, fig.ylabel, kText);
+  if (fig.legend) drawLegend(img, ax, series);
   if (!img.saveToFile(path)) throw std::runtime_error(path + ": cannot write the PNG");
 }
 
