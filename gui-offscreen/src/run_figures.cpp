@@ -191,4 +191,20 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
   return written;
 }
 
+std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const std::string& dir) {
+  const Model& model = *r.model;
+  std::optional<PlanView> plan;
+  const auto names = model.stackedStateNames();
+  const auto px = std::find(names.begin(), names.end(), "px"), py = std::find(names.begin(), names.end(), "py");
+  if (px != names.end() && py != names.end()) {
+    plan = PlanView{px - names.begin(), py - names.begin(), model.landmarks(), "beacons", {}};
+    if (r.dead_reckoning) {
+      std::vector<Eigen::Vector2d> path;
+      for (const auto& row : r.dead_reckoning->rows) path.emplace_back(row.mean[plan->x], row.mean[plan->y]);
+      plan->paths.emplace_back("dead reckoning", std::move(path));
+    }
+  }
+  return writeRunFigures(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan);
+}
+
 }  // namespace gssm::plot

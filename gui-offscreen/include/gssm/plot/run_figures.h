@@ -12,6 +12,7 @@
 #include "gssm/core/data.h"
 #include "gssm/model/model.h"
 #include "gssm/analysis/offline.h"
+#include "gssm/io/process.h"
 
 namespace gssm::plot {
 
@@ -32,5 +33,10 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
                                          const Truth* truth, const std::string& dir,
                                          const std::string& scenario_label,
                                          const std::optional<PlanView>& plan = std::nullopt);
+
+/// The figures of a processed dataset (gssm-process's, gssm.process's):
+/// writeRunFigures with a plan view when the model has px and py (its
+/// landmarks, and the dead reckoning when the rows are at inputs).
+std::vector<std::string> writeProcessFigures(const io::ProcessResult& result, const std::string& dir);
 
 }  // namespace gssm::plot

@@ -1,0 +1,136 @@
+#include "gssm/io/process.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "gssm/checkpoint/checkpoint.h"
+#include "gssm/core/error.h"
+#include "gssm/io/config.h"
+#include "gssm/io/run_files.h"
+
+namespace gssm::io {
+
+namespace fs = std::filesystem;
+
+bool ProcessOptions::validate(std::string* why) const {
+  auto fail = [&](const std::string& w) {
+    if (why) *why = "process: " + w;
+    return false;
+  };
+  if (data_dir.empty()) return fail("no dataset folder (data_dir)");
+  if (out_dir.empty()) return fail("no output folder (out_dir)");
+  if (window && (*window < 1 || *window > 1000000)) return fail("window = " + std::to_string(*window) + ": expected 1..10^6");
+  if (checkpoint_every > 1000000000) return fail("checkpoint_every is out of range");
+  return true;
+}
+
+namespace {
+// A run resumed into another output folder continues the files its
+// checkpoint's folder holds: copied here first (the checkpoint records how
+// far they got; RunFiles cuts them there).
+void continueOutputsIn(const std::string& out, const std::string& checkpoint, Method method) {
+  const fs::path from = fs::absolute(checkpoint).parent_path();
+  if (fs::equivalent(from, fs::absolute(out))) return;
+  for (const auto& name : {RunFiles::estimatesName(method), RunFiles::recordsName(method)}) {
+    if (!fs::exists(from / name))
+      throw CheckpointError(checkpoint + ": cannot resume: " + (from / name).string() +
+                            " (the output written up to the checkpoint) is missing");
+    fs::copy_file(from / name, fs::path(out) / name, fs::copy_options::overwrite_existing);
+  }
+}
+
+// The methods to run: as asked, or every one; with resume, the checkpoint's
+// one streaming method.
+std::vector<Method> methodsToRun(const ProcessOptions& o, const Model& model) {
+  std::vector<Method> methods = o.methods;
+  if (methods.empty() && o.resume.empty())
+    for (const auto& info : gssm::methods()) methods.push_back(info.method);
+  if (o.resume.empty()) return methods;
+  CheckpointInfo info;
+  restoreCheckpoint(model, o.resume, &info);  // throws a clear error if unusable
+  if (methods.empty()) methods = {info.method};
+  if (methods.size() != 1 || !methodInfo(methods[0]).streaming)
+    throw InvalidArgument(std::string("resume: resumes one streaming method; the checkpoint's is '") +
+                          methodName(info.method) + "'");
+  if (methods[0] != info.method)
+    throw CheckpointError(o.resume + ": cannot resume this run: it was written by method '" +
+                          methodName(info.method) + "', this run is '" + methodName(methods[0]) + "'");
+  return methods;
+}
+
+// The dataset, and what its bad rows did (skipped, or stopped the reading).
+void readData(const ProcessOptions& o, const Model& model, ProcessResult& r, const ProcessCallbacks& cb) {
+  readDatasetData(o.data_dir, model, r.dataset, o.skip_bad_rows ? BadRows::Skip : BadRows::Stop, &r.config);
+  if (o.skip_bad_rows) r.status.skipped = r.dataset.row_errors;
+  else if (!r.dataset.row_errors.empty()) r.status = {true, r.dataset.row_errors.front(), {}};
+  if (cb.skipped)
+    for (const auto& e : r.status.skipped) cb.skipped(e);
+  if (r.dataset.measurements.empty())
+    throw InputError(r.status.partial ? r.status.stopped_at : o.data_dir + ": no measurements");
+}
+
+// One method's run, its estimates written as it goes (with checkpoints, the
+// records the metrics need too).
+OfflineRun runMethod(const ProcessOptions& o, const Model& model, const ProcessResult& r, EstimatorOptions options,
+                     Method method, const ProcessCallbacks& cb) {
+  options.method = method;
+  const bool streaming = methodInfo(method).streaming;
+  RunFiles files(o.out_dir, model, method, streaming && (o.checkpoint_every > 0 || !o.resume.empty()));
+  StreamingCheckpoints checkpoints;
+  if (streaming) {
+    checkpoints = {o.checkpoint_every
+                       ? (fs::path(o.out_dir) / ("checkpoint-" + std::string(methodName(method)) + ".ckpt")).string()
+                       : "",
+                   o.checkpoint_every, o.resume, &files};
+    if (!o.resume.empty()) continueOutputsIn(o.out_dir, o.resume, method);
+  }
+  std::function<void(std::size_t, std::size_t)> progress;
+  if (cb.progress) progress = [&cb, method](std::size_t done, std::size_t total) { cb.progress(method, done, total); };
+  const RowTimes rows = r.dataset.rows_at_inputs ? RowTimes::Inputs : RowTimes::Measurements;
+  OfflineRun run = runOffline(model, options, r.dataset.measurements, r.dataset.inputs, progress, checkpoints, rows);
+  if (!streaming)
+    for (const auto& row : run.rows) files.row(row);
+  files.finish();
+  return run;
+}
+
+// Rows at inputs on a planar model: the filter with no measurements.
+std::optional<OfflineRun> deadReckoning(const Model& model, const ProcessResult& r, EstimatorOptions options) {
+  const auto names = model.stackedStateNames();
+  const bool planar = std::count(names.begin(), names.end(), "px") && std::count(names.begin(), names.end(), "py");
+  if (!planar || !r.dataset.rows_at_inputs) return std::nullopt;
+  options.method = Method::Ekf;
+  return runOffline(model, options, {}, r.dataset.inputs, {}, {}, RowTimes::Inputs);
+}
+}  // namespace
+
+ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb) {
+  std::string why;
+  if (!o.validate(&why)) throw InvalidArgument(why);
+  ProcessResult r;
+  r.config = readScenario(o.data_dir, o.config);
+  std::shared_ptr<const Model> model(makeModel(r.config, o.data_dir));
+  r.model = model;
+  const std::vector<Method> methods = methodsToRun(o, *model);
+  readData(o, *model, r, cb);
+  fs::create_directories(o.out_dir);
+  EstimatorOptions options = estimatorOptions(r.config, *model);
+  options.t0 = r.dataset.t0;
+  if (o.window) options.fixed_lag.window = options.paper_window.window = *o.window;
+  const Truth* truth = r.dataset.truth ? &*r.dataset.truth : nullptr;
+  for (const Method method : methods) {
+    r.runs.push_back(runMethod(o, *model, r, options, method, cb));
+    r.metrics.push_back(computeMetrics(*model, r.runs.back(), truth));
+    r.files.push_back((fs::path(o.out_dir) / RunFiles::estimatesName(method)).string());
+    if (cb.finished) cb.finished(r.runs.back(), r.metrics.back());
+  }
+  const std::string json = (fs::path(o.out_dir) / "metrics.json").string();
+  std::ofstream(json) << metricsJson(r.metrics, o.data_dir, r.status);
+  r.files.push_back(json);
+  r.label = r.config.getString("scenario", "name", fs::path(o.data_dir).filename().string());
+  r.dead_reckoning = deadReckoning(*model, r, options);
+  return r;
+}
+
+}  // namespace gssm::io
