@@ -31,17 +31,19 @@ from ._gssm import (
     UpdateReport,
     StateEstimate,
     Run,
+    Method,
+    ProcessResult,
     methods,
     checkpoint_info,
 )
 from . import models, io, analysis  # noqa: E402  (after _gssm: they wrap it)
-from ._options import make_options  # noqa: E402
+from ._options import make_options, method_of  # noqa: E402
 
 __all__ = [
     "Error", "InvalidArgument", "InputError", "NumericalError", "CheckpointError",
     "Estimator", "EstimatorOptions", "EkfOptions", "SmootherOptions", "BatchOptions",
-    "EstimatorReport", "UpdateReport", "StateEstimate", "Run",
-    "methods", "make_options", "make_estimator", "run", "restore", "checkpoint_info",
+    "EstimatorReport", "UpdateReport", "StateEstimate", "Run", "Method", "ProcessResult",
+    "methods", "make_options", "make_estimator", "run", "process", "restore", "checkpoint_info",
     "simulate", "models", "io", "analysis",
 ]
 
@@ -74,7 +76,7 @@ def run(model, data, method="fixed-lag", *, options=None, rows_at_inputs=None, p
     The result equals gssm-process's estimates bit for bit.
     """
     if options is None:
-        options = _dataset_options(data, model, method)
+        options = _dataset_options(data, model, method_of(method).text)
     o = make_options(method, options=options, **settings)
     o.validate(model)
     return _gssm.run_dataset(model, data, o, rows_at_inputs, progress)
@@ -113,6 +115,39 @@ def simulate(scenario="paper", seed=1, steps=400, **kwargs):
                                   % (sorted(kwargs), scenario))
         return _gssm.io.simulate_scenario(scenario, seed, steps)
     return _gssm.io.simulate_model(scenario, seed, steps, **kwargs)
+
+
+def process(data, out, *, method="all", config=None, window=None, checkpoint_every=None, resume=None,
+            skip_bad_rows=False, figures=True, progress=None):
+    """gssm-process in this process: runs estimators over a dataset folder and
+    writes estimates-<method>.csv, metrics.json and (figures=True) the fig-*.png
+    into `out`, the same files gssm-process writes. Returns a gssm.ProcessResult
+    (its runs, metrics.json's text, the files written; partial and stopped_at
+    when a bad row stopped it, after what came before was processed).
+
+    method: "all" (with resume=: the checkpoint's), a gssm.Method or its
+    name, or a list of them. config: an INI file instead of the folder's
+    scenario.ini. window: fixed-lag and paper-window states. checkpoint_every,
+    resume: as gssm-process's --checkpoint-every, --resume. progress: a
+    callable(method, done, total), called from the loop. Errors are gssm.Error
+    subclasses naming file, line and column, as gssm-process prints them.
+    """
+    if isinstance(method, str) and method == "all":
+        methods = []
+    elif isinstance(method, (list, tuple)):
+        methods = [method_of(m) for m in method]
+    else:
+        methods = [method_of(method)]
+    result = _gssm.process_dataset(str(data), str(out), methods, str(config or ""), window,
+                                   int(checkpoint_every or 0), str(resume or ""), bool(skip_bad_rows), progress)
+    if figures:
+        try:
+            from . import _plot
+        except ImportError as e:
+            raise Error("gssm.process: figures need the gssm._plot extension (built with the apps, "
+                        "GSSM_BUILD_APPS=ON); pass figures=False (%s)" % e) from e
+        result._add_files(_plot.write_process_figures(result, str(out)))
+    return result
 
 
 def _restore_pickled(model, data):

@@ -1,7 +1,12 @@
 """EstimatorOptions from keyword arguments (make_estimator, run)."""
 from . import _gssm
 
-_GROUPS = ("ekf", "smoother", "batch")
+
+def method_of(method):
+    """A gssm.Method from itself or its name ("fixed-lag")."""
+    if isinstance(method, _gssm.Method):
+        return method
+    return _gssm.Method.named(str(method))
 
 
 def make_options(method="fixed-lag", *, options=None, window=None, ordering=None, t0=None,
@@ -16,19 +21,20 @@ def make_options(method="fixed-lag", *, options=None, window=None, ordering=None
     BatchOptions (e.g. smoother={"relinearize_threshold": 1e-3}).
     Unknown names raise gssm.InvalidArgument.
     """
+    m = method_of(method)
     if options is None:
-        o = _gssm.EstimatorOptions(method)
+        o = _gssm.EstimatorOptions(m.text)
     else:
         import copy
         o = copy.deepcopy(options)
-        o.method = method
+        o.method = m.text
     if window is not None:
-        if method == "paper-window":
+        if m == _gssm.Method.PAPER_WINDOW:
             o.paper_window_window = int(window)
-        elif method == "fixed-lag":
+        elif m == _gssm.Method.FIXED_LAG:
             o.fixed_lag_window = int(window)
         else:
-            raise _gssm.InvalidArgument("window= is a setting of fixed-lag and paper-window, not of '%s'" % method)
+            raise _gssm.InvalidArgument("window= is a setting of fixed-lag and paper-window, not of '%s'" % m.text)
     if ordering is not None:
         o.ordering = ordering
     if t0 is not None:

@@ -1,5 +1,5 @@
 """Campaigns on Dask: Monte Carlo over seeds × scenarios × methods, and
-gssm-process over a folder of logs, on any dask.distributed cluster.
+gssm.process over a folder of logs, on any dask.distributed cluster.
 
     import gssm.campaign as gc
     res = gc.monte_carlo("paper", seeds=100)        # a LocalCluster on this machine
@@ -15,8 +15,6 @@ number of workers.
 import contextlib
 import json
 import os
-import shutil
-import subprocess
 import sys
 import time
 import uuid
@@ -165,7 +163,7 @@ def save_monte_carlo(result, out, command=None):
     for i, state in enumerate(result.state_names):
         fig, ax = plt.subplots(figsize=(8, 4.5), dpi=100)
         for m in result.methods:
-            style = "--" if m.method == "batch" else "-"
+            style = "-" if _gssm.Method.named(m.method).streaming else "--"  # the batch uses all the data
             ax.plot(m.times, m.rmse_over_time[:, i], style, lw=1.5, label=m.method)
         ax.set_title("RMSE of %s over %d seeds (%s)" % (state, result.seeds, result.scenario))
         ax.set_xlabel("time t (s)")
@@ -180,52 +178,37 @@ def save_monte_carlo(result, out, command=None):
     return paths
 
 
-def _gssm_process_path(executable):
-    if executable:
-        return executable
-    if os.environ.get("GSSM_PROCESS"):
-        return os.environ["GSSM_PROCESS"]
+def _process_one(data, out, settings):
+    """One log through gssm.process in this (worker) process; its exit code
+    as gssm-process would give it: 0, 3 when a bad row stopped it partway,
+    1 when it failed (the error's message in "error")."""
+    from . import process
     try:
-        from ._paths import GSSM_PROCESS
-        if GSSM_PROCESS and os.path.exists(GSSM_PROCESS):
-            return GSSM_PROCESS
-    except ImportError:
-        pass
-    found = shutil.which("gssm-process")
-    if found:
-        return found
-    raise _gssm.Error("gssm-process not found: build the apps (GSSM_BUILD_APPS=ON), put it on PATH, "
-                      "or pass executable= / set GSSM_PROCESS")
+        r = process(data, out, **settings)
+    except _gssm.Error as e:
+        return {"data": data, "out": out, "returncode": 1, "error": str(e), "metrics": None, "files": []}
+    return {"data": data, "out": out, "returncode": 3 if r.partial else 0, "error": r.stopped_at,
+            "metrics": json.loads(r.metrics_json), "files": list(r.files)}
 
 
-def _process_one(executable, data, out, args):
-    proc = subprocess.run([executable, "--data", data, "--out", out] + list(args), capture_output=True, text=True)
-    metrics = None
-    path = os.path.join(out, "metrics.json")
-    if os.path.exists(path):
-        with open(path) as f:
-            metrics = json.load(f)
-    return {"data": data, "out": out, "returncode": proc.returncode, "stdout": proc.stdout,
-            "stderr": proc.stderr, "metrics": metrics}
+def process_folder(folder, out, *, method="all", window=None, config=None, skip_bad_rows=False, figures=True,
+                   client=None, workers=None, retries=3, progress=True):
+    """gssm.process over every dataset folder (a folder with a scenario.ini)
+    under `folder`, one Dask task per log, in the workers' own processes,
+    outputs in out/<log name>/.
 
-
-def process_folder(folder, out, *, method="all", window=None, args=(), client=None, workers=None, retries=3,
-                   progress=True, executable=None):
-    """gssm-process over every dataset folder (a folder with a scenario.ini)
-    under `folder`, one Dask task per log, outputs in out/<log name>/.
-
-    method, window: as gssm-process's --method and --window; args: further
-    command-line arguments. client: as in monte_carlo (False: one after the
-    other in this process). Returns {log name: {"returncode", "metrics",
-    "stdout", "stderr", "data", "out"}}; raises gssm.Error naming every log
-    that failed, after all have run.
+    method, window, config, skip_bad_rows, figures: as gssm.process. client:
+    as in monte_carlo (False: one after the other in this process). Returns
+    {log name: {"returncode" (gssm-process's exit code), "error", "metrics",
+    "files", "data", "out"}}; raises gssm.Error naming every log that failed,
+    after all have run.
     """
     logs = sorted(d for d in os.listdir(folder) if os.path.isfile(os.path.join(folder, d, "scenario.ini")))
     if not logs:
         raise _gssm.InvalidArgument("process_folder: no dataset folders (with a scenario.ini) in " + folder)
-    exe = _gssm_process_path(executable)
-    extra = ["--method", method] + (["--window", str(window)] if window else []) + list(args)
-    jobs = {name: (exe, os.path.abspath(os.path.join(folder, name)), os.path.abspath(os.path.join(out, name)), extra)
+    settings = dict(method=method, window=window, config=config, skip_bad_rows=skip_bad_rows, figures=figures,
+                    progress=None)
+    jobs = {name: (os.path.abspath(os.path.join(folder, name)), os.path.abspath(os.path.join(out, name)), settings)
             for name in logs}
     bar = _Progress(len(jobs), "gssm.campaign.process_folder", progress)
     results = {}
@@ -246,6 +229,5 @@ def process_folder(folder, out, *, method="all", window=None, args=(), client=No
     if failed:
         raise _gssm.Error("process_folder: %d of %d logs failed: %s" % (
             len(failed), len(results),
-            "; ".join("%s (exit %d): %s" % (n, r["returncode"], r["stderr"].strip().splitlines()[-1:] or "")
-                      for n, r in sorted(failed.items()))))
+            "; ".join("%s (exit %d): %s" % (n, r["returncode"], r["error"]) for n, r in sorted(failed.items()))))
     return dict(sorted(results.items()))

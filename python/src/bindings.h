@@ -12,6 +12,7 @@
 #include "gssm/analysis/offline.h"
 #include "gssm/estimator/estimator.h"
 #include "gssm/io/dataset.h"
+#include "gssm/io/process.h"
 #include "gssm/model/model.h"
 #include "gssm/model/simulation.h"
 
@@ -70,5 +71,13 @@ struct PyRun {
   OfflineRun run;
   std::vector<std::string> names;
 };
+
+/// A processed dataset (gssm.process): the C++ result, shared with the
+/// plotting extension (gssm._plot) that draws its figures.
+struct PyProcessResult {
+  std::shared_ptr<io::ProcessResult> result;
+};
+
+void bindProcess(py::module_& m);
 
 }  // namespace gssm::python

@@ -15,4 +15,5 @@ PYBIND11_MODULE(_gssm, m) {
   gssm::python::bindAnalysis(analysis);
   py::module_ campaign = m.def_submodule("campaign", "Monte Carlo campaigns, seed by seed.");
   gssm::python::bindCampaign(campaign);
+  gssm::python::bindProcess(m);
 }

@@ -126,7 +126,8 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
     if (cb.finished) cb.finished(r.runs.back(), r.metrics.back());
   }
   const std::string json = (fs::path(o.out_dir) / "metrics.json").string();
-  std::ofstream(json) << metricsJson(r.metrics, o.data_dir, r.status);
+  r.metrics_json = metricsJson(r.metrics, o.data_dir, r.status);
+  std::ofstream(json) << r.metrics_json;
   r.files.push_back(json);
   r.label = r.config.getString("scenario", "name", fs::path(o.data_dir).filename().string());
   r.dead_reckoning = deadReckoning(*model, r, options);

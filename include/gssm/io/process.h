@@ -43,6 +43,7 @@ struct ProcessResult {
   /// Rows at inputs on a model with px, py: the EKF on the inputs alone.
   std::optional<OfflineRun> dead_reckoning;
   std::string label;               ///< [scenario] name, or the folder's name
+  std::string metrics_json;        ///< the text of metrics.json
   std::vector<std::string> files;  ///< what was written
 };
 
