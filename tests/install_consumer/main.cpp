@@ -14,5 +14,8 @@ int main() {
   // The upper libraries are exported too (gssm::io links gssm::analysis and gssm::gssm).
   const gssm::Method m = gssm::io::parseMethod("fixed-lag", "consumer");
   std::cout << "consumer: method " << m << "\n";
-  return ekf.mean().allFinite() && m == gssm::Method::FixedLag ? 0 : 1;
+  // Models register themselves when the library loads: one from its INI form.
+  const auto model = gssm::io::makeModel(gssm::io::IniDocument::parse("[model]\ntype = nav_2d\n", "consumer.ini"));
+  std::cout << "consumer: model " << model->name() << "\n";
+  return ekf.mean().allFinite() && m == gssm::Method::FixedLag && model->name() == "nav_2d" ? 0 : 1;
 }
