@@ -17,6 +17,8 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
+SETUPTOOLS_BUILD = os.path.join(ROOT, "build-pip")  # not CMake's build/
+os.makedirs(SETUPTOOLS_BUILD, exist_ok=True)
 
 
 class CMakeExtension(Extension):
@@ -62,4 +64,5 @@ setup(
     ext_modules=[CMakeExtension("gssm._gssm")],
     cmdclass={"build_ext": CMakeBuild},
     zip_safe=False,
+    options={"build": {"build_base": SETUPTOOLS_BUILD}, "egg_info": {"egg_base": SETUPTOOLS_BUILD}},
 )

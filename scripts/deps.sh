@@ -12,6 +12,7 @@ GSSM_PACKAGES=(
   libegl-mesa0 libgl1-mesa-dri
   python3
   pybind11-dev python3-dev python3-numpy python3-pytest python3-distributed python3-matplotlib
+  python3-venv python3-pip python3-setuptools python3-wheel
   clang libclang-rt-14-dev
   locales
 )
