@@ -78,6 +78,14 @@ MatrixXd rowsOf(const std::vector<VectorXd>& v) {
   return m;
 }
 
+// The result of `method` (a gssm.Method or its name) on this seed.
+const MonteCarloSeedResult::PerMethod& methodResult(const MonteCarloSeedResult& r, const py::object& method) {
+  const Method wanted = py::isinstance<py::str>(method) ? methodFromName(method.cast<std::string>()) : method.cast<Method>();
+  for (const auto& m : r.methods)
+    if (m.method == wanted) return m;
+  throw InvalidArgument(std::string("SeedResult: no method '") + methodName(wanted) + "' in this result");
+}
+
 bool sameSeedResult(const MonteCarloSeedResult& a, const MonteCarloSeedResult& b) {
   if (a.seed != b.seed || a.times != b.times || a.methods.size() != b.methods.size()) return false;
   for (std::size_t i = 0; i < a.methods.size(); ++i) {
@@ -103,19 +111,13 @@ void bindSeedResult(py::module_& c) {
                              })
       .def(
           "rmse",
-          [](const MonteCarloSeedResult& r, const std::string& method) -> py::object {
-            for (const auto& m : r.methods)
-              if (methodName(m.method) == method) return m.ok ? py::cast(m.rmse) : py::none();
-            throw InvalidArgument("SeedResult: no method '" + method + "'");
+          [](const MonteCarloSeedResult& r, const py::object& method) -> py::object {
+            const auto& m = methodResult(r, method);
+            return m.ok ? py::cast(m.rmse) : py::none();
           },
           py::arg("method"))
       .def(
-          "error",
-          [](const MonteCarloSeedResult& r, const std::string& method) {
-            for (const auto& m : r.methods)
-              if (methodName(m.method) == method) return m.error;
-            throw InvalidArgument("SeedResult: no method '" + method + "'");
-          },
+          "error", [](const MonteCarloSeedResult& r, const py::object& method) { return methodResult(r, method).error; },
           py::arg("method"), "what the method threw on this seed ('' if it ran)")
       .def(py::pickle(&seedState, &seedFromState))
       .def("__eq__", &sameSeedResult);
