@@ -407,7 +407,7 @@ py::array_t<double> runCovariances(const PyRun& r) {
 
 PyRun runDataset(std::shared_ptr<Model> model, const PyDataset& data, const EstimatorOptions& options,
                  const std::optional<bool> rows_at_inputs, const std::function<void(std::size_t, std::size_t)>& progress) {
-  const RowTimes rows = rows_at_inputs.value_or(data.data.rows_at_inputs) ? RowTimes::Inputs : RowTimes::Measurements;
+  const RowTimes rows = !rows_at_inputs ? data.data.rows : *rows_at_inputs ? RowTimes::Inputs : RowTimes::Measurements;
   PyRun out;
   out.names = model->stackedStateNames();
   if (callsPython(*model) || progress) {

@@ -46,7 +46,8 @@ void fillFromSimulation(PyDataset& d) {
   d.data.inputs = run.inputs;
   d.data.truth = run.truth();
   d.data.t0 = run.times.empty() ? 0.0 : run.times.front();
-  d.data.rows_at_inputs = d.data.scenario.getString("dataset", "rows", "measurements") == "inputs";
+  const std::string rows = d.data.scenario.getString("dataset", "rows", "measurements");
+  d.data.rows = rows == "inputs" ? RowTimes::Inputs : rows == "epochs" ? RowTimes::Epochs : RowTimes::Measurements;
 }
 
 PyDataset datasetFromArrays(const VectorXd& t, const MatrixXd& y, const std::optional<Eigen::VectorXi>& channel,
@@ -83,7 +84,7 @@ PyDataset datasetFromArrays(const VectorXd& t, const MatrixXd& y, const std::opt
     d.data.truth = std::move(tr);
   }
   d.data.t0 = t0;
-  d.data.rows_at_inputs = rows_at_inputs;
+  d.data.rows = rows_at_inputs ? RowTimes::Inputs : RowTimes::Measurements;
   d.model = std::move(model);
   return d;
 }
@@ -194,7 +195,7 @@ void bindDataset(py::module_& io) {
                                return py::cast(all);
                              }, "the stacked components truth_x gives")
       .def_property_readonly("t0", [](const PyDataset& d) { return d.data.t0; }, "time of x_c(0)")
-      .def_property_readonly("rows_at_inputs", [](const PyDataset& d) { return d.data.rows_at_inputs; },
+      .def_property_readonly("rows_at_inputs", [](const PyDataset& d) { return d.data.rows == RowTimes::Inputs; },
                              "estimates are reported at the input times (odometry-driven logs)")
       .def_property_readonly("dir", [](const PyDataset& d) { return d.data.dir; })
       .def_property_readonly("model", [](const PyDataset& d) { return d.model; },

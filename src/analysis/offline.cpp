@@ -135,7 +135,7 @@ class StreamingRun {
                const std::vector<Input>& inputs, const StreamingCheckpoints& checkpoints, RowTimes rows)
       : model_(model), options_(options), measurements_(measurements), inputs_(inputs), checkpoints_(checkpoints),
         inline_recorder_(out_), recorder_(checkpoints.recorder ? *checkpoints.recorder : inline_recorder_),
-        at_inputs_(rows == RowTimes::Inputs) {
+        at_inputs_(rows == RowTimes::Inputs), at_epochs_(rows == RowTimes::Epochs) {
     out_.method = options.method;
     at_.data_fingerprint = internal::kFnv1a64Basis;
     if (!checkpoints.resume_from.empty()) resume();
@@ -153,7 +153,7 @@ class StreamingRun {
       if (!checkpoints_.path.empty() && (i + 1) % checkpoints_.every == 0) checkpoint(i + 1);
     }
     feedInputsBefore(std::numeric_limits<double>::infinity());  // inputs after the last measurement
-    if (at_inputs_ && at_.row_due) addRow(est_->current());
+    if ((at_inputs_ || at_epochs_) && at_.row_due) addRow(est_->current());
     out_.total_seconds = seconds_before_ + since(start_) - recording_;
     sendRecords();
     out_.summary = est_->report().detail;
@@ -173,7 +173,7 @@ class StreamingRun {
   void feedInputsBefore(double t) {
     for (; at_.next_input < inputs_.size() && inputs_[at_.next_input].t < t; ++at_.next_input) {
       const double ti = std::max(inputs_[at_.next_input].t, est_->time());
-      if (at_inputs_ && at_.row_due && ti > est_->time()) addRow(est_->current());
+      if ((at_inputs_ || at_epochs_) && at_.row_due && ti > est_->time()) addRow(est_->current()), at_.row_due = at_inputs_;
       const bool advances = ti > est_->time();
       est_->addInput(ti, inputs_[at_.next_input].u);
       if (at_inputs_ && advances) at_.row_due = true;
@@ -197,7 +197,7 @@ class StreamingRun {
   OfflineRun out_;
   InlineRecorder inline_recorder_;
   RunRecorder& recorder_;
-  const bool at_inputs_;
+  const bool at_inputs_, at_epochs_;
   const Clock::time_point start_ = Clock::now();
   std::unique_ptr<Estimator> est_;
   RunProgress at_;  // where the run is (what a checkpoint stores)
@@ -238,7 +238,7 @@ void StreamingRun::resume() {
 
 void StreamingRun::update(const Measurement& m) {
   feedInputsBefore(m.t);
-  if (at_inputs_ && at_.row_due && m.t > est_->time()) {
+  if ((at_inputs_ || at_epochs_) && at_.row_due && m.t > est_->time()) {
     addRow(est_->current());
     at_.row_due = false;
   }
@@ -250,9 +250,11 @@ void StreamingRun::update(const Measurement& m) {
   // The EKF gates instead of weighting; the others' weight is the
   // measurement factor's own, at the estimate after its update.
   const bool weigh = model_.channel(m.channel).loss.robust() && options_.method != Method::Ekf;
-  if (!at_inputs_ || weigh) {
+  if (at_epochs_) at_.row_due = true;  // the epoch's row: before the first later measurement
+  const bool row_now = !at_inputs_ && !at_epochs_;
+  if (row_now || weigh) {
     const StateEstimate e = est_->current();
-    if (!at_inputs_) addRow(e);
+    if (row_now) addRow(e);
     if (weigh && MeasurementFactor(model_, e.step, m).weight(stateValues(model_, e)) < 1.0) ++out_.downweighted;
   }
   out_.rejected = est_->reportNumbers().rejected;  // not report(): formatting its line costs ~15% of an EKF update

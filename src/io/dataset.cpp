@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <optional>
 
+#include "gssm/core/angles.h"
 #include "gssm/core/error.h"
+#include "gssm/core/time.h"
 #include "gssm/io/csv.h"
 
 namespace gssm::io {
@@ -44,11 +47,14 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
 }
 
 namespace {
+// Words separated by blanks or commas (not inside parentheses: "yaw(qw,qx,qy,qz)").
 std::vector<std::string> words(const std::string& s) {
   std::vector<std::string> out;
   std::string w;
+  int depth = 0;
   for (char c : s + " ") {
-    if (c == ' ' || c == '\t' || c == ',') {
+    depth += c == '(' ? 1 : c == ')' ? -1 : 0;
+    if (depth == 0 && (c == ' ' || c == '\t' || c == ',')) {
       if (!w.empty()) out.push_back(w);
       w.clear();
     } else {
@@ -75,36 +81,96 @@ void requireIncreasing(const CsvTable& t, std::size_t r, double prev, double now
                                   : " is before the previous row's " + formatDouble(prev)));
 }
 
+// One entry of [dataset] truth_columns: a state, and where its truth is: a
+// column of the same name ("px"), another column ("px=x"), or the yaw of a
+// quaternion's columns, scalar first ("yaw=yaw(qw,qx,qy,qz)").
+struct TruthColumn {
+  int state = -1;
+  std::vector<int> columns;  // one; or four: a quaternion
+  double value(const CsvRows::Row& row) const {
+    if (columns.size() == 1) return row[static_cast<std::size_t>(columns[0])];
+    const double w = row[static_cast<std::size_t>(columns[0])], x = row[static_cast<std::size_t>(columns[1])],
+                 y = row[static_cast<std::size_t>(columns[2])], z = row[static_cast<std::size_t>(columns[3])];
+    return std::atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z));
+  }
+};
+
+TruthColumn truthColumn(const std::string& entry, const CsvTable& truth, const IniDocument& ini, const Model& model) {
+  const auto names = model.stackedStateNames();
+  const auto eq = entry.find('=');
+  const std::string state = entry.substr(0, eq), source = eq == std::string::npos ? state : entry.substr(eq + 1);
+  const auto it = std::find(names.begin(), names.end(), state);
+  if (it == names.end())
+    throw InputError(ini.where("dataset", "truth_columns") + ": '" + state + "' is not a state of model '" +
+                     model.name() + "'");
+  TruthColumn c;
+  c.state = static_cast<int>(it - names.begin());
+  if (source.rfind("yaw(", 0) == 0 && source.back() == ')') {
+    std::string args = source.substr(4, source.size() - 5);
+    std::replace(args.begin(), args.end(), ',', ' ');
+    for (const auto& q : words(args)) c.columns.push_back(requireColumn(truth, q, "[dataset] truth_columns " + entry));
+    if (c.columns.size() != 4)
+      throw InputError(ini.where("dataset", "truth_columns") + ": '" + entry + "': yaw(qw,qx,qy,qz) takes four columns");
+    return c;
+  }
+  c.columns.push_back(requireColumn(truth, source, "[dataset] truth_columns"));
+  return c;
+}
+
 // [dataset] truth: the true values of the named states, by time.
 void readTruth(const std::string& path, const IniDocument& ini, const Model& model, Dataset& out) {
   const CsvTable truth = readCsv(path);
   const int tc = requireColumn(truth, "t", "the time");
   Truth tr;
-  const auto names = model.stackedStateNames();
-  std::vector<int> cols;
-  for (const auto& n : words(ini.getString("dataset", "truth_columns"))) {
-    const auto it = std::find(names.begin(), names.end(), n);
-    if (it == names.end())
-      throw InputError(ini.source() + ": [dataset] truth_columns: '" + n + "' is not a state of model '" +
-                       model.name() + "'");
-    tr.components.push_back(static_cast<int>(it - names.begin()));
-    cols.push_back(requireColumn(truth, n, "[dataset] truth_columns"));
+  std::vector<TruthColumn> cols;
+  for (const auto& entry : words(ini.getString("dataset", "truth_columns"))) {
+    cols.push_back(truthColumn(entry, truth, ini, model));
+    tr.components.push_back(cols.back().state);
   }
   for (std::size_t r = 0; r < truth.rows.size(); ++r) {
     const double t = truth.rows[r][static_cast<std::size_t>(tc)];
     if (r) requireIncreasing(truth, r, tr.times.back(), t);
     Eigen::VectorXd z(static_cast<Eigen::Index>(cols.size()));
-    for (std::size_t i = 0; i < cols.size(); ++i) z[static_cast<Eigen::Index>(i)] = truth.rows[r][static_cast<std::size_t>(cols[i])];
+    for (std::size_t i = 0; i < cols.size(); ++i) z[static_cast<Eigen::Index>(i)] = cols[i].value(truth.rows[r]);
     tr.times.push_back(t);
     tr.states.push_back(std::move(z));
   }
   out.truth = std::move(tr);
 }
 
-// [dataset] start_time (a number, or the truth's first time) and rows.
+// The truth at each measurement time, linearly interpolated between its rows
+// (angles by their wrapped difference); times outside the truth are left out.
+void interpolateTruth(const Model& model, Dataset& out) {
+  const Truth& tr = *out.truth;
+  Truth at;
+  at.components = tr.components;
+  const auto& angles = model.angleStates();
+  std::size_t k = 0;
+  for (const auto& m : out.measurements) {
+    if (!at.times.empty() && sameTime(at.times.back(), m.t)) continue;
+    while (k + 1 < tr.times.size() && tr.times[k + 1] < m.t) ++k;
+    if (k + 1 >= tr.times.size() || m.t < tr.times[k]) continue;
+    const double w = (m.t - tr.times[k]) / (tr.times[k + 1] - tr.times[k]);
+    Eigen::VectorXd z = tr.states[k];
+    for (Eigen::Index i = 0; i < z.size(); ++i) {
+      double d = tr.states[k + 1][i] - tr.states[k][i];
+      if (std::find(angles.begin(), angles.end(), tr.components[static_cast<std::size_t>(i)]) != angles.end())
+        d = wrapAngle(d);
+      z[i] += w * d;
+    }
+    at.times.push_back(m.t);
+    at.states.push_back(std::move(z));
+  }
+  out.truth = std::move(at);
+}
+
+// [dataset] start_time (a number, the truth's first time, or "first": one
+// nominal step before the first measurement, set once they are read) and rows.
 void readStartAndRows(const IniDocument& ini, Dataset& out) {
   const std::string start = ini.getString("dataset", "start_time", "0");
-  if (start == "truth") {
+  if (start == "first") {
+    out.t0 = -std::numeric_limits<double>::infinity();
+  } else if (start == "truth") {
     if (!out.truth || out.truth->times.empty())
       throw InputError(ini.source() + ": [dataset] start_time = truth, but there is no truth file with rows");
     out.t0 = out.truth->times.front();
@@ -112,9 +178,9 @@ void readStartAndRows(const IniDocument& ini, Dataset& out) {
     out.t0 = ini.getDouble("dataset", "start_time", 0.0);
   }
   const std::string rows = ini.getString("dataset", "rows", "measurements");
-  if (rows != "measurements" && rows != "inputs")
-    throw InputError(ini.source() + ": [dataset] rows = '" + rows + "': expected measurements or inputs");
-  out.rows_at_inputs = rows == "inputs";
+  if (rows != "measurements" && rows != "inputs" && rows != "epochs")
+    throw InputError(ini.source() + ": [dataset] rows = '" + rows + "': expected measurements, inputs or epochs");
+  out.rows = rows == "inputs" ? RowTimes::Inputs : rows == "epochs" ? RowTimes::Epochs : RowTimes::Measurements;
 }
 
 // Inputs: rates held from each row's time, or increments over the interval
@@ -150,22 +216,32 @@ void readInputs(const std::string& path, const IniDocument& ini, const Model& mo
 
 // How a measurement row names its channel: [dataset] channel_column,
 // channel_prefix, channel_by.
+// channel_column may name several columns (a link named by its tag and its
+// anchor): the channel is then prefix + their values joined by '_'.
 struct ChannelColumn {
-  int column = -1;  // none: every row is the default channel
+  std::vector<int> columns;  // none: every row is the default channel
   std::string prefix, by;
+  static std::string text(double v) {
+    return v == std::floor(v) ? std::to_string(static_cast<long long>(v)) : formatDouble(v);
+  }
   // The row's channel, or −1 with `problem` set.
   int of(const CsvTable& m, const CsvRows::Row& row, const Model& model, std::string& problem) const {
-    if (column < 0) return 0;
-    const double v = row[static_cast<std::size_t>(column)];
-    const std::string name =
-        by == "index" ? "number " + formatDouble(v)
-                      : prefix + (v == std::floor(v) ? std::to_string(static_cast<long long>(v)) : formatDouble(v));
+    if (columns.empty()) return 0;
+    const double v = row[static_cast<std::size_t>(columns[0])];
+    std::string name = by == "index" ? "number " + formatDouble(v) : prefix + text(v);
+    for (std::size_t i = 1; i < columns.size(); ++i) name += "_" + text(row[static_cast<std::size_t>(columns[i])]);
     int channel = -1;
     for (int c = 0; c < model.numChannels(); ++c)
       if (by == "index" ? v == c : model.channel(c).name == name) channel = c;
-    if (channel < 0)
-      problem = "column '" + m.header[static_cast<std::size_t>(column)] + "': '" + formatDouble(v) + "' names channel '" +
-                name + "', which model '" + model.name() + "' does not have";
+    if (channel < 0) {
+      std::string cols, values;
+      for (int c : columns) {
+        cols += (cols.empty() ? "" : ", ") + m.header[static_cast<std::size_t>(c)];
+        values += (values.empty() ? "" : ", ") + formatDouble(row[static_cast<std::size_t>(c)]);
+      }
+      problem = std::string(columns.size() > 1 ? "columns '" : "column '") + cols + "': '" + values +
+                "' names channel '" + name + "', which model '" + model.name() + "' does not have";
+    }
     return channel;
   }
 };
@@ -173,11 +249,14 @@ struct ChannelColumn {
 ChannelColumn channelColumn(const IniDocument& ini, const CsvTable& m) {
   ChannelColumn cc;
   if (ini.has("dataset", "channel_column"))
-    cc.column = requireColumn(m, ini.getString("dataset", "channel_column"), "[dataset] channel_column");
+    for (const auto& name : words(ini.getString("dataset", "channel_column")))
+      cc.columns.push_back(requireColumn(m, name, "[dataset] channel_column"));
   cc.prefix = ini.getString("dataset", "channel_prefix", "");
   cc.by = ini.getString("dataset", "channel_by", "name");
   if (cc.by != "name" && cc.by != "index")
     throw InputError(ini.source() + ": [dataset] channel_by = '" + cc.by + "': expected name or index");
+  if (cc.by == "index" && cc.columns.size() > 1)
+    throw InputError(ini.where("dataset", "channel_column") + ": channel_by = index takes one column");
   return cc;
 }
 
@@ -191,6 +270,7 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
   for (const auto& n : words(ini.getString("dataset", "measurement_columns")))
     cols.push_back(requireColumn(m, n, "[dataset] measurement_columns"));
   const ChannelColumn channels = channelColumn(ini, m);
+  const double drop_at_or_below = ini.getDouble("dataset", "drop_at_or_below", -std::numeric_limits<double>::infinity());
   std::size_t next_error = 0;
   out.measurements.reserve(m.rows.size());
   for (std::size_t r = 0; r < m.rows.size(); ++r) {
@@ -220,6 +300,12 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
     }
     Eigen::VectorXd y(static_cast<Eigen::Index>(cols.size()));
     for (std::size_t i = 0; i < cols.size(); ++i) y[static_cast<Eigen::Index>(i)] = row[static_cast<std::size_t>(cols[i])];
+    if (y.minCoeff() <= drop_at_or_below) {  // non-physical (a range of 0): an outlier, dropped and counted
+      out.dropped.push_back(m.source + ":" + std::to_string(line) + ": value " + formatDouble(y.minCoeff()) +
+                            " is at or below [dataset] drop_at_or_below = " + formatDouble(drop_at_or_below) +
+                            " (dropped as non-physical)");
+      continue;
+    }
     out.measurements.push_back({t, y, channel, {}});
   }
   std::sort(errors.begin(), errors.end(), [](const CsvRowError& a, const CsvRowError& b) { return a.line < b.line; });
@@ -233,7 +319,7 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
 void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
   ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
                                   "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
-                                  "start_time", "rows"});
+                                  "truth_interpolate", "start_time", "rows", "drop_at_or_below"});
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   out.truth.reset();
   if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0
@@ -242,7 +328,11 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   if (ini.has("dataset", "inputs")) readInputs(file("inputs"), ini, model, out);
   out.measurements.clear();
   out.row_errors.clear();
+  out.dropped.clear();
   if (ini.has("dataset", "measurements")) readMeasurements(file("measurements"), ini, model, out, bad_rows);
+  if (std::isinf(out.t0))  // start_time = first
+    out.t0 = out.measurements.empty() ? 0.0 : out.measurements.front().t - model.nominalStep();
+  if (out.truth && ini.getBool("dataset", "truth_interpolate", false)) interpolateTruth(model, out);
 }
 }  // namespace
 

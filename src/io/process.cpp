@@ -64,6 +64,8 @@ void readData(const ProcessOptions& o, const Model& model, ProcessResult& r, con
   readDatasetData(o.data_dir, model, r.dataset, o.skip_bad_rows ? BadRows::Skip : BadRows::Stop, &r.config);
   if (o.skip_bad_rows) r.status.skipped = r.dataset.row_errors;
   else if (!r.dataset.row_errors.empty()) r.status = {true, r.dataset.row_errors.front(), {}};
+  // Non-physical values the dataset drops by its own rule: skipped, listed.
+  r.status.skipped.insert(r.status.skipped.end(), r.dataset.dropped.begin(), r.dataset.dropped.end());
   if (cb.skipped)
     for (const auto& e : r.status.skipped) cb.skipped(e);
   if (r.dataset.measurements.empty())
@@ -87,8 +89,8 @@ OfflineRun runMethod(const ProcessOptions& o, const Model& model, const ProcessR
   }
   std::function<void(std::size_t, std::size_t)> progress;
   if (cb.progress) progress = [&cb, method](std::size_t done, std::size_t total) { cb.progress(method, done, total); };
-  const RowTimes rows = r.dataset.rows_at_inputs ? RowTimes::Inputs : RowTimes::Measurements;
-  OfflineRun run = runOffline(model, options, r.dataset.measurements, r.dataset.inputs, progress, checkpoints, rows);
+  OfflineRun run =
+      runOffline(model, options, r.dataset.measurements, r.dataset.inputs, progress, checkpoints, r.dataset.rows);
   if (!streaming)
     for (const auto& row : run.rows) files.row(row);
   files.finish();
@@ -99,7 +101,7 @@ OfflineRun runMethod(const ProcessOptions& o, const Model& model, const ProcessR
 std::optional<OfflineRun> deadReckoning(const Model& model, const ProcessResult& r, EstimatorOptions options) {
   const auto names = model.stackedStateNames();
   const bool planar = std::count(names.begin(), names.end(), "px") && std::count(names.begin(), names.end(), "py");
-  if (!planar || !r.dataset.rows_at_inputs) return std::nullopt;
+  if (!planar || r.dataset.rows != RowTimes::Inputs) return std::nullopt;
   options.method = Method::Ekf;
   return runOffline(model, options, {}, r.dataset.inputs, {}, {}, RowTimes::Inputs);
 }

@@ -161,7 +161,7 @@ std::vector<std::string> Model::stackedStateNames() const {
 namespace {
 // Accumulates the worst entry of analytic vs numeric.
 void compare(const Eigen::MatrixXd& analytic, const Eigen::MatrixXd& numeric,
-             const char* name, JacobianCheck& out) {
+             const std::string& name, JacobianCheck& out) {
   if (analytic.rows() != numeric.rows() || analytic.cols() != numeric.cols()) {
     std::ostringstream os;
     os << name << " has size " << analytic.rows() << "x" << analytic.cols() << ", expected "
@@ -192,11 +192,16 @@ JacobianCheck checkJacobians(const Model& model, const Eigen::VectorXd& xc,
   JacobianCheck out;
   Eigen::MatrixXd J_f_xc, J_f_xb, J_h_xc, J_h_xb;
   model.f(xc, xb, u, dt, &J_f_xc, &J_f_xb);
-  model.h(xc, xb, &J_h_xc, &J_h_xb);
   compare(J_f_xc, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.f(v, xb, u, dt); }, xc, d.nc, eps), "J_f_xc", out);
   compare(J_f_xb, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.f(xc, v, u, dt); }, xb, d.nc, eps), "J_f_xb", out);
-  compare(J_h_xc, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.h(v, xb); }, xc, d.ny, eps), "J_h_xc", out);
-  compare(J_h_xb, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.h(xc, v); }, xb, d.ny, eps), "J_h_xb", out);
+  // Every channel's h (channel 0 is the default h).
+  for (int c = 0; c < model.numChannels(); ++c) {
+    const int ny = model.channel(c).dim();
+    const std::string at = c == 0 ? "" : "[" + model.channel(c).name + "]";
+    model.h(c, xc, xb, &J_h_xc, &J_h_xb);
+    compare(J_h_xc, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.h(c, v, xb); }, xc, ny, eps), "J_h_xc" + at, out);
+    compare(J_h_xb, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.h(c, xc, v); }, xb, ny, eps), "J_h_xb" + at, out);
+  }
   return out;
 }
 

@@ -39,7 +39,11 @@ struct OfflineRun {
 
 /// Where a run reports its estimates: after each measurement (gssm's own
 /// datasets), or at each state an input makes (a log's odometry steps).
-enum class RowTimes { Measurements, Inputs };
+/// When a streaming run records an estimate row: after every measurement;
+/// at every input time (a state an input made, before the next later event);
+/// or once per epoch, a distinct measurement time (after its last
+/// measurement), as the batch run reports (several sensors sharing a time).
+enum class RowTimes { Measurements, Inputs, Epochs };
 
 /// Where a streaming run's records go, and what its checkpoints remember of
 /// them (docs/DESIGN.md §7). The run keeps them in OfflineRun and hands the

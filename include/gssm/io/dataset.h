@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gssm/core/data.h"
+#include "gssm/analysis/offline.h"  // RowTimes
 #include "gssm/io/ini.h"
 #include "gssm/model/model.h"
 #include "gssm/model/simulation.h"
@@ -17,9 +18,10 @@ namespace gssm::io {
 struct Dataset {
   std::string dir;
   double t0 = 0;  ///< time of x_c(0)
-  /// One estimate row per input time (a log's odometry steps) instead of
-  /// per measurement.
-  bool rows_at_inputs = false;
+  /// When estimate rows are reported ([dataset] rows): per measurement, per
+  /// input time (a log's odometry steps), or per epoch (a distinct
+  /// measurement time: several sensors at once).
+  RowTimes rows = RowTimes::Measurements;
   IniDocument scenario;
   std::vector<Measurement> measurements;
   std::vector<Input> inputs;  ///< inputs.csv (t,<input names>), if the model has inputs
@@ -28,6 +30,8 @@ struct Dataset {
   /// time not increasing), in file order. With BadRows::Stop only the rows
   /// before the first one are kept; with Skip every good row is kept.
   std::vector<std::string> row_errors;
+  /// Rows dropped as non-physical ([dataset] drop_at_or_below), file:line each.
+  std::vector<std::string> dropped;
 };
 
 enum class BadRows {

@@ -1,0 +1,68 @@
+#pragma once
+// A rigid body moving in a plane, carrying range tags at known lever arms,
+// ranging to anchors at known positions (the UWB planar-pose logs;
+// docs/DESIGN.md §9).
+//   x_c = [px, py, yaw, vx, vy, omega]: the body origin, heading (an angle)
+//         and their rates, constant velocity driven by white acceleration;
+//   range of link (tag i, anchor j), one channel "range_<i>_<j>" each:
+//         s · ‖(p + R(yaw) l_i, h + l_iz) − a_j‖ + b_ij
+// with l_i the tag's lever arm in the body frame, h the known height of the
+// body origin (the problem is planar: the height difference only shortens
+// the horizontal part), a_j the anchor. The constants, each chosen in the
+// configuration: a bias b_ij per link (one node each, only in that link's
+// factors: bias_<i>_<j>), and a common range scale s (1 when off).
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gssm/model/model.h"
+
+namespace gssm::models {
+
+class PlanarRigidBody final : public Model {
+ public:
+  struct Params {
+    double T = 0.01;                        ///< nominal step (s)
+    std::vector<int> tag_ids, anchor_ids;   ///< as the log names them
+    std::vector<Eigen::Vector3d> tags;      ///< lever arms in the body frame (m)
+    std::vector<Eigen::Vector3d> anchors;   ///< positions in the world frame (m)
+    double height = 0.0;                    ///< the body origin's known height (m)
+    double accel_sd = 1.0;                  ///< white acceleration, m/s² per √Hz, each axis
+    double yaw_accel_sd = 1.0;              ///< white angular acceleration, rad/s² per √Hz
+    double range_sd = 0.07;                 ///< σ of one range (m)
+    bool link_biases = true;                ///< a bias per link
+    bool range_scale = false;               ///< a common range scale
+    RobustLoss range_loss;                  ///< on every range
+    double ekf_gate = 0;                    ///< EKF NIS gate of every range (0: none)
+    Eigen::Vector3d start{0, 0, 0};         ///< prior mean of [px, py, yaw]
+    double position_sd = 3.0, yaw_sd = M_PI, velocity_sd = 1.0, omega_sd = 1.0;  ///< prior σ
+    double bias_sd = 0.3;                   ///< prior σ of each bias (mean 0), m
+    double range_scale_sd = 0.05;           ///< prior σ of the scale (mean 1)
+  };
+
+  explicit PlanarRigidBody(const Params& p);
+
+  std::string name() const override { return "planar_rigid_body"; }
+  const Params& params() const { return p_; }
+  std::vector<Eigen::Vector2d> landmarks() const override;
+  /// The channel of link (tag i, anchor j), by their positions in the lists.
+  int channelOf(std::size_t tag, std::size_t anchor) const { return static_cast<int>(tag * p_.anchors.size() + anchor); }
+  /// Index in x_b of link c's bias, −1 without link biases.
+  int biasIndex(int channel) const { return i_bias_ < 0 ? -1 : i_bias_ + channel; }
+
+  Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u, double dt,
+                    Eigen::MatrixXd* J_f_xc = nullptr, Eigen::MatrixXd* J_f_xb = nullptr) const override;
+  Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc = nullptr,
+                    Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                    Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  /// White acceleration over dt on (px, vx), (py, vy), (yaw, omega):
+  /// q²·[[dt³/3, dt²/2], [dt²/2, dt]] each.
+  Eigen::MatrixXd processNoise(double dt) const override;
+
+ private:
+  Params p_;
+  int i_bias_ = -1, i_scale_ = -1;
+};
+
+}  // namespace gssm::models

@@ -1,0 +1,241 @@
+#include "gssm/models/planar_rigid_body.h"
+
+#include <cmath>
+
+#include "gssm/core/error.h"
+#include "gssm/model/noise_params.h"
+#include "gssm/model/registry.h"
+
+namespace gssm::models {
+
+namespace {
+std::string linkName(const PlanarRigidBody::Params& p, std::size_t i, std::size_t j) {
+  return std::to_string(p.tag_ids[i]) + "_" + std::to_string(p.anchor_ids[j]);
+}
+
+int countConstants(const PlanarRigidBody::Params& p) {
+  return (p.link_biases ? static_cast<int>(p.tags.size() * p.anchors.size()) : 0) + (p.range_scale ? 1 : 0);
+}
+
+ModelNames bodyNames(const PlanarRigidBody::Params& p) {
+  ModelNames n{{"px", "py", "yaw", "vx", "vy", "omega"}, {}, {}, {}};
+  if (p.link_biases)
+    for (std::size_t i = 0; i < p.tags.size(); ++i)
+      for (std::size_t j = 0; j < p.anchors.size(); ++j) n.constants.push_back("bias_" + linkName(p, i, j));
+  if (p.range_scale) n.constants.push_back("range_scale");
+  if (!p.tags.empty() && !p.anchors.empty()) n.measurement = {"range_" + linkName(p, 0, 0)};
+  return n;
+}
+
+// q²·[[dt³/3, dt²/2], [dt²/2, dt]] on each (position, rate) pair.
+Eigen::MatrixXd whiteAcceleration(double q_xy, double q_yaw, double dt) {
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(6, 6);
+  for (int i = 0; i < 3; ++i) {
+    const double a = (i < 2 ? q_xy : q_yaw) * (i < 2 ? q_xy : q_yaw);
+    Q(i, i) = a * dt * dt * dt / 3;
+    Q(i, i + 3) = Q(i + 3, i) = a * dt * dt / 2;
+    Q(i + 3, i + 3) = a * dt;
+  }
+  return Q;
+}
+
+ModelNoise bodyNoise(const PlanarRigidBody::Params& p) {
+  if (p.tags.empty() || p.anchors.empty() || p.tags.size() != p.tag_ids.size() || p.anchors.size() != p.anchor_ids.size())
+    throw InvalidArgument("PlanarRigidBody: need at least one tag and one anchor, each with an id");
+  for (double v : {p.accel_sd, p.yaw_accel_sd, p.range_sd, p.position_sd, p.yaw_sd, p.velocity_sd, p.omega_sd,
+                   p.bias_sd, p.range_scale_sd, p.T})
+    if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("PlanarRigidBody: every σ and T must be > 0");
+  ModelNoise n;
+  n.T = p.T;
+  n.Q = whiteAcceleration(p.accel_sd, p.yaw_accel_sd, p.T);
+  n.R = Eigen::MatrixXd::Constant(1, 1, p.range_sd * p.range_sd);
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(6), sd(6);
+  mean.head<3>() = p.start;
+  sd << p.position_sd, p.position_sd, p.yaw_sd, p.velocity_sd, p.velocity_sd, p.omega_sd;
+  n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
+  const int nb = countConstants(p);
+  Eigen::VectorXd bmean = Eigen::VectorXd::Zero(nb), bsd = Eigen::VectorXd::Constant(nb, p.bias_sd);
+  if (p.range_scale) bmean[nb - 1] = 1, bsd[nb - 1] = p.range_scale_sd;
+  n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
+  return n;
+}
+}  // namespace
+
+PlanarRigidBody::PlanarRigidBody(const Params& p)
+    : Model({6, countConstants(p), 0, 1}, bodyNames(p), bodyNoise(p)), p_(p) {
+  int i = 0;
+  if (p.link_biases) {
+    i_bias_ = i;
+    i += static_cast<int>(p.tags.size() * p.anchors.size());
+  }
+  if (p.range_scale) i_scale_ = i++;
+  std::vector<MeasurementChannel> channels;
+  for (std::size_t t = 0; t < p.tags.size(); ++t)
+    for (std::size_t a = 0; a < p.anchors.size(); ++a) {
+      MeasurementChannel ch;
+      ch.name = "range_" + linkName(p, t, a);
+      ch.components = {ch.name};
+      ch.R = Eigen::MatrixXd::Constant(1, 1, p.range_sd * p.range_sd);
+      ch.loss = p.range_loss;
+      ch.ekf_gate = p.ekf_gate;
+      channels.push_back(std::move(ch));
+    }
+  setChannels(std::move(channels));
+  setAngleStates({2});
+}
+
+std::vector<Eigen::Vector2d> PlanarRigidBody::landmarks() const {
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& a : p_.anchors) out.emplace_back(a.head<2>());
+  return out;
+}
+
+Eigen::VectorXd PlanarRigidBody::f(const Eigen::VectorXd& xc, const Eigen::VectorXd& /*xb*/,
+                                   const Eigen::VectorXd& /*u*/, double dt, Eigen::MatrixXd* J_f_xc,
+                                   Eigen::MatrixXd* J_f_xb) const {
+  Eigen::VectorXd out = xc;
+  out.head<3>() += dt * xc.tail<3>();
+  if (J_f_xc) {
+    *J_f_xc = Eigen::MatrixXd::Identity(6, 6);
+    J_f_xc->topRightCorner<3, 3>().diagonal().setConstant(dt);
+  }
+  if (J_f_xb) *J_f_xb = Eigen::MatrixXd::Zero(6, dims().nb);
+  return out;
+}
+
+Eigen::VectorXd PlanarRigidBody::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
+                                   Eigen::MatrixXd* J_h_xb) const {
+  return h(0, xc, xb, J_h_xc, J_h_xb);
+}
+
+// The tag at p + R(yaw)·l (horizontally), the anchor at a: ρ = ‖d‖ with
+// d = (tag − a) and the vertical part dz fixed; ∂ρ/∂p = d_xy/ρ,
+// ∂ρ/∂yaw = d_xy·(R'(yaw) l)/ρ with R' l = (−sin·lx − cos·ly, cos·lx − sin·ly).
+Eigen::VectorXd PlanarRigidBody::h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                                   Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  this->channel(channel);  // range check
+  const std::size_t t = static_cast<std::size_t>(channel) / p_.anchors.size();
+  const std::size_t a = static_cast<std::size_t>(channel) % p_.anchors.size();
+  const Eigen::Vector3d& l = p_.tags[t];
+  const double c = std::cos(xc[2]), s = std::sin(xc[2]);
+  const Eigen::Vector2d rl(c * l.x() - s * l.y(), s * l.x() + c * l.y());
+  const Eigen::Vector2d d = xc.head<2>() + rl - p_.anchors[a].head<2>();
+  const double dz = p_.height + l.z() - p_.anchors[a].z();
+  const double rho = std::sqrt(d.squaredNorm() + dz * dz);
+  const double scale = i_scale_ >= 0 ? xb[i_scale_] : 1.0;
+  const int ib = biasIndex(channel);
+  if (J_h_xc) {
+    *J_h_xc = Eigen::MatrixXd::Zero(1, 6);
+    if (rho > 0) {
+      (*J_h_xc)(0, 0) = scale * d.x() / rho;
+      (*J_h_xc)(0, 1) = scale * d.y() / rho;
+      (*J_h_xc)(0, 2) = scale * (d.x() * -rl.y() + d.y() * rl.x()) / rho;  // R'(yaw) l = (−rl_y, rl_x)
+    }
+  }
+  if (J_h_xb) {
+    *J_h_xb = Eigen::MatrixXd::Zero(1, dims().nb);
+    if (ib >= 0) (*J_h_xb)(0, ib) = 1.0;
+    if (i_scale_ >= 0) (*J_h_xb)(0, i_scale_) = rho;
+  }
+  return Eigen::VectorXd::Constant(1, scale * rho + (ib >= 0 ? xb[ib] : 0.0));
+}
+
+Eigen::MatrixXd PlanarRigidBody::processNoise(double dt) const {
+  return whiteAcceleration(p_.accel_sd, p_.yaw_accel_sd, dt);
+}
+
+namespace {
+std::vector<ParamSpec> bodyParams() {
+  using namespace param;
+  std::vector<ParamSpec> p{
+      real("model", "T", "nominal step (s)"),
+      required(table("model", "anchors", {"anchor", "x", "y", "z"}, "anchors: rows 'id x y z' (m), or a CSV file")),
+      required(table("model", "tags", {"tag", "x", "y", "z"}, "tags' lever arms: rows 'id x y z' (m), or a CSV file")),
+      real("model", "height", "the known height of the body origin (m)"),
+      real("model", "accel_sd", "white acceleration, m/s² per √Hz"),
+      real("model", "yaw_accel_sd", "white angular acceleration, rad/s² per √Hz"),
+      real("model", "range_sd", "σ of one range (m)"),
+      flag("model", "link_biases", "estimate a bias per link (bias_<tag>_<anchor>)"),
+      flag("model", "range_scale", "estimate a common range scale")};
+  for (auto& l : lossParams("model")) p.push_back(l);
+  for (auto& q : {real("model", "ekf_gate", "EKF NIS gate of every range (0: none)"),
+                  vector("prior", "start", "prior mean of [px, py, yaw] (default: the anchors' centroid, 0)"),
+                  real("prior", "position_sd", "prior σ of px and py (m)"), real("prior", "yaw_sd", "prior σ of yaw"),
+                  real("prior", "velocity_sd", "prior σ of vx, vy (m/s)"),
+                  real("prior", "omega_sd", "prior σ of the yaw rate (rad/s)"),
+                  real("prior", "bias_sd", "prior σ of each link bias (mean 0), m"),
+                  real("prior", "range_scale_sd", "prior σ of the range scale (mean 1)")})
+    p.push_back(q);
+  return p;
+}
+
+template <class Points>
+void readPoints(const ParamSource& in, const char* key, const char* column, std::vector<int>& ids, Points& points) {
+  const Eigen::MatrixXd rows = in.table("model", key, {column, "x", "y", "z"});
+  for (Eigen::Index i = 0; i < rows.rows(); ++i) {
+    if (rows(i, 0) != std::floor(rows(i, 0)))
+      throw InputError(in.where("model", key) + ": row " + std::to_string(i + 1) + ": id must be an integer");
+    ids.push_back(static_cast<int>(rows(i, 0)));
+    points.emplace_back(rows(i, 1), rows(i, 2), rows(i, 3));
+  }
+}
+
+PlanarRigidBody::Params readBody(const ParamSource& in) {
+  PlanarRigidBody::Params p;
+  readPoints(in, "anchors", "anchor", p.anchor_ids, p.anchors);
+  readPoints(in, "tags", "tag", p.tag_ids, p.tags);
+  for (auto [key, value] : {std::pair{"T", &p.T}, {"height", &p.height}, {"accel_sd", &p.accel_sd},
+                            {"yaw_accel_sd", &p.yaw_accel_sd}, {"range_sd", &p.range_sd}, {"ekf_gate", &p.ekf_gate}})
+    *value = in.real("model", key, *value);
+  p.link_biases = in.flag("model", "link_biases", p.link_biases);
+  p.range_scale = in.flag("model", "range_scale", p.range_scale);
+  p.range_loss = readLoss(in, "model");
+  if (in.has("prior", "start")) {
+    p.start = in.vector("prior", "start", 3);
+  } else if (!p.anchors.empty()) {
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const auto& a : p.anchors) centroid += a;
+    p.start << centroid.x() / static_cast<double>(p.anchors.size()), centroid.y() / static_cast<double>(p.anchors.size()), 0;
+  }
+  for (auto [key, value] : {std::pair{"position_sd", &p.position_sd}, {"yaw_sd", &p.yaw_sd},
+                            {"velocity_sd", &p.velocity_sd}, {"omega_sd", &p.omega_sd}, {"bias_sd", &p.bias_sd},
+                            {"range_scale_sd", &p.range_scale_sd}})
+    *value = in.real("prior", key, *value);
+  return p;
+}
+
+Eigen::MatrixXd pointRows(const std::vector<int>& ids, const std::vector<Eigen::Vector3d>& points) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(points.size()), 4);
+  for (std::size_t i = 0; i < points.size(); ++i) out.row(static_cast<Eigen::Index>(i)) << ids[i], points[i].transpose();
+  return out;
+}
+
+void writeBody(const PlanarRigidBody::Params& p, ParamSink& out) {
+  out.real("model", "T", p.T);
+  out.matrix("model", "anchors", pointRows(p.anchor_ids, p.anchors));
+  out.matrix("model", "tags", pointRows(p.tag_ids, p.tags));
+  for (auto [key, value] : {std::pair{"height", p.height}, {"accel_sd", p.accel_sd}, {"yaw_accel_sd", p.yaw_accel_sd},
+                            {"range_sd", p.range_sd}})
+    out.real("model", key, value);
+  out.flag("model", "link_biases", p.link_biases);
+  out.flag("model", "range_scale", p.range_scale);
+  writeLoss(p.range_loss, "model", out);
+  out.real("model", "ekf_gate", p.ekf_gate);
+  out.vector("prior", "start", p.start);
+  for (auto [key, value] : {std::pair{"position_sd", p.position_sd}, {"yaw_sd", p.yaw_sd},
+                            {"velocity_sd", p.velocity_sd}, {"omega_sd", p.omega_sd}, {"bias_sd", p.bias_sd},
+                            {"range_scale_sd", p.range_scale_sd}})
+    out.real("prior", key, value);
+}
+
+const ModelRegistration registration{{
+    "planar_rigid_body", {}, "PlanarRigidBody",
+    "A rigid body in a plane (constant velocity) with range tags at lever arms, ranging to anchors; a bias per "
+    "link and a common range scale as optional constants; one channel per link.",
+    bodyParams(),
+    [](const ParamSource& in) -> std::unique_ptr<Model> { return std::make_unique<PlanarRigidBody>(readBody(in)); },
+    [](const Model& m, ParamSink& out) { writeBody(dynamic_cast<const PlanarRigidBody&>(m).params(), out); },
+    [](const Model& m) { return dynamic_cast<const PlanarRigidBody*>(&m) != nullptr; }}};
+}  // namespace
+
+}  // namespace gssm::models

@@ -1,0 +1,78 @@
+#!/usr/bin/python3
+"""gssm-process on the real UWB planar-pose log (datasets/uwb-fast): the
+batch smoother's body-origin and yaw RMSE against the issue's targets, its 24
+learnt link biases against the source repository's calibration runs
+(bias + slope x the link's mean true distance, computed here from the truth),
+and the estimates' columns; the EKF runs over the whole log.
+
+    process_uwb.py BIN_DIR SOURCE_DIR WORK_DIR
+"""
+import csv
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+bin_dir, src, work = sys.argv[1:4]
+data = os.path.join(src, "datasets", "uwb-fast")
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+
+
+def check(cond, what):
+    if not cond:
+        sys.exit("FAIL: " + what)
+    print("ok:", what)
+
+
+def quat_rotate(q, v):
+    w, x, y, z = q
+    return (v[0] * (1 - 2 * (y * y + z * z)) + v[1] * 2 * (x * y - w * z) + v[2] * 2 * (x * z + w * y),
+            v[0] * 2 * (x * y + w * z) + v[1] * (1 - 2 * (x * x + z * z)) + v[2] * 2 * (y * z - w * x),
+            v[0] * 2 * (x * z - w * y) + v[1] * 2 * (y * z + w * x) + v[2] * (1 - 2 * (x * x + y * y)))
+
+
+def reference_biases():
+    """bias + slope x mean true distance of each link (the repository's
+    calibration, judged as a bias-only constant)."""
+    rd = lambda name: list(csv.DictReader(open(os.path.join(data, name))))
+    anchors = {int(r["anchor"]): [float(r[k]) for k in "xyz"] for r in rd("anchors.csv")}
+    tags = {int(r["tag"]): [float(r[k]) for k in "xyz"] for r in rd("tags.csv")}
+    truth = rd("truth.csv")[::10]
+    total = {(t, a): 0.0 for t in tags for a in anchors}
+    for row in truth:
+        p = [float(row[k]) for k in "xyz"]
+        q = [float(row[k]) for k in ("qw", "qx", "qy", "qz")]
+        for t, lever in tags.items():
+            r = quat_rotate(q, lever)
+            tag = [p[i] + r[i] for i in range(3)]
+            for a, pos in anchors.items():
+                total[(t, a)] += math.dist(tag, pos)
+    return {(int(r["tag"]), int(r["anchor"])):
+            float(r["bias"]) + float(r["slope"]) * total[(int(r["tag"]), int(r["anchor"]))] / len(truth)
+            for r in rd("calibration_reference.csv")}
+
+
+out = os.path.join(work, "uwb")
+r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--method", "batch", "--out", out],
+                   capture_output=True, text=True)
+check(r.returncode == 0, "gssm-process --method batch runs on uwb-fast: " + r.stderr.strip()[-300:])
+m = json.load(open(os.path.join(out, "metrics.json")))["methods"]["batch"]
+check(m["rows"] == 13481, "one estimate row per epoch (%d)" % m["rows"])
+origin, yaw = m["position_error_m"]["rmse"], math.degrees(m["rmse"]["yaw"])
+check(origin <= 0.042, "batch body-origin RMSE %.2f cm <= 4.2 cm" % (100 * origin))
+check(yaw <= 4.7, "batch yaw RMSE %.2f deg <= 4.7 deg" % yaw)
+ref = reference_biases()
+diff = [m["constants"]["bias_%d_%d" % k] - v for k, v in ref.items()]
+rms = math.sqrt(sum(d * d for d in diff) / len(diff))
+check(len(diff) == 24 and rms <= 0.020, "24 learnt link biases %.2f cm RMS from the calibration runs (<= 2.0 cm)" % (100 * rms))
+header = open(os.path.join(out, "estimates-batch.csv")).readline().strip().split(",")
+check(header[:4] == ["t", "px", "py", "yaw"] and "bias_2_7" in header and "sd_bias_2_7" in header,
+      "estimates columns t, px, py, yaw, bias_<tag>_<anchor> and their sd_")
+r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--method", "ekf", "--out", out],
+                   capture_output=True, text=True)
+e = json.load(open(os.path.join(out, "metrics.json")))["methods"]["ekf"]
+check(r.returncode == 0 and e["position_error_m"]["rmse"] < 0.1,
+      "the EKF (30 states) over the whole log: origin RMSE %.2f cm" % (100 * e["position_error_m"]["rmse"]))

@@ -1,0 +1,105 @@
+// The [dataset] options a log of several tags and anchors needs: a channel
+// named by two columns (tag, anchor), the truth's yaw from a quaternion and
+// interpolated to the measurement times, start_time = first, a non-physical
+// value dropped and listed, one row per epoch; bad rows named by file:line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+
+#include "gssm/analysis/offline.h"
+#include "gssm/core/error.h"
+#include "gssm/io/config.h"
+#include "gssm/io/dataset.h"
+
+using namespace gssm;
+namespace fs = std::filesystem;
+
+namespace {
+const char* kIni =
+    "[model]\ntype = planar_rigid_body\nT = 0.01\nanchors = [0 -3 3 1; 1 3 3 1; 2 0 -3 1]\n"
+    "tags = [0 -0.1 0 0; 1 0.1 0 0]\nheight = 1\n"
+    "[dataset]\nmeasurements = ranges.csv\nmeasurement_columns = range\nchannel_column = tag anchor\n"
+    "channel_prefix = range_\ndrop_at_or_below = 0\ntruth = truth.csv\n"
+    "truth_columns = px=x py=y yaw=yaw(qw,qx,qy,qz)\ntruth_interpolate = true\nstart_time = first\nrows = epochs\n";
+
+std::string writeLog(const std::string& name, const std::string& ranges) {
+  const fs::path dir = fs::path(::testing::TempDir()) / name;
+  fs::create_directories(dir);
+  std::ofstream(dir / "scenario.ini") << kIni;
+  std::ofstream(dir / "ranges.csv") << ranges;
+  // Yaw 0.2 rad at t = 0 and 0.4 rad at t = 1 (quaternion about z, scalar first).
+  std::ofstream truth(dir / "truth.csv");
+  truth.precision(17);
+  truth << "t,x,y,z,qw,qx,qy,qz\n"
+                                   << "0,1,2,1," << std::cos(0.1) << ",0,0," << std::sin(0.1) << "\n"
+                                   << "1,2,4,1," << std::cos(0.2) << ",0,0," << std::sin(0.2) << "\n";
+  return dir.string();
+}
+
+io::Dataset read(const std::string& dir, io::BadRows bad = io::BadRows::Throw) {
+  const io::IniDocument ini = io::readScenario(dir);
+  const auto model = io::makeModel(ini, dir);
+  io::Dataset d;
+  io::readDatasetData(dir, *model, d, bad, &ini);
+  return d;
+}
+}  // namespace
+
+TEST(DatasetLayouts, LinksNamedByTwoColumnsAndTruthYawInterpolated) {
+  const std::string dir = writeLog("uwb_layout",
+                                   "t,tag,anchor,range\n0.25,0,0,4.1\n0.25,1,2,3.9\n0.25,0,1,0\n0.5,1,1,2.5\n");
+  const io::Dataset d = read(dir);
+  ASSERT_EQ(d.measurements.size(), 3u);  // the range of 0 dropped
+  const auto model = io::makeModel(io::readScenario(dir), dir);
+  EXPECT_EQ(model->channel(d.measurements[0].channel).name, "range_0_0");
+  EXPECT_EQ(model->channel(d.measurements[1].channel).name, "range_1_2");
+  EXPECT_EQ(model->channel(d.measurements[2].channel).name, "range_1_1");
+  EXPECT_EQ(d.measurements[2].y[0], 2.5);
+  ASSERT_EQ(d.dropped.size(), 1u);
+  EXPECT_NE(d.dropped[0].find("ranges.csv:4"), std::string::npos) << d.dropped[0];
+  EXPECT_DOUBLE_EQ(d.t0, 0.25 - 0.01);  // start_time = first: one nominal step before
+  EXPECT_EQ(d.rows, RowTimes::Epochs);
+  // The truth at the two epochs (0.25, 0.5), linear in position and yaw.
+  ASSERT_TRUE(d.truth);
+  ASSERT_EQ(d.truth->times.size(), 2u);
+  EXPECT_EQ(d.truth->components, (std::vector<int>{0, 1, 2}));
+  EXPECT_NEAR(d.truth->states[0][0], 1.25, 1e-12);
+  EXPECT_NEAR(d.truth->states[1][1], 3.0, 1e-12);
+  EXPECT_NEAR(d.truth->states[0][2], 0.25, 1e-12);
+  EXPECT_NEAR(d.truth->states[1][2], 0.3, 1e-12);
+}
+
+TEST(DatasetLayouts, AnUnknownLinkIsNamedByFileLineAndColumns) {
+  const std::string dir = writeLog("uwb_bad_link", "t,tag,anchor,range\n0.25,0,0,4.1\n0.3,5,0,3.9\n");
+  try {
+    read(dir);
+    FAIL() << "an unknown tag was accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("ranges.csv:3: columns 'tag, anchor': '5, 0' names channel 'range_5_0'"), std::string::npos)
+        << msg;
+  }
+  const io::Dataset partial = read(dir, io::BadRows::Stop);  // what came before is kept
+  EXPECT_EQ(partial.measurements.size(), 1u);
+  ASSERT_EQ(partial.row_errors.size(), 1u);
+}
+
+TEST(DatasetLayouts, EpochRowsOfAStreamingRunAreTheBatchRows) {
+  const std::string dir = writeLog("uwb_epochs",
+                                   "t,tag,anchor,range\n0.25,0,0,4.1\n0.25,1,2,3.9\n0.25,0,1,3.2\n0.5,1,1,2.5\n"
+                                   "0.5,0,2,4.4\n0.75,1,0,4.0\n");
+  const io::Dataset d = read(dir);
+  const auto model = io::makeModel(io::readScenario(dir), dir);
+  EstimatorOptions o(Method::Ekf);
+  o.t0 = d.t0;
+  const OfflineRun ekf = runOffline(*model, o, d.measurements, {}, {}, {}, d.rows);
+  o.method = Method::Batch;
+  const OfflineRun batch = runOffline(*model, o, d.measurements, {}, {}, {}, d.rows);
+  ASSERT_EQ(ekf.rows.size(), 3u);
+  ASSERT_EQ(batch.rows.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(ekf.rows[i].t, batch.rows[i].t);
+  EXPECT_EQ(ekf.update_seconds.size(), 6u);  // still one update per measurement
+}
