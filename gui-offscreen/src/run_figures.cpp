@@ -114,18 +114,25 @@ Figure planFigure(const std::vector<std::string>& names, const std::vector<Offli
     }
     f.series.push_back(std::move(p));
   }
+  // A small square marker per landmark, drawn as a closed series: 1.2% of
+  // the drawing's extent (3 m on Plaza's 250 m, 12 cm in a 10 m room).
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& s : f.series)
+    for (std::size_t i = 0; i < s.x.size(); ++i)
+      lo = std::min({lo, s.x[i], s.y[i]}), hi = std::max({hi, s.x[i], s.y[i]});
+  for (const auto& c : plan.landmarks) lo = std::min({lo, c.x(), c.y()}), hi = std::max({hi, c.x(), c.y()});
+  const double h = hi > lo ? 0.012 * (hi - lo) : 1.0;
   for (std::size_t b = 0; b < plan.landmarks.size(); ++b) {
-    // a small square marker per landmark, drawn as a closed series
     const Eigen::Vector2d c = plan.landmarks[b];
-    Series m{b == 0 ? plan.landmark_label : "", {c.x() - 3, c.x() + 3, c.x() + 3, c.x() - 3, c.x() - 3},
-             {c.y() - 3, c.y() - 3, c.y() + 3, c.y() + 3, c.y() - 3}, Color{200, 0, 0}, 3, false};
+    Series m{b == 0 ? plan.landmark_label : "", {c.x() - h, c.x() + h, c.x() + h, c.x() - h, c.x() - h},
+             {c.y() - h, c.y() - h, c.y() + h, c.y() + h, c.y() - h}, Color{200, 0, 0}, 3, false};
     f.series.push_back(std::move(m));
   }
   // Headroom above the data for the legend (it would hide a beacon).
-  double lo = INFINITY, hi = -INFINITY;
+  double ylo = INFINITY, yhi = -INFINITY;
   for (const auto& s : f.series)
-    for (double y : s.y) lo = std::min(lo, y), hi = std::max(hi, y);
-  if (hi > lo) f.ylim = std::make_pair(lo - 0.05 * (hi - lo), hi + 0.55 * (hi - lo));
+    for (double y : s.y) ylo = std::min(ylo, y), yhi = std::max(yhi, y);
+  if (yhi > ylo) f.ylim = std::make_pair(ylo - 0.05 * (yhi - ylo), yhi + 0.55 * (yhi - ylo));
   return f;
 }
 
