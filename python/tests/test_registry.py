@@ -77,3 +77,19 @@ def test_bad_keyword_values_name_the_keyword():
         gssm.models.RangeBeacon2D()
     with pytest.raises(gssm.Error, match=r"RangeBeacon2D\(loss=...\).*huber"):
         gssm.models.RangeBeacon2D(beacons=[[0, 0.0, 0.0]], loss="hubber")
+
+
+def test_planar_rigid_body_from_keywords_and_from_the_uwb_log(repo):
+    anchors = [[0, -3.0, 3.0, 1.0], [1, 3.0, 3.0, 1.0], [2, 0.0, -3.0, 1.0]]
+    tags = [[0, -0.1, 0.0, 0.0], [1, 0.1, 0.0, 0.0]]
+    m = gssm.models.PlanarRigidBody(anchors=anchors, tags=tags, height=1.0, range_sd=0.05)
+    assert isinstance(m, gssm.models.PlanarRigidBody) and m.nc == 6 and m.nb == 6
+    assert [c.name for c in m.channels][:2] == ["range_0_0", "range_0_1"]
+    assert m.constant_names[-1] == "bias_1_2" and m.angle_states == [2]
+    np.testing.assert_array_equal(m.landmarks, [[-3.0, 3.0], [3.0, 3.0], [0.0, -3.0]])
+    data = gssm.simulate(m, seed=3, steps=120, channels=[c.name for c in m.channels])
+    run = gssm.run(m, data, method="batch")
+    assert np.all(np.abs(run.mean[-1, 6:] - data.truth_x[-1, 6:]) < 4 * run.sd[-1, 6:])
+    uwb = gssm.io.read_dataset(os.path.join(repo, "datasets", "uwb-fast"))
+    assert isinstance(uwb.model, gssm.models.PlanarRigidBody) and len(uwb.model.channels) == 24
+    assert len(uwb) == 323514 and uwb.truth_x.shape[1] == 3
