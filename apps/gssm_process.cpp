@@ -88,6 +88,9 @@ int main(int argc, char** argv) {
     cli.parse(argc, argv);
     const gssm::io::ProcessOptions options = processOptions(cli);
     const gssm::io::ProcessResult r = gssm::io::processDataset(options, consoleCallbacks());
+    if (r.status.late_rows > 0)
+      std::cout << "gssm-process: " << r.status.late_rows << " measurement rows came after later ones (up to "
+                << r.status.max_lateness << " s late): processed in time order\n";
     for (const auto& p : gssm::plot::writeProcessFigures(r, options.out_dir)) std::cout << "figure: " << p << "\n";
     std::cout << "gssm-process: wrote " << options.out_dir << "/metrics.json and estimates-*.csv\n";
     if (r.status.partial) {

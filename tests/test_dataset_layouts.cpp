@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <iomanip>
 
 #include "gssm/analysis/offline.h"
@@ -102,4 +103,49 @@ TEST(DatasetLayouts, EpochRowsOfAStreamingRunAreTheBatchRows) {
   ASSERT_EQ(batch.rows.size(), 3u);
   for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(ekf.rows[i].t, batch.rows[i].t);
   EXPECT_EQ(ekf.update_seconds.size(), 6u);  // still one update per measurement
+}
+
+namespace {
+// Writes a two-beacon range log: `order` lists the rows' times as written.
+std::string writeBeaconLog(const std::string& name, const std::vector<double>& times, const std::string& extra = "") {
+  const fs::path dir = fs::path(::testing::TempDir()) / name;
+  fs::create_directories(dir);
+  std::ofstream(dir / "scenario.ini")
+      << "[model]\ntype = range_beacon_2d\nbeacons = [0 0 0; 1 10 0]\nrange_scale = false\n[prior]\nstart = 5 5\n"
+      << "[dataset]\nmeasurements = ranges.csv\nmeasurement_columns = range\nchannel_column = beacon\n"
+      << "channel_prefix = range_\n" << extra;
+  std::ofstream ranges(dir / "ranges.csv");
+  ranges << "t,beacon,range\n";
+  for (double t : times) ranges << t << "," << (static_cast<int>(t * 10) % 2) << "," << 7 + t << "\n";
+  return dir.string();
+}
+}  // namespace
+
+TEST(DatasetLayouts, RowsWrittenLateAreReadInTimeOrderAndCounted) {
+  // Two blocks written late (as the Plaza radio's): 0.6-0.8 after 1.0, 1.3 after 1.5.
+  const std::vector<double> written{0.1, 0.2, 0.3, 0.4, 0.5, 0.9, 1.0, 0.6, 0.7, 0.8, 1.1, 1.2, 1.4, 1.5, 1.3, 1.6};
+  std::vector<double> sorted = written;
+  std::sort(sorted.begin(), sorted.end());
+  const io::Dataset late = read(writeBeaconLog("late_blocks", written));
+  const io::Dataset inorder = read(writeBeaconLog("in_order", sorted));
+  EXPECT_EQ(late.late_rows, 4u);
+  EXPECT_NEAR(late.max_lateness, 1.0 - 0.6, 1e-12);
+  EXPECT_EQ(inorder.late_rows, 0u);
+  ASSERT_EQ(late.measurements.size(), inorder.measurements.size());
+  for (std::size_t i = 0; i < late.measurements.size(); ++i) {
+    EXPECT_EQ(late.measurements[i].t, inorder.measurements[i].t);
+    EXPECT_EQ(late.measurements[i].channel, inorder.measurements[i].channel);
+    EXPECT_EQ(late.measurements[i].y, inorder.measurements[i].y);
+  }
+  // Strict, by option: the first row that goes back is named, what came before kept.
+  const std::string strict = writeBeaconLog("late_strict", written, "out_of_order = error\n");
+  try {
+    read(strict);
+    FAIL() << "a row back in time was accepted with out_of_order = error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("ranges.csv:9: column 't': time 0.6 is before the previous row's 1"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(read(strict, io::BadRows::Stop).measurements.size(), 7u);
 }

@@ -260,6 +260,15 @@ ChannelColumn channelColumn(const IniDocument& ini, const CsvTable& m) {
   return cc;
 }
 
+// [dataset] out_of_order: sort (the default: rows that go back in time are
+// put in time order, counted) or error (today's strict reading).
+bool strictTimeOrder(const IniDocument& ini) {
+  const std::string mode = ini.getString("dataset", "out_of_order", "sort");
+  if (mode != "sort" && mode != "error")
+    throw InputError(ini.where("dataset", "out_of_order") + " = '" + mode + "': expected sort or error");
+  return mode == "error";
+}
+
 // Measurements: one channel per row, named by a column (or the default).
 void readMeasurements(const std::string& path, const IniDocument& ini, const Model& model, Dataset& out,
                       BadRows bad_rows) {
@@ -271,6 +280,8 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
     cols.push_back(requireColumn(m, n, "[dataset] measurement_columns"));
   const ChannelColumn channels = channelColumn(ini, m);
   const double drop_at_or_below = ini.getDouble("dataset", "drop_at_or_below", -std::numeric_limits<double>::infinity());
+  const bool strict = strictTimeOrder(ini);
+  double latest = -std::numeric_limits<double>::infinity();
   std::size_t next_error = 0;
   out.measurements.reserve(m.rows.size());
   for (std::size_t r = 0; r < m.rows.size(); ++r) {
@@ -285,9 +296,9 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
       throw InputError(ini.source() + ": [dataset] measurement_columns names " + std::to_string(cols.size()) +
                        " columns; channel '" + model.channel(channel).name + "' has " +
                        std::to_string(model.channel(channel).dim()) + " components");
-    if (problem.empty() && !out.measurements.empty() && t < out.measurements.back().t)
+    if (problem.empty() && strict && !out.measurements.empty() && t < out.measurements.back().t)
       problem = "column 't': time " + formatDouble(t) + " is before the previous row's " +
-                formatDouble(out.measurements.back().t);
+                formatDouble(out.measurements.back().t) + " ([dataset] out_of_order = error)";
     if (problem.empty() && !(t > out.t0))
       problem = "column 't': time " + formatDouble(t) + " is not after the start " + formatDouble(out.t0);
     if (!problem.empty()) {
@@ -306,8 +317,14 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
                             " (dropped as non-physical)");
       continue;
     }
+    if (t < latest) ++out.late_rows, out.max_lateness = std::max(out.max_lateness, latest - t);
+    latest = std::max(latest, t);
     out.measurements.push_back({t, y, channel, {}});
   }
+  // Rows written late (blocks, buffers): in time order, equal times in file order.
+  if (out.late_rows > 0)
+    std::stable_sort(out.measurements.begin(), out.measurements.end(),
+                     [](const Measurement& a, const Measurement& b) { return a.t < b.t; });
   std::sort(errors.begin(), errors.end(), [](const CsvRowError& a, const CsvRowError& b) { return a.line < b.line; });
   for (const auto& e : errors) {
     out.row_errors.push_back(e.message);
@@ -319,7 +336,7 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
 void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
   ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
                                   "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
-                                  "truth_interpolate", "start_time", "rows", "drop_at_or_below"});
+                                  "truth_interpolate", "start_time", "rows", "drop_at_or_below", "out_of_order"});
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   out.truth.reset();
   if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0
@@ -329,6 +346,8 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   out.measurements.clear();
   out.row_errors.clear();
   out.dropped.clear();
+  out.late_rows = 0;
+  out.max_lateness = 0;
   if (ini.has("dataset", "measurements")) readMeasurements(file("measurements"), ini, model, out, bad_rows);
   if (std::isinf(out.t0))  // start_time = first
     out.t0 = out.measurements.empty() ? 0.0 : out.measurements.front().t - model.nominalStep();

@@ -23,6 +23,7 @@ std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& 
   std::ostringstream os;
   os << "{\n  \"dataset\": " << jsonQuoted(dataset) << ",\n  \"partial\": " << (status.partial ? "true" : "false");
   if (status.partial) os << ",\n  \"stopped_at\": " << jsonQuoted(status.stopped_at);
+  os << ",\n  \"out_of_order_rows\": " << status.late_rows << ",\n  \"max_lateness_s\": " << num(status.max_lateness);
   os << ",\n  \"skipped_rows\": " << status.skipped.size() << ",\n  \"skipped\": [";
   for (std::size_t i = 0; i < status.skipped.size(); ++i) os << (i ? ", " : "") << jsonQuoted(status.skipped[i]);
   os << "],\n  \"methods\": {";

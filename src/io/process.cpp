@@ -64,6 +64,8 @@ void readData(const ProcessOptions& o, const Model& model, ProcessResult& r, con
   readDatasetData(o.data_dir, model, r.dataset, o.skip_bad_rows ? BadRows::Skip : BadRows::Stop, &r.config);
   if (o.skip_bad_rows) r.status.skipped = r.dataset.row_errors;
   else if (!r.dataset.row_errors.empty()) r.status = {true, r.dataset.row_errors.front(), {}};
+  r.status.late_rows = r.dataset.late_rows;
+  r.status.max_lateness = r.dataset.max_lateness;
   // Non-physical values the dataset drops by its own rule: skipped, listed.
   r.status.skipped.insert(r.status.skipped.end(), r.dataset.dropped.begin(), r.dataset.dropped.end());
   if (cb.skipped)

@@ -32,6 +32,10 @@ struct Dataset {
   std::vector<std::string> row_errors;
   /// Rows dropped as non-physical ([dataset] drop_at_or_below), file:line each.
   std::vector<std::string> dropped;
+  /// Measurement rows that came after a later time in the file (put in
+  /// time order, [dataset] out_of_order = sort), and the largest lateness (s).
+  std::size_t late_rows = 0;
+  double max_lateness = 0;
 };
 
 enum class BadRows {

@@ -13,6 +13,8 @@ struct DatasetStatus {
   bool partial = false;               ///< processing stopped at a bad row
   std::string stopped_at;             ///< the error that stopped it
   std::vector<std::string> skipped;   ///< rows skipped (--skip-bad-rows)
+  std::size_t late_rows = 0;          ///< rows out of time order, put in order
+  double max_lateness = 0;            ///< the latest of them, s
 };
 
 /// metrics.json for several runs of one dataset.
