@@ -11,7 +11,7 @@ namespace gssm::models {
 namespace {
 int countConstants(const RangeBeacon2D::Params& p) {
   return (p.range_scale ? 1 : 0) + (p.range_offsets ? static_cast<int>(p.beacons.size()) : 0) +
-         (p.odometry_scale ? 1 : 0);
+         (p.odometry_scale ? 1 : 0) + (p.heading_rate_bias ? 1 : 0);
 }
 
 ModelNames beaconNames(const RangeBeacon2D::Params& p) {
@@ -20,6 +20,7 @@ ModelNames beaconNames(const RangeBeacon2D::Params& p) {
   if (p.range_offsets)
     for (int id : p.beacon_ids) n.constants.push_back("range_offset_" + std::to_string(id));
   if (p.odometry_scale) n.constants.push_back("odometry_scale");
+  if (p.heading_rate_bias) n.constants.push_back("heading_rate_bias");
   if (!p.beacon_ids.empty()) n.measurement = {"range_" + std::to_string(p.beacon_ids.front())};
   return n;
 }
@@ -41,6 +42,7 @@ ModelNoise beaconNoise(const RangeBeacon2D::Params& p) {
   if (p.range_offsets)
     for (std::size_t b = 0; b < p.beacons.size(); ++b) mean[i] = 0, sd[i++] = p.range_offset_sd;
   if (p.odometry_scale) mean[i] = 1, sd[i++] = p.odometry_scale_sd;
+  if (p.heading_rate_bias) mean[i] = 0, sd[i++] = p.heading_rate_bias_sd;
   n.prior_constants = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
   return n;
 }
@@ -57,6 +59,7 @@ RangeBeacon2D::RangeBeacon2D(const Params& p)
     i += static_cast<int>(p.beacons.size());
   }
   if (p.odometry_scale) i_odo_ = i++;
+  if (p.heading_rate_bias) i_hrb_ = i++;
   std::vector<MeasurementChannel> channels;
   for (int id : p.beacon_ids) {
     MeasurementChannel ch;
@@ -76,7 +79,8 @@ Eigen::VectorXd RangeBeacon2D::f(const Eigen::VectorXd& xc, const Eigen::VectorX
   const double s = i_odo_ >= 0 ? xb[i_odo_] : 1.0;
   const double d = u[0] * dt, c = std::cos(xc[2]), sn = std::sin(xc[2]);
   Eigen::VectorXd out(3);
-  out << xc[0] + s * d * c, xc[1] + s * d * sn, xc[2] + u[1] * dt;
+  const double b = i_hrb_ >= 0 ? xb[i_hrb_] : 0.0;
+  out << xc[0] + s * d * c, xc[1] + s * d * sn, xc[2] + (u[1] - b) * dt;
   if (J_f_xc) {
     *J_f_xc = Eigen::MatrixXd::Identity(3, 3);
     (*J_f_xc)(0, 2) = -s * d * sn;
@@ -88,6 +92,7 @@ Eigen::VectorXd RangeBeacon2D::f(const Eigen::VectorXd& xc, const Eigen::VectorX
       (*J_f_xb)(0, i_odo_) = d * c;
       (*J_f_xb)(1, i_odo_) = d * sn;
     }
+    if (i_hrb_ >= 0) (*J_f_xb)(2, i_hrb_) = -dt;
   }
   return out;
 }
@@ -140,6 +145,7 @@ std::vector<ParamSpec> rangeBeaconParams() {
       flag("model", "range_scale", "estimate a common range scale s_r"),
       flag("model", "range_offsets", "estimate a range offset per beacon"),
       flag("model", "odometry_scale", "estimate an odometry distance scale s_d"),
+      flag("model", "heading_rate_bias", "estimate a bias of the odometry's turn rate (rad/s)"),
       real("model", "range_sd", "σ of one range (m)"),
       real("model", "distance_sd", "odometry position noise, m per √m travelled"),
       real("model", "turn_sd", "heading noise, rad per √rad turned"),
@@ -154,7 +160,8 @@ std::vector<ParamSpec> rangeBeaconParams() {
                   real("prior", "heading_sd", "prior σ of the heading (rad)"),
                   real("prior", "range_scale_sd", "prior σ of s_r (mean 1)"),
                   real("prior", "range_offset_sd", "prior σ of each range offset (mean 0), m"),
-                  real("prior", "odometry_scale_sd", "prior σ of s_d (mean 1)")})
+                  real("prior", "odometry_scale_sd", "prior σ of s_d (mean 1)"),
+                  real("prior", "heading_rate_bias_sd", "prior σ of the turn-rate bias (mean 0), rad/s")})
     p.push_back(q);
   return p;
 }
@@ -182,6 +189,7 @@ RangeBeacon2D::Params readRangeBeacon(const ParamSource& in) {
   p.range_scale = in.flag("model", "range_scale", p.range_scale);
   p.range_offsets = in.flag("model", "range_offsets", p.range_offsets);
   p.odometry_scale = in.flag("model", "odometry_scale", p.odometry_scale);
+  p.heading_rate_bias = in.flag("model", "heading_rate_bias", p.heading_rate_bias);
   for (auto [key, value] : {std::pair{"range_sd", &p.range_sd}, {"distance_sd", &p.distance_sd},
                             {"turn_sd", &p.turn_sd}, {"heading_drift_sd", &p.heading_drift_sd},
                             {"position_sd_per_s", &p.position_sd_per_s}, {"heading_sd_per_s", &p.heading_sd_per_s}})
@@ -195,6 +203,7 @@ RangeBeacon2D::Params readRangeBeacon(const ParamSource& in) {
   p.range_scale_sd = in.real("prior", "range_scale_sd", p.range_scale_sd);
   p.range_offset_sd = in.real("prior", "range_offset_sd", p.range_offset_sd);
   p.odometry_scale_sd = in.real("prior", "odometry_scale_sd", p.odometry_scale_sd);
+  p.heading_rate_bias_sd = in.real("prior", "heading_rate_bias_sd", p.heading_rate_bias_sd);
   return p;
 }
 
@@ -207,6 +216,7 @@ void writeRangeBeacon(const RangeBeacon2D::Params& p, ParamSink& out) {
   out.flag("model", "range_scale", p.range_scale);
   out.flag("model", "range_offsets", p.range_offsets);
   out.flag("model", "odometry_scale", p.odometry_scale);
+  out.flag("model", "heading_rate_bias", p.heading_rate_bias);
   for (auto [key, value] : {std::pair{"range_sd", p.range_sd}, {"distance_sd", p.distance_sd}, {"turn_sd", p.turn_sd},
                             {"heading_drift_sd", p.heading_drift_sd}, {"position_sd_per_s", p.position_sd_per_s},
                             {"heading_sd_per_s", p.heading_sd_per_s}})
@@ -220,6 +230,7 @@ void writeRangeBeacon(const RangeBeacon2D::Params& p, ParamSink& out) {
   out.real("prior", "range_scale_sd", p.range_scale_sd);
   out.real("prior", "range_offset_sd", p.range_offset_sd);
   out.real("prior", "odometry_scale_sd", p.odometry_scale_sd);
+  out.real("prior", "heading_rate_bias_sd", p.heading_rate_bias_sd);
 }
 
 const ModelRegistration registration{{

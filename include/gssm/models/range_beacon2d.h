@@ -5,11 +5,12 @@
 //   u   = [v, omega]: odometry as speed and turn rate over the interval (a
 //         log's distance and heading increments divided by its duration, so
 //         a step split by a range measurement moves in proportion),
-//   px += s_d·v·dt·cos(heading), py += s_d·v·dt·sin(heading), heading += omega·dt
+//   px += s_d·v·dt·cos(heading), py += s_d·v·dt·sin(heading), heading += (omega − b_ω)·dt
 //   range to beacon i (one channel "range_<id>" each) = s_r·‖p − b_i‖ + o_i
 // The constants, each chosen in the configuration: a common range scale s_r
 // (1 when off), a per-beacon range offset o_i (0 when off), an odometry
-// distance scale s_d (1 when off). Process noise grows with the distance and
+// distance scale s_d (1 when off), a heading-rate bias b_ω of the odometry's
+// turn rate (a gyro-like drift; 0 when off). Process noise grows with the distance and
 // the turn of each step (variances additive over split steps).
 #include <vector>
 
@@ -26,6 +27,7 @@ class RangeBeacon2D final : public Model {
     bool range_scale = true;               ///< estimate a common range scale s_r
     bool range_offsets = false;            ///< estimate a range offset per beacon
     bool odometry_scale = false;           ///< estimate an odometry distance scale s_d
+    bool heading_rate_bias = false;        ///< estimate a bias b_ω of the odometry's turn rate
     double range_sd = 0.5;                 ///< σ of one range (m)
     double distance_sd = 0.05;             ///< odometry position noise, m per √m travelled
     double turn_sd = 0.05;                 ///< heading noise, rad per √rad turned
@@ -37,6 +39,7 @@ class RangeBeacon2D final : public Model {
     double range_scale_sd = 0.1;           ///< prior σ of s_r (mean 1)
     double range_offset_sd = 1.0;          ///< prior σ of each o_i (mean 0), m
     double odometry_scale_sd = 0.05;       ///< prior σ of s_d (mean 1)
+    double heading_rate_bias_sd = 0.01;    ///< prior σ of b_ω (mean 0), rad/s
     RobustLoss range_loss;                 ///< on every range channel
     double ekf_gate = 0;                   ///< EKF NIS gate of every range channel (0: none)
   };
@@ -50,6 +53,7 @@ class RangeBeacon2D final : public Model {
   int rangeScaleIndex() const { return i_scale_; }
   int rangeOffsetIndex(std::size_t beacon) const { return i_offset_ < 0 ? -1 : i_offset_ + static_cast<int>(beacon); }
   int odometryScaleIndex() const { return i_odo_; }
+  int headingRateBiasIndex() const { return i_hrb_; }
 
   Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u, double dt,
                     Eigen::MatrixXd* J_f_xc = nullptr, Eigen::MatrixXd* J_f_xb = nullptr) const override;
@@ -64,7 +68,7 @@ class RangeBeacon2D final : public Model {
 
  private:
   Params p_;
-  int i_scale_ = -1, i_offset_ = -1, i_odo_ = -1;
+  int i_scale_ = -1, i_offset_ = -1, i_odo_ = -1, i_hrb_ = -1;
 };
 
 }  // namespace gssm::models
