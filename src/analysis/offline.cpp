@@ -135,7 +135,8 @@ class StreamingRun {
                const std::vector<Input>& inputs, const StreamingCheckpoints& checkpoints, RowTimes rows)
       : model_(model), options_(options), measurements_(measurements), inputs_(inputs), checkpoints_(checkpoints),
         inline_recorder_(out_), recorder_(checkpoints.recorder ? *checkpoints.recorder : inline_recorder_),
-        at_inputs_(rows == RowTimes::Inputs), at_epochs_(rows == RowTimes::Epochs) {
+        at_inputs_(rows == RowTimes::Inputs), at_epochs_(rows == RowTimes::Epochs),
+        group_epochs_(at_epochs_ && !options.compute_nis) {
     out_.method = options.method;
     at_.data_fingerprint = internal::kFnv1a64Basis;
     if (!checkpoints.resume_from.empty()) resume();
@@ -146,11 +147,16 @@ class StreamingRun {
   }
 
   OfflineRun run(const std::function<void(std::size_t, std::size_t)>& progress) {
-    const std::size_t every = std::max<std::size_t>(1, measurements_.size() / 100);
-    for (std::size_t i = at_.next_measurement; i < measurements_.size(); ++i) {
-      update(measurements_[i]);
-      if (progress && ((i + 1) % every == 0 || i + 1 == measurements_.size())) progress(i + 1, measurements_.size());
-      if (!checkpoints_.path.empty() && (i + 1) % checkpoints_.every == 0) checkpoint(i + 1);
+    const std::size_t n = measurements_.size(), every = std::max<std::size_t>(1, n / 100);
+    for (std::size_t i = at_.next_measurement; i < n;) {
+      // With rows per epoch, the measurements of one instant are one update.
+      std::size_t j = i + 1;
+      if (group_epochs_)
+        while (j < n && measurements_[j].t == measurements_[i].t) ++j;
+      update(i, j);
+      if (progress && (j / every > i / every || j == n)) progress(j, n);
+      if (!checkpoints_.path.empty() && j / checkpoints_.every > i / checkpoints_.every) checkpoint(j);
+      i = j;
     }
     feedInputsBefore(std::numeric_limits<double>::infinity());  // inputs after the last measurement
     if ((at_inputs_ || at_epochs_) && at_.row_due) addRow(est_->current());
@@ -162,7 +168,7 @@ class StreamingRun {
 
  private:
   void resume();
-  void update(const Measurement& m);
+  void update(std::size_t first, std::size_t end);
   void checkpoint(std::size_t next_measurement);
   void addRow(const StateEstimate& e) { out_.rows.push_back({e.t, e.mean, e.covariance}); }
   // Events in time order: an input at t makes the state at t (when after
@@ -197,7 +203,7 @@ class StreamingRun {
   OfflineRun out_;
   InlineRecorder inline_recorder_;
   RunRecorder& recorder_;
-  const bool at_inputs_, at_epochs_;
+  const bool at_inputs_, at_epochs_, group_epochs_;
   const Clock::time_point start_ = Clock::now();
   std::unique_ptr<Estimator> est_;
   RunProgress at_;  // where the run is (what a checkpoint stores)
@@ -236,26 +242,40 @@ void StreamingRun::resume() {
   seconds_before_ = out_.total_seconds;
 }
 
-void StreamingRun::update(const Measurement& m) {
+// Measurements [first, end) of one instant (one unless grouped by epoch):
+// one update; each gets an equal share of its time.
+void StreamingRun::update(std::size_t first, std::size_t end) {
+  const Measurement& m = measurements_[first];
   feedInputsBefore(m.t);
   if ((at_inputs_ || at_epochs_) && at_.row_due && m.t > est_->time()) {
     addRow(est_->current());
     at_.row_due = false;
   }
   const auto t0 = Clock::now();
-  est_->addMeasurement(m);
-  out_.update_seconds.push_back(since(t0));
-  at_.data_fingerprint = foldMeasurement(at_.data_fingerprint, m);
+  if (end == first + 1) est_->addMeasurement(m);
+  else est_->addMeasurements(std::vector<Measurement>(measurements_.begin() + first, measurements_.begin() + end));
+  const double seconds = since(t0) / static_cast<double>(end - first);
+  for (std::size_t i = first; i < end; ++i) {
+    out_.update_seconds.push_back(seconds);
+    at_.data_fingerprint = foldMeasurement(at_.data_fingerprint, measurements_[i]);
+  }
   if (options_.compute_nis) out_.nis.push_back(est_->reportNumbers().nis);
+  if (at_epochs_) at_.row_due = true;  // the epoch's row: before the first later measurement
   // The EKF gates instead of weighting; the others' weight is the
   // measurement factor's own, at the estimate after its update.
-  const bool weigh = model_.channel(m.channel).loss.robust() && options_.method != Method::Ekf;
-  if (at_epochs_) at_.row_due = true;  // the epoch's row: before the first later measurement
+  bool weigh = false;
+  for (std::size_t i = first; i < end; ++i)
+    weigh = weigh || (model_.channel(measurements_[i].channel).loss.robust() && options_.method != Method::Ekf);
   const bool row_now = !at_inputs_ && !at_epochs_;
   if (row_now || weigh) {
     const StateEstimate e = est_->current();
     if (row_now) addRow(e);
-    if (weigh && MeasurementFactor(model_, e.step, m).weight(stateValues(model_, e)) < 1.0) ++out_.downweighted;
+    for (std::size_t i = first; weigh && i < end; ++i) {
+      const Measurement& mi = measurements_[i];
+      if (model_.channel(mi.channel).loss.robust() &&
+          MeasurementFactor(model_, e.step, mi).weight(stateValues(model_, e)) < 1.0)
+        ++out_.downweighted;
+    }
   }
   out_.rejected = est_->reportNumbers().rejected;  // not report(): formatting its line costs ~15% of an EKF update
   out_.iterations = std::max(out_.iterations, est_->reportNumbers().iterations);

@@ -147,7 +147,7 @@ Eigen::VectorXd Estimator::inputInForce() const {
 
 void Estimator::advance(double t) {
   const auto start = std::chrono::steady_clock::now();
-  doStep(k_ + 1, t - t_, inputInForce(), nullptr);
+  doStep(k_ + 1, t - t_, inputInForce(), nullptr, 0);
   t_ = t;
   ++k_;
   report_.measurements = k_;
@@ -185,8 +185,7 @@ void Estimator::addMeasurement(double t, const std::string& channel, const Eigen
   addMeasurement(Measurement{t, y, model_.channelIndex(channel), {}});
 }
 
-void Estimator::addMeasurement(const Measurement& m) {
-  const auto start = std::chrono::steady_clock::now();
+void Estimator::requireUsable(const Measurement& m) const {
   const double t = m.t;
   if (!std::isfinite(t) || t < t_ || (t == t_ && k_ == 0)) {
     std::ostringstream os;
@@ -206,17 +205,44 @@ void Estimator::addMeasurement(const Measurement& m) {
   if (m.R.size())
     requireCovariance(m.R, ch.dim(), std::string(methodName()) + ": own noise covariance of the measurement at t = " +
                                          std::to_string(t));
-  const double nis = options_.compute_nis ? innovationNis(t - t_, inputInForce(), m) : report_.nis;
+}
+
+void Estimator::addMeasurement(const Measurement& m) {
+  const auto start = std::chrono::steady_clock::now();
+  requireUsable(m);
+  const double nis = options_.compute_nis ? innovationNis(m.t - t_, inputInForce(), m) : report_.nis;
+  addAt(m.t, &m, 1);
+  report_.nis = nis;
+  report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Estimator::addMeasurements(const std::vector<Measurement>& ms) {
+  if (ms.empty()) return;
+  if (options_.compute_nis) {
+    for (const auto& m : ms) addMeasurement(m);
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  for (const auto& m : ms) {
+    requireUsable(m);
+    if (m.t != ms.front().t)
+      throw InvalidArgument(std::string(methodName()) + ": addMeasurements takes one instant; t = " +
+                            std::to_string(m.t) + " differs from " + std::to_string(ms.front().t));
+  }
+  addAt(ms.front().t, ms.data(), ms.size());
+  report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Validated measurements at time t: at the newest state, or a new one.
+void Estimator::addAt(double t, const Measurement* ms, std::size_t count) {
   if (t == t_) {
-    doMeasurement(k_, m);  // at the newest state
+    doMeasurements(k_, ms, count);
   } else {
-    doStep(k_ + 1, t - t_, inputInForce(), &m);  // strong guarantee: throws before changing anything
+    doStep(k_ + 1, t - t_, inputInForce(), ms, count);  // strong guarantee: throws before changing anything
     t_ = t;
     ++k_;
   }
-  report_.nis = nis;
   report_.measurements = k_;
-  report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 namespace {
@@ -258,19 +284,19 @@ class EkfEstimator final : public Estimator {
   }
 
  protected:
-  void doStep(std::int64_t, double dt, const Eigen::VectorXd& u, const Measurement* m) override {
+  void doStep(std::int64_t, double dt, const Eigen::VectorXd& u, const Measurement* ms, std::size_t count) override {
     ExtendedKalmanFilter next = ekf_;  // commit only if both halves succeed
     next.predict(ekf_.time() + dt, u);
-    if (m) next.update(*m);
+    for (std::size_t i = 0; i < count; ++i) next.update(ms[i]);
     ekf_ = std::move(next);
     report_.iterations = 1;
     report_.rejected = ekf_.rejected();
-    updated_ = m != nullptr;
+    updated_ = count > 0;
     markDetail();
   }
-  void doMeasurement(std::int64_t, const Measurement& m) override {
+  void doMeasurements(std::int64_t, const Measurement* ms, std::size_t count) override {
     ExtendedKalmanFilter next = ekf_;
-    next.update(m);
+    for (std::size_t i = 0; i < count; ++i) next.update(ms[i]);
     ekf_ = std::move(next);
     report_.rejected = ekf_.rejected();
     updated_ = true;
@@ -348,8 +374,8 @@ class SmootherEstimator final : public Estimator {
   }
 
  protected:
-  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* m) override {
-    const auto factors = stepFactors(model_, k, dt, u, m);
+  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* ms, std::size_t count) override {
+    const auto factors = stepFactors(model_, k, dt, u, ms, count);
     const Eigen::VectorXd xb = model_.dims().nb ? smoother_.estimate(Key::constants())
                                                 : Eigen::VectorXd(Eigen::VectorXd::Zero(0));
     Values initial;
@@ -360,8 +386,10 @@ class SmootherEstimator final : public Estimator {
     times_.push_back(times_.back() + dt);
     while (keep_times_ > 0 && times_.size() > keep_times_) times_.pop_front();
   }
-  void doMeasurement(std::int64_t k, const Measurement& m) override {
-    report_.smoother = smoother_.update({std::make_shared<MeasurementFactor>(model_, k, m)}, Values{});
+  void doMeasurements(std::int64_t k, const Measurement* ms, std::size_t count) override {
+    std::vector<FactorPtr> factors;
+    for (std::size_t i = 0; i < count; ++i) factors.push_back(std::make_shared<MeasurementFactor>(model_, k, ms[i]));
+    report_.smoother = smoother_.update(factors, Values{});
     report_.iterations = report_.smoother.iterations;
     markDetail();
   }
@@ -431,14 +459,14 @@ class PaperWindowEstimator final : public Estimator {
   }
 
  protected:
-  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* m) override {
+  void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* ms, std::size_t count) override {
     // Work on copies; commit at the end.
     auto steps = steps_;
     auto times = times_;
     Values values = values_;
     Gaussian prior_state = prior_state_, prior_constants = prior_constants_;
     std::int64_t oldest = oldest_;
-    steps.push_back(stepFactors(model_, k, dt, u, m));
+    steps.push_back(stepFactors(model_, k, dt, u, ms, count));
     const Eigen::VectorXd xb = model_.dims().nb ? values.at(Key::constants()) : Eigen::VectorXd();
     values.insert(Key::state(k), predictState(model_, values.at(Key::state(k - 1)), xb, u, dt, k));
     times.push_back(times.back() + dt);
@@ -470,10 +498,10 @@ class PaperWindowEstimator final : public Estimator {
   }
 
  private:
-  void doMeasurement(std::int64_t k, const Measurement& m) override {
+  void doMeasurements(std::int64_t k, const Measurement* ms, std::size_t count) override {
     auto steps = steps_;
     Values values = values_;
-    steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, m));
+    for (std::size_t i = 0; i < count; ++i) steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, ms[i]));
     BatchSolver solver(gaussNewton());
     const BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state_, prior_constants_, oldest_), values);
     steps_ = std::move(steps);

@@ -43,9 +43,9 @@ std::vector<FactorPtr> priorFactors(const Model& model, const Gaussian& state_pr
 }
 
 std::vector<FactorPtr> stepFactors(const Model& model, std::int64_t k, double dt, const Eigen::VectorXd& u,
-                                   const Measurement* measurement) {
+                                   const Measurement* measurements, std::size_t count) {
   std::vector<FactorPtr> f{std::make_shared<ProcessFactor>(model, k - 1, u, dt)};
-  if (measurement) f.push_back(std::make_shared<MeasurementFactor>(model, k, *measurement));
+  for (std::size_t i = 0; i < count; ++i) f.push_back(std::make_shared<MeasurementFactor>(model, k, measurements[i]));
   return f;
 }
 

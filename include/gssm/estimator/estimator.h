@@ -110,6 +110,12 @@ class Estimator {
   /// A measurement on m.channel, with its own noise covariance m.R when given
   /// (a receiver that reports its accuracy).
   void addMeasurement(const Measurement& m);
+  /// Several measurements of one instant (an epoch: every sensor read at
+  /// once) as one update: the smoothers add all their factors in one
+  /// elimination, the EKF updates with each in turn. All share one time,
+  /// checked like addMeasurement's; none is taken if one is refused. With
+  /// compute_nis they go one by one (each NIS before its own update).
+  void addMeasurements(const std::vector<Measurement>& ms);
 
   /// Newest state and constants with their joint covariance.
   virtual StateEstimate current() = 0;
@@ -144,15 +150,19 @@ class Estimator {
  protected:
   /// Validated options (makeEstimator); the report starts with what they say is used.
   Estimator(const Model& model, const EstimatorOptions& options);
-  /// Processes a validated step k−1 → k under input u, with the measurement
-  /// y at x_c(k) when y is non-empty; must be strongly exception safe.
-  virtual void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* m) = 0;
-  /// Adds a measurement at the newest state x_c(k), k ≥ 1; strongly safe.
-  virtual void doMeasurement(std::int64_t k, const Measurement& m) = 0;
+  /// Processes a validated step k−1 → k under input u, with the `count`
+  /// measurements ms[0..count) at x_c(k); must be strongly exception safe.
+  virtual void doStep(std::int64_t k, double dt, const Eigen::VectorXd& u, const Measurement* ms,
+                      std::size_t count) = 0;
+  /// Adds measurements ms[0..count) at the newest state x_c(k), k ≥ 1; strongly safe.
+  virtual void doMeasurements(std::int64_t k, const Measurement* ms, std::size_t count) = 0;
   /// The one-line `detail` of the last update, called by report() only
   /// after markDetail() (default: the smoother report's line).
   virtual std::string formatDetail() const { return report_.smoother.toString(); }
   void markDetail() { detail_stale_ = true; }
+  /// addMeasurement's checks of one measurement (time, channel, values, R).
+  void requireUsable(const Measurement& m) const;
+  void addAt(double t, const Measurement* ms, std::size_t count);
 
   const Model& model_;
   mutable EstimatorReport report_;

@@ -24,9 +24,9 @@ std::vector<FactorPtr> priorFactors(const Model& model, const Gaussian& state_pr
 
 /// What the step k−1 → k adds to the graph: its process factor x_c(k−1) →
 /// x_c(k) under input u over dt (touching x_b), and the measurement at
-/// x_c(k) when one is given (docs/DESIGN.md §1, eqs. 2–3).
+/// x_c(k) of each of measurements[0..count) (docs/DESIGN.md §1, eqs. 2–3).
 std::vector<FactorPtr> stepFactors(const Model& model, std::int64_t k, double dt, const Eigen::VectorXd& u,
-                                   const Measurement* measurement = nullptr);
+                                   const Measurement* measurements = nullptr, std::size_t count = 0);
 
 /// x_c(0) sits at t0; each measurement opens a new step. Inputs are held
 /// (zero-order hold) from their time on; before the first input u = 0.
