@@ -99,11 +99,18 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
     ++rejected_;
     return false;
   }
-  const Eigen::MatrixXd K = llt.solve(H * P_).transpose();  // P Hᵀ S⁻¹ (P, S symmetric)
-  const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(n, n) - K * H;
-  Eigen::MatrixXd P = options_.joseph_form
-                          ? Eigen::MatrixXd(IKH * P_ * IKH.transpose() + K * R * K.transpose())
-                          : Eigen::MatrixXd(IKH * P_);
+  const Eigen::MatrixXd HP = H * P_;                        // m × n
+  const Eigen::MatrixXd K = llt.solve(HP).transpose();       // P Hᵀ S⁻¹ (P, S symmetric)
+  // Joseph form (I − KH) P (I − KH)ᵀ + K R Kᵀ, expanded as
+  // P − K(HP) − (K(HP))ᵀ + K S Kᵀ: O(n²m) for an m-row update instead of
+  // two n×n×n products (a 30-state filter's scalar update: 6× fewer flops).
+  Eigen::MatrixXd P;
+  if (options_.joseph_form) {
+    const Eigen::MatrixXd KHP = K * HP;
+    P = P_ - KHP - KHP.transpose() + K * S * K.transpose();
+  } else {
+    P = P_ - K * HP;
+  }
   P = 0.5 * (P + P.transpose());
   Eigen::LLT<Eigen::MatrixXd> pcheck(P);
   if (pcheck.info() != Eigen::Success || !P.allFinite())
