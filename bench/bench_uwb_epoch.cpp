@@ -1,0 +1,77 @@
+// Per-epoch latency on the real UWB log (datasets/uwb-fast: 24 ranges an
+// epoch, 24 link-bias constants): each streaming estimator fed the first
+// 2000 epochs, an epoch as one update (Estimator::addMeasurements) or range
+// by range; the median and p99 of the epoch times as counters (seconds), in
+// one run so the ratios to the EKF share the machine's state.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+
+#include "gssm/analysis/metrics.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/io/config.h"
+#include "gssm/io/dataset.h"
+
+namespace {
+
+struct Log {
+  std::unique_ptr<gssm::Model> model;
+  gssm::io::Dataset data;
+  std::vector<std::vector<gssm::Measurement>> epochs;
+  gssm::EstimatorOptions options;
+};
+
+const Log& uwbLog() {
+  static Log log = [] {
+    Log l;
+    const std::string dir = std::string(GSSM_SOURCE_DIR) + "/datasets/uwb-fast";
+    const gssm::io::IniDocument ini = gssm::io::readScenario(dir);
+    l.model = gssm::io::makeModel(ini, dir);
+    gssm::io::readDatasetData(dir, *l.model, l.data, gssm::io::BadRows::Throw, &ini);
+    for (const auto& m : l.data.measurements) {
+      if (l.epochs.empty() || l.epochs.back().front().t != m.t) {
+        if (l.epochs.size() == 2000) break;
+        l.epochs.emplace_back();
+      }
+      l.epochs.back().push_back(m);
+    }
+    l.options = gssm::io::estimatorOptions(ini, *l.model);
+    l.options.t0 = l.data.t0;
+    return l;
+  }();
+  return log;
+}
+
+void streamEpochs(benchmark::State& state, gssm::Method method, bool grouped) {
+  const Log& log = uwbLog();
+  gssm::EstimatorOptions o = log.options;
+  o.method = method;
+  std::vector<double> times;
+  for (auto _ : state) {
+    auto est = gssm::makeEstimator(*log.model, o);
+    for (const auto& epoch : log.epochs) {
+      const auto t0 = std::chrono::steady_clock::now();
+      if (grouped) est->addMeasurements(epoch);
+      else
+        for (const auto& m : epoch) est->addMeasurement(m);
+      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    benchmark::DoNotOptimize(est->current().mean.data());
+  }
+  state.counters["epoch_median_s"] = gssm::percentile(times, 50);
+  state.counters["epoch_p99_s"] = gssm::percentile(times, 99);
+  state.counters["epochs"] = static_cast<double>(times.size());
+}
+
+void BM_UwbEkf(benchmark::State& s) { streamEpochs(s, gssm::Method::Ekf, true); }
+void BM_UwbFixedLag(benchmark::State& s) { streamEpochs(s, gssm::Method::FixedLag, true); }
+void BM_UwbFixedLagRangeByRange(benchmark::State& s) { streamEpochs(s, gssm::Method::FixedLag, false); }
+void BM_UwbIncremental(benchmark::State& s) { streamEpochs(s, gssm::Method::Incremental, true); }
+
+}  // namespace
+
+BENCHMARK(BM_UwbEkf)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_UwbFixedLag)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_UwbFixedLagRangeByRange)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_UwbIncremental)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_MAIN();
