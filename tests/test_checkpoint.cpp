@@ -296,6 +296,19 @@ TEST(Checkpoint, CommittedVersionOneFilesStillRestore) {
   }
 }
 
+TEST(Checkpoint, ASlotWithAnEmptyLinearizationIsRefusedByName) {
+  // Found by the checkpoint fuzzer (header repaired): a live factor slot
+  // whose linearization is on no variable left the slot without a record,
+  // and storing it read a record that did not exist.
+  const models::Radar2D radar;
+  std::ifstream f(std::string(GSSM_SOURCE_DIR) + "/tests/fuzz/corpus/checkpoint/regression-empty-slot-linearization.ckpt",
+                  std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 28u);
+  const std::string msg = errorOf([&] { restoreCheckpointBytes(radar, withValidChecksum(bytes), "fuzz.ckpt"); });
+  EXPECT_NE(msg.find("linearization is on no variable"), std::string::npos) << msg;
+}
+
 TEST(Checkpoint, OptionsThatWouldStallAnUpdateAreRefused) {
   // Found by the checkpoint fuzzer: a checkpoint (header repaired) whose
   // options asked for 4194307 relinearization rounds per update restored

@@ -157,6 +157,9 @@ void BayesTreeEngine::loadSlots(ByteReader& in, const Model& model) {
     FactorPtr factor;
     if (in.boolean((name + " has a nonlinear factor").c_str())) factor = readFactor(in, model, name);
     const LinearFactor linear = readLinear(in, model, name + " linearization");
+    // A live slot's factor is on some variable (found by the checkpoint fuzzer:
+    // an empty one left the slot without a record).
+    if (linear.keys().empty()) in.fail(name + ": its linearization is on no variable");
     if (factor) {  // the slot holds it as a running engine does (a model's factor as its numbers)
       if (linear.keys() != factor->keys()) in.fail(name + ": its linearization does not match its factor");
       slot.nonlinear = SlotFactor(factor, &model);
