@@ -198,6 +198,23 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
   return written;
 }
 
+namespace {
+// The tracks of the points the body carries (a trolley's tags), from the
+// last run's estimates.
+void addBodyPointTracks(const Model& model, const io::ProcessResult& r, PlanView& plan) {
+  const auto names = model.bodyPointNames();
+  if (names.empty() || r.runs.empty()) return;
+  std::vector<std::vector<Eigen::Vector2d>> tracks(names.size());
+  const auto nc = static_cast<Eigen::Index>(model.dims().nc);
+  for (const auto& row : r.runs.back().rows) {
+    const auto points = model.bodyPoints(row.mean.head(nc));
+    for (std::size_t i = 0; i < points.size() && i < tracks.size(); ++i) tracks[i].push_back(points[i]);
+  }
+  for (std::size_t i = 0; i < names.size(); ++i)
+    plan.paths.emplace_back(names[i] + " (" + display(r.runs.back().method) + ")", std::move(tracks[i]));
+}
+}  // namespace
+
 std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const std::string& dir) {
   const Model& model = *r.model;
   std::optional<PlanView> plan;
@@ -210,6 +227,7 @@ std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const s
       for (const auto& row : r.dead_reckoning->rows) path.emplace_back(row.mean[plan->x], row.mean[plan->y]);
       plan->paths.emplace_back("dead reckoning", std::move(path));
     }
+    addBodyPointTracks(model, r, *plan);
   }
   return writeRunFigures(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan);
 }

@@ -90,6 +90,19 @@ std::vector<Eigen::Vector2d> PlanarRigidBody::landmarks() const {
   return out;
 }
 
+std::vector<Eigen::Vector2d> PlanarRigidBody::bodyPoints(const Eigen::VectorXd& xc) const {
+  const double c = std::cos(xc[2]), s = std::sin(xc[2]);
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& l : p_.tags) out.emplace_back(xc[0] + c * l.x() - s * l.y(), xc[1] + s * l.x() + c * l.y());
+  return out;
+}
+
+std::vector<std::string> PlanarRigidBody::bodyPointNames() const {
+  std::vector<std::string> out;
+  for (int id : p_.tag_ids) out.push_back("tag " + std::to_string(id));
+  return out;
+}
+
 Eigen::VectorXd PlanarRigidBody::f(const Eigen::VectorXd& xc, const Eigen::VectorXd& /*xb*/,
                                    const Eigen::VectorXd& /*u*/, double dt, Eigen::MatrixXd* J_f_xc,
                                    Eigen::MatrixXd* J_f_xb) const {

@@ -125,6 +125,11 @@ class Model {
   /// Fixed points its measurements refer to (beacons), in the world frame,
   /// for plan-view figures; none by default.
   virtual std::vector<Eigen::Vector2d> landmarks() const { return {}; }
+  /// Points carried by the body at state x_c (sensors at lever arms), in the
+  /// world frame, for plan-view figures; none by default.
+  virtual std::vector<Eigen::Vector2d> bodyPoints(const Eigen::VectorXd& /*xc*/) const { return {}; }
+  /// Their names (one per point), e.g. "tag 0".
+  virtual std::vector<std::string> bodyPointNames() const { return {}; }
 
   /// All state names in the stacked order [x_c; x_b].
   std::vector<std::string> stackedStateNames() const;

@@ -45,6 +45,9 @@ class PlanarRigidBody final : public Model {
   std::string name() const override { return "planar_rigid_body"; }
   const Params& params() const { return p_; }
   std::vector<Eigen::Vector2d> landmarks() const override;
+  /// The tags in the world frame: p + R(yaw)·l_i.
+  std::vector<Eigen::Vector2d> bodyPoints(const Eigen::VectorXd& xc) const override;
+  std::vector<std::string> bodyPointNames() const override;
   /// The channel of link (tag i, anchor j), by their positions in the lists.
   int channelOf(std::size_t tag, std::size_t anchor) const { return static_cast<int>(tag * p_.anchors.size() + anchor); }
   /// Index in x_b of link c's bias, −1 without link biases.
