@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <functional>
 #include <iostream>
+#include <sstream>
 #include <unistd.h>
 
 #include "cli.h"
@@ -54,14 +55,15 @@ gssm::io::ProcessCallbacks consoleCallbacks() {
   cb.skipped = [](const std::string& e) { std::cerr << "gssm-process: skipped " << e << "\n"; };
   cb.finished = [](const gssm::OfflineRun& run, const gssm::RunMetrics& m) {
     const auto& last = run.rows.back();
-    std::cout << std::left << std::setw(7) << gssm::methodName(run.method) << " final (t = " << last.t << "):";
+    std::ostringstream line;  // its own stream: the constants' fixed 3 decimals do not leak into the next time
+    line << std::left << std::setw(7) << gssm::methodName(run.method) << " final (t = " << last.t << "):";
+    line << std::fixed << std::setprecision(3);
     for (std::size_t i = 0; i < m.constant_names.size(); ++i) {
       const auto j = static_cast<Eigen::Index>(last.mean.size() - static_cast<Eigen::Index>(m.constant_names.size()) +
                                                static_cast<Eigen::Index>(i));
-      std::cout << "  " << m.constant_names[i] << " = " << std::fixed << std::setprecision(3) << last.mean[j] << " ± "
-                << std::sqrt(last.covariance(j, j)) << std::defaultfloat;
+      line << "  " << m.constant_names[i] << " = " << last.mean[j] << " ± " << std::sqrt(last.covariance(j, j));
     }
-    std::cout << "\n        " << run.summary << "\n";
+    std::cout << line.str() << "\n        " << run.summary << "\n";
   };
   return cb;
 }
