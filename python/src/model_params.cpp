@@ -18,13 +18,6 @@ using namespace pybind11::literals;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-// The Sections parameter whose sub-sections are "<prefix>.<name>".
-const ParamSpec* sectionsParam(const ModelType& type, const std::string& prefix) {
-  for (const auto& p : type.params)
-    if (p.kind == ParamKind::Sections && p.subsection == prefix) return &p;
-  return nullptr;
-}
-
 class DictParamSource final : public ParamSource {
  public:
   DictParamSource(const ModelType& type, py::dict kwargs) : type_(type), kwargs_(std::move(kwargs)) {}
@@ -56,7 +49,7 @@ class DictParamSource final : public ParamSource {
   std::string pythonKey(const std::string& s, const std::string& k) const {
     const auto dot = s.find('.');
     if (dot != std::string::npos) {
-      const ParamSpec* p = sectionsParam(type_, s.substr(0, dot));
+      const ParamSpec* p = type_.sectionsParam(s.substr(0, dot));
       return (p ? p->pythonKey() : s) + "['" + s.substr(dot + 1) + "']['" + k + "']";
     }
     return pythonKeyOf(s, k);
@@ -89,7 +82,7 @@ py::object DictParamSource::lookup(const std::string& s, const std::string& k) c
     const std::string key = pythonKeyOf(s, k);
     return kwargs_.contains(key) ? py::reinterpret_borrow<py::object>(kwargs_[key.c_str()]) : py::none();
   }
-  const ParamSpec* p = sectionsParam(type_, s.substr(0, dot));
+  const ParamSpec* p = type_.sectionsParam(s.substr(0, dot));
   if (!p || !kwargs_.contains(p->pythonKey())) return py::none();
   for (const py::handle item : kwargs_[p->pythonKey().c_str()]) {
     const py::dict d = py::reinterpret_borrow<py::dict>(item);
@@ -174,7 +167,7 @@ void DictParamSink::put(const std::string& s, const std::string& k, py::object v
     out_[pythonKeyOf(s, k).c_str()] = v;
     return;
   }
-  const ParamSpec* p = sectionsParam(type_, s.substr(0, dot));
+  const ParamSpec* p = type_.sectionsParam(s.substr(0, dot));
   const std::string key = p ? p->pythonKey() : s.substr(0, dot);
   if (!out_.contains(key)) out_[key.c_str()] = py::list();
   py::list list = out_[key.c_str()];
@@ -206,11 +199,9 @@ const char* kindName(ParamKind k) {
 
 py::dict typeInfo(const ModelType& t) {
   py::list params;
-  for (const auto& p : t.params) {
-    if (sectionsParam(t, p.section)) continue;  // a sub-section's key: in the list of dicts
-    params.append(py::dict("name"_a = p.pythonKey(), "section"_a = p.section, "key"_a = p.key,
-                           "kind"_a = kindName(p.kind), "required"_a = p.required, "doc"_a = p.doc));
-  }
+  for (const ParamSpec* p : t.keywordParams())  // a sub-section's keys are in its list of dicts
+    params.append(py::dict("name"_a = p->pythonKey(), "section"_a = p->section, "key"_a = p->key,
+                           "kind"_a = kindName(p->kind), "required"_a = p->required, "doc"_a = p->doc));
   return py::dict("name"_a = t.name, "aliases"_a = t.aliases, "class_name"_a = t.class_name,
                   "summary"_a = t.summary, "params"_a = params);
 }
@@ -223,16 +214,14 @@ const ModelType& typeNamed(const std::string& name) {
 
 std::shared_ptr<Model> makeRegistered(const std::string& name, const py::dict& kwargs) {
   const ModelType& t = typeNamed(name);
+  const std::vector<const ParamSpec*> keywords = t.keywordParams();
   for (const auto& item : kwargs) {
     const std::string key = py::str(item.first).cast<std::string>();
-    bool known = false;
+    if (std::any_of(keywords.begin(), keywords.end(), [&](const ParamSpec* p) { return p->pythonKey() == key; }))
+      continue;
     std::string list;
-    for (const auto& p : t.params) {
-      if (sectionsParam(t, p.section)) continue;
-      known = known || p.pythonKey() == key;
-      list += (list.empty() ? "" : ", ") + p.pythonKey();
-    }
-    if (!known) throw InvalidArgument("gssm.models." + t.class_name + ": unknown parameter '" + key + "' (known: " + list + ")");
+    for (const ParamSpec* p : keywords) list += (list.empty() ? "" : ", ") + p->pythonKey();
+    throw InvalidArgument("gssm.models." + t.class_name + ": unknown parameter '" + key + "' (known: " + list + ")");
   }
   return std::shared_ptr<Model>(t.read(DictParamSource(t, kwargs)));
 }

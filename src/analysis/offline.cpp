@@ -253,7 +253,7 @@ void StreamingRun::update(std::size_t first, std::size_t end) {
   }
   const auto t0 = Clock::now();
   if (end == first + 1) est_->addMeasurement(m);
-  else est_->addMeasurements(std::vector<Measurement>(measurements_.begin() + first, measurements_.begin() + end));
+  else est_->addMeasurements(&measurements_[first], end - first);
   const double seconds = since(t0) / static_cast<double>(end - first);
   for (std::size_t i = first; i < end; ++i) {
     out_.update_seconds.push_back(seconds);

@@ -150,7 +150,6 @@ void Estimator::advance(double t) {
   doStep(k_ + 1, t - t_, inputInForce(), nullptr, 0);
   t_ = t;
   ++k_;
-  report_.measurements = k_;
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -216,20 +215,22 @@ void Estimator::addMeasurement(const Measurement& m) {
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-void Estimator::addMeasurements(const std::vector<Measurement>& ms) {
-  if (ms.empty()) return;
+void Estimator::addMeasurements(const std::vector<Measurement>& ms) { addMeasurements(ms.data(), ms.size()); }
+
+void Estimator::addMeasurements(const Measurement* ms, std::size_t count) {
+  if (count == 0) return;
   if (options_.compute_nis) {
-    for (const auto& m : ms) addMeasurement(m);
+    for (std::size_t i = 0; i < count; ++i) addMeasurement(ms[i]);
     return;
   }
   const auto start = std::chrono::steady_clock::now();
-  for (const auto& m : ms) {
-    requireUsable(m);
-    if (m.t != ms.front().t)
+  for (std::size_t i = 0; i < count; ++i) {
+    requireUsable(ms[i]);
+    if (ms[i].t != ms[0].t)
       throw InvalidArgument(std::string(methodName()) + ": addMeasurements takes one instant; t = " +
-                            std::to_string(m.t) + " differs from " + std::to_string(ms.front().t));
+                            std::to_string(ms[i].t) + " differs from " + std::to_string(ms[0].t));
   }
-  addAt(ms.front().t, ms.data(), ms.size());
+  addAt(ms[0].t, ms, count);
   report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -242,7 +243,7 @@ void Estimator::addAt(double t, const Measurement* ms, std::size_t count) {
     t_ = t;
     ++k_;
   }
-  report_.measurements = k_;
+  report_.measurements += static_cast<std::int64_t>(count);
 }
 
 namespace {

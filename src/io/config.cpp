@@ -85,11 +85,14 @@ ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& mode
   return o;
 }
 
+// [smoother]'s key beyond SmootherOptions': the incremental smoother's ordering.
+const std::vector<std::string> kSmootherOwnKeys{"ordering"};
+
 // [smoother]: the relinearization policy both smoothers share, and the
 // incremental smoother's ordering.
 void readSmoother(const IniDocument& ini, EstimatorOptions& eo) {
   const std::string smoother = sectionOf(Method::Incremental);  // the fixed lag reads it too
-  readSection(ini, smoother, eo.smoother, {"ordering"});
+  readSection(ini, smoother, eo.smoother, kSmootherOwnKeys);
   const std::string ordering = ini.getString(smoother, "ordering", orderingName(eo.incremental.ordering));
   const auto named = orderingNamed(ordering);
   if (!named)
@@ -144,7 +147,7 @@ void writeEstimatorOptions(const EstimatorOptions& options, IniDocument& ini) {
 
 std::vector<std::pair<std::string, std::vector<std::string>>> estimatorIniKeys() {
   std::vector<std::string> smoother = optionKeyNames<SmootherOptions>();
-  smoother.push_back("ordering");
+  smoother.insert(smoother.end(), kSmootherOwnKeys.begin(), kSmootherOwnKeys.end());
   return {{sectionOf(Method::Ekf), optionKeyNames<ExtendedKalmanFilterOptions>()},
           {sectionOf(Method::Incremental), smoother},
           {sectionOf(Method::FixedLag), {"window"}},

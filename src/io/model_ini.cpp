@@ -23,6 +23,12 @@ std::string dataFile(const IniDocument& ini, const std::string& data_dir, const 
 
 namespace {
 
+std::string joined(const std::vector<std::string>& words, const char* sep) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : sep) + w;
+  return out;
+}
+
 class IniParamSource final : public ParamSource {
  public:
   IniParamSource(const IniDocument& ini, std::string data_dir) : ini_(ini), data_dir_(std::move(data_dir)) {}
@@ -62,11 +68,6 @@ class IniParamSource final : public ParamSource {
   std::string where(const std::string& s, const std::string& k) const override { return ini_.where(s, k); }
 
  private:
-  static std::string joined(const std::vector<std::string>& words, const char* sep) {
-    std::string out;
-    for (const auto& w : words) out += (out.empty() ? "" : sep) + w;
-    return out;
-  }
   const IniDocument& ini_;
   std::string data_dir_;
 };
@@ -93,9 +94,7 @@ class IniParamSink final : public ParamSink {
   void flag(const std::string& s, const std::string& k, bool v) override { ini_.set(s, k, v ? "true" : "false"); }
   void text(const std::string& s, const std::string& k, const std::string& v) override { ini_.set(s, k, v); }
   void names(const std::string& s, const std::string& k, const std::vector<std::string>& v) override {
-    std::string line;
-    for (const auto& w : v) line += (line.empty() ? "" : " ") + w;
-    ini_.set(s, k, line);
+    ini_.set(s, k, joined(v, " "));
   }
   void vector(const std::string& s, const std::string& k, const Eigen::VectorXd& v) override {
     ini_.set(s, k, Eigen::MatrixXd(v.transpose()));

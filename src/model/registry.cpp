@@ -44,14 +44,23 @@ const ParamSpec* ModelType::param(const std::string& section, const std::string&
   return nullptr;
 }
 
+const ParamSpec* ModelType::sectionsParam(const std::string& prefix) const {
+  for (const auto& p : params)
+    if (p.kind == ParamKind::Sections && p.subsection == prefix) return &p;
+  return nullptr;
+}
+
+std::vector<const ParamSpec*> ModelType::keywordParams() const {
+  std::vector<const ParamSpec*> out;
+  for (const auto& p : params)
+    if (!sectionsParam(p.section)) out.push_back(&p);
+  return out;
+}
+
 std::vector<std::string> ModelType::sections() const {
   std::vector<std::string> out;
-  for (const auto& p : params) {
-    const bool sub = std::any_of(params.begin(), params.end(), [&](const ParamSpec& q) {
-      return q.kind == ParamKind::Sections && q.subsection == p.section;
-    });
-    if (!sub && std::find(out.begin(), out.end(), p.section) == out.end()) out.push_back(p.section);
-  }
+  for (const ParamSpec* p : keywordParams())
+    if (std::find(out.begin(), out.end(), p->section) == out.end()) out.push_back(p->section);
   return out;
 }
 

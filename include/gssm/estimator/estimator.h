@@ -116,6 +116,8 @@ class Estimator {
   /// checked like addMeasurement's; none is taken if one is refused. With
   /// compute_nis they go one by one (each NIS before its own update).
   void addMeasurements(const std::vector<Measurement>& ms);
+  /// The same for ms[0..count), where they already lie in order.
+  void addMeasurements(const Measurement* ms, std::size_t count);
 
   /// Newest state and constants with their joint covariance.
   virtual StateEstimate current() = 0;

@@ -36,6 +36,10 @@ struct ModelType {
   std::function<bool(const Model&)> owns;
 
   const ParamSpec* param(const std::string& section, const std::string& key) const;
+  /// The Sections parameter whose sub-sections are "<prefix>.<name>", if any.
+  const ParamSpec* sectionsParam(const std::string& prefix) const;
+  /// Its keyword parameters (Python's): every one but a sub-section's keys.
+  std::vector<const ParamSpec*> keywordParams() const;
   /// The [section]s its parameters live in (not sub-sections).
   std::vector<std::string> sections() const;
   /// Keys declared in `section` (for a sub-section "channel.gps": those of "channel").
