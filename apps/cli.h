@@ -2,6 +2,7 @@
 // A small command-line parser shared by the apps: "--name value" options and
 // "--flag" switches, each declared with its help text. Unknown or malformed
 // options give a one-line error naming them.
+#include <charconv>
 #include <cstdlib>
 #include <iostream>
 #include <map>
@@ -63,6 +64,16 @@ class CommandLine {
     if (v.empty() || *end != '\0' || x < lo || x > hi)
       throw std::invalid_argument("option --" + name + " = '" + v + "': expected an integer in [" +
                                   std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return x;
+  }
+
+  double getDouble(const std::string& name, double lo, double hi) const {
+    const std::string v = get(name);
+    double x = 0;
+    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+    if (v.empty() || ec != std::errc() || end != v.data() + v.size() || !(x >= lo && x <= hi))
+      throw std::invalid_argument("option --" + name + " = '" + v + "': expected a number in [" + std::to_string(lo) +
+                                  ", " + std::to_string(hi) + "]");
     return x;
   }
 

@@ -39,6 +39,7 @@ gssm::io::ProcessOptions processOptions(const gssm::apps::CommandLine& cli) {
     o.checkpoint_every = static_cast<std::size_t>(cli.getInt("checkpoint-every", 1, 1000000000));
   o.resume = cli.given("resume") ? cli.get("resume") : "";
   o.skip_bad_rows = cli.given("skip-bad-rows");
+  if (cli.given("learn")) o.learn = true;
   return o;
 }
 
@@ -52,6 +53,7 @@ gssm::io::ProcessCallbacks consoleCallbacks() {
       std::cerr << "\r" << gssm::methodName(m) << ": " << 100 * done / total << "% (" << done << "/" << total << ")"
                 << (done == total ? "\n" : "") << std::flush;
     };
+  cb.learnt = [](const gssm::NoiseLearningReport& r) { std::cout << r.toString(); };
   cb.skipped = [](const std::string& e) { std::cerr << "gssm-process: skipped " << e << "\n"; };
   cb.finished = [](const gssm::OfflineRun& run, const gssm::RunMetrics& m) {
     const auto& last = run.rows.back();
@@ -86,6 +88,7 @@ int main(int argc, char** argv) {
     cli.option("resume", "FILE",
                "continue the streaming run that wrote checkpoint FILE (its method, unless --method says "
                "the same); the output equals an uninterrupted run's");
+    cli.flag("learn", "learn the noise from the log first ([learn] of the INI); writes OUTDIR/scenario.ini, learn.json");
     cli.flag("skip-bad-rows", "skip malformed measurement rows (listed in metrics.json) instead of stopping at the first");
     cli.parse(argc, argv);
     const gssm::io::ProcessOptions options = processOptions(cli);

@@ -1,4 +1,5 @@
 #include "gssm/plot/run_figures.h"
+#include "gssm/plot/learn_figure.h"
 
 #include <algorithm>
 #include <cmath>
@@ -229,7 +230,10 @@ std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const s
     }
     addBodyPointTracks(model, r, *plan);
   }
-  return writeRunFigures(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan);
+  std::vector<std::string> files =
+      writeRunFigures(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan);
+  if (r.learnt) files.push_back(writeLearningFigure(*r.learnt, dir, r.label));
+  return files;
 }
 
 }  // namespace gssm::plot

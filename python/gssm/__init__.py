@@ -15,6 +15,8 @@ baseline and the batch MAP, on the same model object.
 
 Methods are named as gssm-process names them: see gssm.methods().
 """
+import os
+
 from . import _gssm
 from ._gssm import (
     Error,
@@ -33,6 +35,8 @@ from ._gssm import (
     Run,
     Method,
     ProcessResult,
+    LearnReport,
+    LearntParameter,
     methods,
     checkpoint_info,
 )
@@ -43,7 +47,8 @@ __all__ = [
     "Error", "InvalidArgument", "InputError", "NumericalError", "CheckpointError",
     "Estimator", "EstimatorOptions", "EkfOptions", "SmootherOptions", "BatchOptions",
     "EstimatorReport", "UpdateReport", "StateEstimate", "Run", "Method", "ProcessResult",
-    "methods", "make_options", "make_estimator", "run", "process", "restore", "checkpoint_info",
+    "LearnReport", "LearntParameter",
+    "methods", "make_options", "make_estimator", "run", "process", "learn", "restore", "checkpoint_info",
     "simulate", "models", "io", "analysis",
 ]
 
@@ -117,8 +122,34 @@ def simulate(scenario="paper", seed=1, steps=400, **kwargs):
     return _gssm.io.simulate_model(scenario, seed, steps, **kwargs)
 
 
+def learn(model_or_folder, data=None, *, out=None, config=None, parameters=None, start=0.0, search_range=1e4,
+          max_evaluations=4000, tolerance=1e-7, max_restarts=6, standard_errors=True):
+    """Noise learnt from a log, no truth (docs/DESIGN.md §10): the σs the
+    model declares learnable fitted by maximum likelihood (an ungated EKF's
+    prediction errors, Nelder-Mead over log σ). Returns a gssm.LearnReport:
+    .model (the learnt model), .parameters (start, value, standard_error,
+    identifiable, note), .log_likelihood per iteration.
+
+        report = gssm.learn(model, data, start=1.0)      # a model and a gssm.io dataset
+        report = gssm.learn("datasets/plaza2", out="out/learnt")   # what gssm-learn does
+
+    A folder: its scenario.ini (or config=) with its [learn] options; writes
+    out/scenario.ini (the input with the learnt values) and out/learn.json.
+    parameters: names to learn ("range_sd", "Q", "Q[1]"; default every
+    learnable one); start: every σ starts here (0: the model's values).
+    """
+    if isinstance(model_or_folder, (str, os.PathLike)):
+        if data is not None or out is None:
+            raise InvalidArgument("gssm.learn(folder, out=DIR): a dataset folder takes out=, not data")
+        return _gssm._learn_folder(str(model_or_folder), str(out), str(config or ""))
+    if data is None:
+        raise InvalidArgument("gssm.learn(model, data): the data to learn from (gssm.io.read_dataset, gssm.simulate)")
+    return _gssm._learn_model(model_or_folder, data, list(parameters or []), float(start), float(search_range),
+                              int(max_evaluations), float(tolerance), int(max_restarts), bool(standard_errors))
+
+
 def process(data, out, *, method="all", config=None, window=None, checkpoint_every=None, resume=None,
-            skip_bad_rows=False, figures=True, progress=None):
+            skip_bad_rows=False, figures=True, progress=None, learn=None):
     """gssm-process in this process: runs estimators over a dataset folder and
     writes estimates-<method>.csv, metrics.json and (figures=True) the fig-*.png
     into `out`, the same files gssm-process writes. Returns a gssm.ProcessResult
@@ -128,7 +159,9 @@ def process(data, out, *, method="all", config=None, window=None, checkpoint_eve
     method: "all" (with resume=: the checkpoint's), a gssm.Method or its
     name, or a list of them. config: an INI file instead of the folder's
     scenario.ini. window: fixed-lag and paper-window states. checkpoint_every,
-    resume: as gssm-process's --checkpoint-every, --resume. progress: a
+    resume: as gssm-process's --checkpoint-every, --resume. learn: True to
+    learn the noise first (gssm-process --learn), False not to, None as the
+    INI's [learn] enabled says. progress: a
     callable(method, done, total), called from the loop. Errors are gssm.Error
     subclasses naming file, line and column, as gssm-process prints them.
     """
@@ -139,7 +172,8 @@ def process(data, out, *, method="all", config=None, window=None, checkpoint_eve
     else:
         methods = [method_of(method)]
     result = _gssm.process_dataset(str(data), str(out), methods, str(config or ""), window,
-                                   int(checkpoint_every or 0), str(resume or ""), bool(skip_bad_rows), progress)
+                                   int(checkpoint_every or 0), str(resume or ""), bool(skip_bad_rows), progress,
+                                   learn)
     if figures:
         try:
             from . import _plot

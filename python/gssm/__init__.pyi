@@ -1,6 +1,6 @@
 # Type stubs of the gssm package (checked against the module by
 # python/tests/test_stubs.py).
-from typing import Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Callable, Dict, List, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -193,6 +193,34 @@ class ProcessResult:
     def stopped_at(self) -> str: ...
     @property
     def skipped(self) -> List[str]: ...
+    @property
+    def learnt(self) -> Optional[LearnReport]: ...
+
+class LearntParameter:
+    name: str
+    section: str
+    key: str
+    index: int
+    given: float
+    start: float
+    value: float
+    standard_error: float
+    identifiable: bool
+    note: str
+
+class LearnReport:
+    parameters: List[LearntParameter]
+    log_likelihood: Vector
+    given_log_likelihood: float
+    start_log_likelihood: float
+    final_log_likelihood: float
+    evaluations: int
+    iterations: int
+    restarts: int
+    converged: bool
+    seconds: float
+    model: Model
+    params: Dict[str, object]
 
 MethodLike = Union[str, Method]
 
@@ -214,7 +242,14 @@ def run(model: Model, data: Dataset, method: MethodLike = "fixed-lag", *, option
 def process(data: str, out: str, *, method: Union[MethodLike, Sequence[MethodLike]] = "all",
             config: Optional[str] = None, window: Optional[int] = None, checkpoint_every: Optional[int] = None,
             resume: Optional[str] = None, skip_bad_rows: bool = False, figures: bool = True,
-            progress: Optional[Callable[[Method, int, int], None]] = None) -> ProcessResult: ...
+            progress: Optional[Callable[[Method, int, int], None]] = None,
+            learn: Optional[bool] = None) -> ProcessResult: ...
+@overload
+def learn(model_or_folder: Model, data: Dataset, *, parameters: Optional[Sequence[str]] = None,
+          start: float = 0.0, search_range: float = 1e4, max_evaluations: int = 4000, tolerance: float = 1e-7,
+          max_restarts: int = 6, standard_errors: bool = True) -> LearnReport: ...
+@overload
+def learn(model_or_folder: str, *, out: str, config: Optional[str] = None) -> LearnReport: ...
 def restore(model: Model, source: Union[bytes, bytearray, memoryview, str]) -> Estimator: ...
 def checkpoint_info(model: Model, data: bytes) -> Dict[str, object]: ...
 def simulate(scenario: Union[str, Model] = "paper", seed: int = 1, steps: int = 400, *,

@@ -79,5 +79,6 @@ struct PyProcessResult {
 };
 
 void bindProcess(py::module_& m);
+void bindLearn(py::module_& m);
 
 }  // namespace gssm::python

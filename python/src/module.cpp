@@ -16,4 +16,5 @@ PYBIND11_MODULE(_gssm, m) {
   py::module_ campaign = m.def_submodule("campaign", "Monte Carlo campaigns, seed by seed.");
   gssm::python::bindCampaign(campaign);
   gssm::python::bindProcess(m);
+  gssm::python::bindLearn(m);
 }

@@ -29,7 +29,8 @@ void bindMethod(py::module_& m) {
 
 io::ProcessOptions processOptions(const std::string& data, const std::string& out, const std::vector<Method>& methods,
                                   const std::string& config, std::optional<int> window,
-                                  std::size_t checkpoint_every, const std::string& resume, bool skip_bad_rows) {
+                                  std::size_t checkpoint_every, const std::string& resume, bool skip_bad_rows,
+                                  std::optional<bool> learn) {
   io::ProcessOptions o;
   o.data_dir = data;
   o.out_dir = out;
@@ -39,14 +40,16 @@ io::ProcessOptions processOptions(const std::string& data, const std::string& ou
   o.checkpoint_every = checkpoint_every;
   o.resume = resume;
   o.skip_bad_rows = skip_bad_rows;
+  o.learn = learn;
   return o;
 }
 
 PyProcessResult process(const std::string& data, const std::string& out, const std::vector<Method>& methods,
                         const std::string& config, std::optional<int> window, std::size_t checkpoint_every,
-                        const std::string& resume, bool skip_bad_rows, const py::object& progress) {
+                        const std::string& resume, bool skip_bad_rows, const py::object& progress,
+                        std::optional<bool> learn) {
   const io::ProcessOptions o =
-      processOptions(data, out, methods, config, window, checkpoint_every, resume, skip_bad_rows);
+      processOptions(data, out, methods, config, window, checkpoint_every, resume, skip_bad_rows, learn);
   io::ProcessCallbacks cb;
   PyProcessResult r;
   if (progress.is_none()) {
@@ -82,6 +85,9 @@ void bindProcessResult(py::module_& m) {
                              "a bad row stopped it (what came before was processed and written)")
       .def_property_readonly("stopped_at", [](const PyProcessResult& r) { return r.result->status.stopped_at; })
       .def_property_readonly("skipped", [](const PyProcessResult& r) { return r.result->status.skipped; })
+      .def_property_readonly("learnt", [](const PyProcessResult& r) -> py::object {
+        return r.result->learnt ? py::cast(*r.result->learnt) : py::none();
+      }, "the noise learning's gssm.LearnReport, when it ran")
       .def("_add_files", [](PyProcessResult& r, const std::vector<std::string>& f) {
         r.result->files.insert(r.result->files.end(), f.begin(), f.end());
       })
@@ -97,7 +103,7 @@ void bindProcess(py::module_& m) {
   bindProcessResult(m);
   m.def("process_dataset", &process, py::arg("data"), py::arg("out"), py::arg("methods"), py::arg("config") = "",
         py::arg("window") = py::none(), py::arg("checkpoint_every") = 0, py::arg("resume") = "",
-        py::arg("skip_bad_rows") = false, py::arg("progress") = py::none(),
+        py::arg("skip_bad_rows") = false, py::arg("progress") = py::none(), py::arg("learn") = py::none(),
         "gssm.process without keyword conveniences");
 }
 

@@ -27,6 +27,11 @@ def gssm_process():
     return app("gssm-process")
 
 
+@pytest.fixture(scope="session")
+def gssm_learn():
+    return app("gssm-learn")
+
+
 def run_app(*args):
     proc = subprocess.run([str(a) for a in args], capture_output=True, text=True)
     assert proc.returncode == 0, "%s failed (%d):\n%s\n%s" % (args[0], proc.returncode, proc.stdout, proc.stderr)

@@ -47,7 +47,9 @@ def datasets(repo, tmp_path_factory):
 def test_run_equals_gssm_process_bit_for_bit(name, datasets, gssm_process, tmp_path):
     data_dir = datasets[name]
     run_app(gssm_process, "--data", data_dir, "--method", "all", "--out", tmp_path)
-    data = gssm.io.read_dataset(data_dir)
+    # A dataset whose [learn] is on ran on the learnt model: its learnt scenario.ini.
+    learnt = os.path.join(tmp_path, "learn.json")
+    data = gssm.io.read_dataset(data_dir, config=os.path.join(tmp_path, "scenario.ini") if os.path.exists(learnt) else "")
     for method in METHODS:
         header, cpp = read_estimates(os.path.join(tmp_path, "estimates-%s.csv" % method))
         run = gssm.run(data.model, data, method=method)

@@ -163,6 +163,21 @@ const IniDocument::Entry& IniDocument::require(const std::string& section,
   return *e;
 }
 
+int IniDocument::lineOf(const std::string& section, const std::string& key) const {
+  const Entry* e = find(section, key);
+  return e ? e->line : 0;
+}
+
+int IniDocument::lastLineOf(const std::string& section) const {
+  for (const auto& s : sections_)
+    if (s.name == section) {
+      int last = s.line;
+      for (const auto& e : s.entries) last = std::max(last, e.line);
+      return last;
+    }
+  return 0;
+}
+
 std::string IniDocument::where(const std::string& section, const std::string& key) const {
   const Entry* e = find(section, key);
   return source_ + (e ? ":" + std::to_string(e->line) : std::string()) + ": [" + section + "] " + key;

@@ -1,5 +1,9 @@
 #include "gssm/io/json_text.h"
 
+#include <cmath>
+
+#include "gssm/io/number_text.h"
+
 #include <cstdio>
 
 namespace gssm::io {
@@ -54,5 +58,7 @@ std::string jsonQuoted(std::string_view text) {
   }
   return out + "\"";
 }
+
+std::string jsonNumber(double v) { return std::isfinite(v) ? formatDouble(v) : "null"; }
 
 }  // namespace gssm::io

@@ -9,7 +9,7 @@
 namespace gssm::io {
 
 namespace {
-std::string num(double v) { return std::isfinite(v) ? io::formatDouble(v) : "null"; }
+std::string num(double v) { return jsonNumber(v); }
 std::string perState(const std::vector<std::string>& names, const Eigen::VectorXd& v) {
   std::string out = "{";
   for (std::size_t i = 0; i < names.size(); ++i)

@@ -7,6 +7,7 @@
 #include "gssm/checkpoint/checkpoint.h"
 #include "gssm/core/error.h"
 #include "gssm/io/config.h"
+#include "gssm/io/learn_config.h"
 #include "gssm/io/run_files.h"
 
 namespace gssm::io {
@@ -118,6 +119,14 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   r.model = model;
   const std::vector<Method> methods = methodsToRun(o, *model);
   readData(o, *model, r, cb);
+  if (const LearnSettings learn = learnSettings(r.config); o.learn.value_or(learn.enabled)) {
+    LearnResult learnt = learnAndWrite(*model, r.config, r.dataset, o.out_dir, learn.options);
+    r.config = std::move(learnt.config);
+    model = r.model = learnt.report.model;
+    r.files.insert(r.files.end(), learnt.files.begin(), learnt.files.end());
+    r.learnt = std::move(learnt.report);
+    if (cb.learnt) cb.learnt(*r.learnt);
+  }
   fs::create_directories(o.out_dir);
   EstimatorOptions options = estimatorOptions(r.config, *model);
   options.t0 = r.dataset.t0;

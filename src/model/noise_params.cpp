@@ -6,8 +6,9 @@ namespace gssm {
 
 std::vector<ParamSpec> noiseParams(NoiseKeys keys) {
   std::vector<ParamSpec> p{param::real("model", "T", "nominal step (s)")};
-  if (keys.Q) p.push_back(param::matrix("model", "Q", "process noise covariance of one nominal step (n_c×n_c)"));
-  p.push_back(param::matrix("model", "R", "measurement noise covariance (n_y×n_y)"));
+  if (keys.Q)
+    p.push_back(param::learnable(param::matrix("model", "Q", "process noise covariance of one nominal step (n_c×n_c)")));
+  p.push_back(param::learnable(param::matrix("model", "R", "measurement noise covariance (n_y×n_y)")));
   p.push_back(param::vector("prior", "state_mean", "prior mean of x_c(0)"));
   p.push_back(param::matrix("prior", "state_cov", "prior covariance of x_c(0)"));
   if (keys.constants) {

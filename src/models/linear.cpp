@@ -145,7 +145,7 @@ std::vector<ParamSpec> linearParams() {
                            sections("model", "channels", "channel", "further sensors, each a [channel.<name>]"),
                            matrix("channel", "C_c", "the channel's C_c"),
                            matrix("channel", "C_b", "the channel's C_b"),
-                           matrix("channel", "R", "the channel's noise covariance"),
+                           learnable(matrix("channel", "R", "the channel's noise covariance")),
                            names("channel", "components", "the channel's component names"),
                            names("model", "state_names", "names of x_c (default x1..)"),
                            names("model", "constant_names", "names of x_b (default b1..)"),

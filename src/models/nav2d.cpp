@@ -94,7 +94,7 @@ std::vector<Eigen::Vector2d> points(const Eigen::MatrixXd& rows) {
 
 std::vector<ParamSpec> navParams() {
   std::vector<ParamSpec> p = noiseParams({false, true});
-  p.push_back(param::real("model", "accel_noise", "white acceleration noise density (m/s²/√Hz)"));
+  p.push_back(param::learnable(param::real("model", "accel_noise", "white acceleration noise density (m/s²/√Hz)")));
   p.push_back(param::table("model", "beacons", {"x", "y"}, "beacon positions (m), one row 'x y' each"));
   return p;
 }

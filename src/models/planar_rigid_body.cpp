@@ -165,9 +165,9 @@ std::vector<ParamSpec> bodyParams() {
       required(table("model", "anchors", {"anchor", "x", "y", "z"}, "anchors: rows 'id x y z' (m), or a CSV file")),
       required(table("model", "tags", {"tag", "x", "y", "z"}, "tags' lever arms: rows 'id x y z' (m), or a CSV file")),
       real("model", "height", "the known height of the body origin (m)"),
-      real("model", "accel_sd", "white acceleration, m/s² per √Hz"),
-      real("model", "yaw_accel_sd", "white angular acceleration, rad/s² per √Hz"),
-      real("model", "range_sd", "σ of one range (m)"),
+      learnable(real("model", "accel_sd", "white acceleration, m/s² per √Hz")),
+      learnable(real("model", "yaw_accel_sd", "white angular acceleration, rad/s² per √Hz")),
+      learnable(real("model", "range_sd", "σ of one range (m)")),
       flag("model", "link_biases", "estimate a bias per link (bias_<tag>_<anchor>)"),
       flag("model", "range_scale", "estimate a common range scale")};
   for (auto& l : lossParams("model")) p.push_back(l);

@@ -146,12 +146,12 @@ std::vector<ParamSpec> rangeBeaconParams() {
       flag("model", "range_offsets", "estimate a range offset per beacon"),
       flag("model", "odometry_scale", "estimate an odometry distance scale s_d"),
       flag("model", "heading_rate_bias", "estimate a bias of the odometry's turn rate (rad/s)"),
-      real("model", "range_sd", "σ of one range (m)"),
-      real("model", "distance_sd", "odometry position noise, m per √m travelled"),
-      real("model", "turn_sd", "heading noise, rad per √rad turned"),
-      real("model", "heading_drift_sd", "heading noise, rad per √m travelled"),
-      real("model", "position_sd_per_s", "position noise floor, m per √s"),
-      real("model", "heading_sd_per_s", "heading noise floor, rad per √s")};
+      learnable(real("model", "range_sd", "σ of one range (m)")),
+      learnable(real("model", "distance_sd", "odometry position noise, m per √m travelled")),
+      learnable(real("model", "turn_sd", "heading noise, rad per √rad turned")),
+      learnable(real("model", "heading_drift_sd", "heading noise, rad per √m travelled")),
+      learnable(real("model", "position_sd_per_s", "position noise floor, m per √s")),
+      learnable(real("model", "heading_sd_per_s", "heading noise floor, rad per √s"))};
   for (auto& l : lossParams("model")) p.push_back(l);
   for (auto& q : {real("model", "ekf_gate", "EKF NIS gate of every range (0: none)"),
                   any("prior", "start", "prior mean of [px, py] (m), or 'truth': the truth file's first row"),

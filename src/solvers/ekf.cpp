@@ -94,7 +94,7 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   Eigen::VectorXd innov = y - yhat;
   wrapAngles(innov, ch.angles);
   const double nis = innov.dot(llt.solve(innov));
-  if (ch.ekf_gate > 0 && nis > ch.ekf_gate) {  // an outlier: leave the estimate as it is
+  if (options_.use_gates && ch.ekf_gate > 0 && nis > ch.ekf_gate) {  // an outlier: leave the estimate as it is
     nis_ = nis;
     ++rejected_;
     return false;
@@ -120,6 +120,9 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   wrapAngles(z_, model_->angleStates());
   P_ = std::move(P);
   nis_ = nis;
+  // log N(e; 0, S) = −½ (eᵀS⁻¹e + log det S + m log 2π), log det S from S's Cholesky factor.
+  const double log_det_S = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
+  log_likelihood_ -= 0.5 * (nis + log_det_S + static_cast<double>(ch.dim()) * std::log(2.0 * M_PI));
   return true;
 }
 

@@ -1,8 +1,10 @@
 #!/usr/bin/python3
-"""gssm-process on the real CMU Plaza 2 log (datasets/plaza2): the numbers of
-the run against the targets, the range scale against an offline fit to the
-truth computed here, the estimates lined up with the truth, the run with the
-range scale switched off, and bad input named by file, line and column.
+"""gssm-process on the real CMU Plaza 2 log (datasets/plaza2): the noise
+learnt from the log (from 1.0 each), the numbers of the run against the
+targets, the range scale against an offline fit to the truth computed here,
+the learnt scenario.ini reproducing the run, the estimates lined up with the
+truth, the run with the range scale switched off, and bad input named by
+file, line and column.
 
     process_plaza.py BIN_DIR SOURCE_DIR WORK_DIR
 """
@@ -68,10 +70,34 @@ print("offline fit against the truth: range = %.4f * distance + %.3f over %d ran
 scale = metrics["batch"]["constants"]["range_scale"]
 check(abs(scale - a) <= 0.002, "batch range scale %.4f within 0.002 of the offline fit %.4f" % (scale, a))
 
-check(pos["batch"] <= 0.33, "batch (smoothed) position RMSE %.3f m <= 0.33" % pos["batch"])
+check(pos["batch"] <= 0.27, "batch (smoothed) position RMSE %.3f m <= 0.27" % pos["batch"])
 for m in ("incremental", "fixed-lag"):
-    check(pos[m] <= 0.62, "%s position RMSE %.3f m <= 0.62" % (m, pos[m]))
+    check(pos[m] <= 0.39, "%s position RMSE %.3f m <= 0.39" % (m, pos[m]))
     check(pos[m] <= pos["ekf"], "%s (%.3f m) no worse than the EKF of the same model (%.3f m)" % (m, pos[m], pos["ekf"]))
+
+# The noise was learnt from the log: learn.json and the learnt scenario.ini.
+learn = json.load(open(os.path.join(out, "learn.json")))
+trace = learn["log_likelihood_trace"]
+check(learn["converged"] and all(b >= a for a, b in zip(trace, trace[1:])),
+      "learning converged; its log-likelihood never decreased (%d iterations, %.1f -> %.1f)"
+      % (len(trace), trace[0], trace[-1]))
+learnt = {p["name"]: p for p in learn["parameters"]}
+check(sorted(learnt) == sorted(["range_sd", "distance_sd", "turn_sd", "heading_drift_sd", "position_sd_per_s",
+                                "heading_sd_per_s"]) and all(p["start"] == 1.0 for p in learnt.values()),
+      "the six noise σs learnt, each from 1.0")
+rs = learnt["range_sd"]
+check(rs["identifiable"] and 0.4 < rs["learnt"] < 0.7 and 0 < rs["standard_error"] < 0.05,
+      "range_sd learnt %.3f ± %.3f m" % (rs["learnt"], rs["standard_error"]))
+check(learn["log_likelihood"]["final"] > learn["log_likelihood"]["given"],
+      "the learnt noise explains the log better than the hand-tuned values (%.1f vs %.1f)"
+      % (learn["log_likelihood"]["final"], learn["log_likelihood"]["given"]))
+again = os.path.join(work, "plaza2-learnt")
+r = process("--data", data, "--config", os.path.join(out, "scenario.ini"), "--method", "batch", "--out", again)
+check(r.returncode == 0 and not os.path.exists(os.path.join(again, "learn.json")) and
+      open(os.path.join(again, "estimates-batch.csv")).read() == open(os.path.join(out, "estimates-batch.csv")).read(),
+      "the learnt scenario.ini reproduces the batch estimates without learning again")
+r = process("--data", data, "--method", "batch", "--out", data)
+check(r.returncode != 0 and "would replace its own" in r.stderr, "refuses to write the learnt INI over the dataset's")
 
 # One row per odometry step, at the truth's times.
 odo = rows(os.path.join(data, "odometry.csv"))
@@ -132,13 +158,17 @@ check(r.returncode != 0 and "ranges.csv:2: column 'beacon': '1' names channel 'r
       "an unknown channel name is named: " + r.stderr.strip()[-200:])
 # Checkpoint and resume on the real log (rows at the odometry times): stop
 # at a bad range, repair it, resume from the last checkpoint: the same
-# estimates as an uninterrupted run.
+# estimates as an uninterrupted run. A resumed run must use the model the
+# checkpoint was made with: here the learnt scenario.ini (learning on the
+# first, partial run would have learnt from part of the log).
+learnt_cfg = os.path.join(out, "scenario.ini")
 bad = corrupt("ranges.csv", lambda l: l.__setitem__(901, l[901].rsplit(",", 1)[0] + ",nan"))
-r = process("--data", bad, "--method", "fixed-lag", "--checkpoint-every", "500", "--out", os.path.join(work, "c1"))
+r = process("--data", bad, "--config", learnt_cfg, "--method", "fixed-lag", "--checkpoint-every", "500",
+            "--out", os.path.join(work, "c1"))
 check(r.returncode == 3, "stops at the bad range with a checkpoint written")
 shutil.copy(os.path.join(data, "ranges.csv"), os.path.join(bad, "ranges.csv"))
-r = process("--data", bad, "--method", "fixed-lag", "--resume", os.path.join(work, "c1", "checkpoint-fixed-lag.ckpt"),
-            "--out", os.path.join(work, "c2"))
+r = process("--data", bad, "--config", learnt_cfg, "--method", "fixed-lag", "--resume",
+            os.path.join(work, "c1", "checkpoint-fixed-lag.ckpt"), "--out", os.path.join(work, "c2"))
 check(r.returncode == 0, "resumes on the repaired log: " + r.stderr.strip()[-200:])
 check(open(os.path.join(work, "c2", "estimates-fixed-lag.csv")).read() ==
       open(os.path.join(out, "estimates-fixed-lag.csv")).read(),

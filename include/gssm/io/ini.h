@@ -54,6 +54,10 @@ class IniDocument {
   void requireOnlyKeys(const std::string& section, const std::vector<std::string>& allowed) const;
 
   const std::string& source() const { return source_; }
+  /// The file line of [section] key (0: absent, or set in memory).
+  int lineOf(const std::string& section, const std::string& key) const;
+  /// The line of the section's last key (or of its header); 0 when absent.
+  int lastLineOf(const std::string& section) const;
   /// "file:line: [section] key" where the key is, "file: [section] key" where it is not.
   std::string where(const std::string& section, const std::string& key) const;
 

@@ -11,5 +11,7 @@ namespace gssm::io {
 /// UTF-8 kept as it is, and each byte of invalid UTF-8 as U+FFFD, so the
 /// result always parses.
 std::string jsonQuoted(std::string_view text);
+/// A number in round-trip form; null when not finite (JSON has no NaN).
+std::string jsonNumber(double v);
 
 }  // namespace gssm::io

@@ -15,6 +15,7 @@
 #include "gssm/io/dataset.h"
 #include "gssm/io/ini.h"
 #include "gssm/io/metrics_json.h"
+#include "gssm/learn/noise_learning.h"
 
 namespace gssm::io {
 
@@ -29,6 +30,10 @@ struct ProcessOptions {
   std::size_t checkpoint_every = 0;  ///< streaming methods: a checkpoint every N measurements (0: none)
   std::string resume;             ///< continue the run that wrote this checkpoint
   bool skip_bad_rows = false;     ///< skip malformed measurement rows instead of stopping at the first
+  /// Learn the noise first (true), or not (false), whatever [learn] enabled
+  /// says; unset: as [learn] enabled says. The learnt scenario.ini and
+  /// learn.json go to out_dir, and every method runs on the learnt model.
+  std::optional<bool> learn;
   /// Empty when usable; otherwise says which field is wrong.
   bool validate(std::string* why = nullptr) const;
 };
@@ -38,6 +43,8 @@ struct ProcessResult {
   IniDocument config;              ///< the scenario.ini used
   Dataset dataset;
   DatasetStatus status;            ///< rows skipped, or where a bad row stopped it (partial)
+  /// The noise learning, when it ran (config and model are then the learnt ones).
+  std::optional<NoiseLearningReport> learnt;
   std::vector<OfflineRun> runs;    ///< one per method, in order
   std::vector<RunMetrics> metrics; ///< of each run
   /// Rows at inputs on a model with px, py: the EKF on the inputs alone.
@@ -52,6 +59,8 @@ struct ProcessCallbacks {
   std::function<void(Method, std::size_t done, std::size_t total)> progress;
   /// After each method's run, with its metrics.
   std::function<void(const OfflineRun&, const RunMetrics&)> finished;
+  /// After the noise learning, when it ran (before the first method).
+  std::function<void(const NoiseLearningReport&)> learnt;
   /// A skipped row (skip_bad_rows).
   std::function<void(const std::string&)> skipped;
 };

@@ -38,6 +38,10 @@ struct ParamSpec {
   std::string doc;          ///< one line, with the unit
   std::vector<std::string> columns;  ///< Table: its data file's columns, in order
   std::string subsection;   ///< Sections: the prefix of its sub-sections ("channel")
+  /// A noise level learning may fit (docs/DESIGN.md §10): a Real is a
+  /// standard deviation (> 0, in its unit); a Matrix a covariance whose
+  /// diagonal scales are fitted (each entry a variance, correlations kept).
+  bool learnable = false;
   std::string pythonKey() const { return pythonKeyOf(section, key); }
 };
 
@@ -63,6 +67,11 @@ inline ParamSpec table(std::string s, std::string k, std::vector<std::string> co
 inline ParamSpec sections(std::string s, std::string k, std::string subsection, std::string doc) {
   ParamSpec p = of(ParamKind::Sections, s, k, doc);
   p.subsection = std::move(subsection);
+  return p;
+}
+/// The same declaration, marked as a noise level that can be learnt.
+inline ParamSpec learnable(ParamSpec p) {
+  p.learnable = true;
   return p;
 }
 /// The same declaration, without a default: the source must give it.

@@ -22,6 +22,9 @@ struct ExtendedKalmanFilterOptions {
   /// Joseph-form covariance update (numerically safer; same result in exact
   /// arithmetic).
   bool joseph_form = true;
+  /// Apply the channels' EKF gates (false: every measurement updates, as the
+  /// prediction-error likelihood of noise learning needs; not an INI key).
+  bool use_gates = true;
   bool validate(int nb, std::string* why = nullptr) const;
 };
 
@@ -50,6 +53,10 @@ class ExtendedKalmanFilter {
   const Eigen::MatrixXd& covariance() const { return P_; }
   /// Normalized innovation squared of the last update (NIS).
   double lastNis() const { return nis_; }
+  /// Σ log N(e; 0, S) over the updates taken since construction: the
+  /// prediction-error decomposition of the log-likelihood of the data
+  /// (docs/DESIGN.md §10; not checkpointed).
+  double logLikelihood() const { return log_likelihood_; }
   /// Measurements rejected by their channel's gate so far.
   std::int64_t rejected() const { return rejected_; }
   const Model& model() const { return *model_; }
@@ -67,6 +74,7 @@ class ExtendedKalmanFilter {
   Eigen::VectorXd z_;
   Eigen::MatrixXd P_;
   double nis_ = 0.0;
+  double log_likelihood_ = 0.0;
   std::int64_t rejected_ = 0;
 };
 

@@ -36,7 +36,8 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
 
 /// The figures of a processed dataset (gssm-process's, gssm.process's):
 /// writeRunFigures with a plan view when the model has px and py (its
-/// landmarks, and the dead reckoning when the rows are at inputs).
+/// landmarks, and the dead reckoning when the rows are at inputs), and the
+/// learning's log-likelihood figure when the noise was learnt.
 std::vector<std::string> writeProcessFigures(const io::ProcessResult& result, const std::string& dir);
 
 }  // namespace gssm::plot

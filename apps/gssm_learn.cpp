@@ -1,0 +1,34 @@
+// gssm-learn: learns a dataset's noise from its own log (docs/DESIGN.md
+// §10) and writes the learnt scenario.ini, learn.json and the
+// log-likelihood figure.
+#include <iostream>
+
+#include "cli.h"
+#include "gssm/io/learn_config.h"
+#include "gssm/plot/learn_figure.h"
+
+int main(int argc, char** argv) {
+  return gssm::apps::runApp("gssm-learn", [&] {
+    gssm::apps::CommandLine cli("gssm-learn",
+                                "Learns the noise σs a dataset's model declares learnable from the log alone "
+                                "(maximum likelihood, no truth) and writes OUTDIR/scenario.ini (the input with the "
+                                "learnt values), learn.json and fig-learn-loglik.png.");
+    cli.option("data", "DIR", "dataset folder");
+    cli.option("out", "OUTDIR", "output folder (not the dataset's)");
+    cli.option("config", "FILE", "INI file to use instead of DIR/scenario.ini ([learn] gives the options)");
+    cli.option("start", "SIGMA", "every σ starts here (overrides [learn] start; 0: the [model] values)");
+    cli.parse(argc, argv);
+    const std::string data = cli.require("data"), out = cli.require("out");
+    std::optional<gssm::NoiseLearningOptions> options;
+    if (cli.given("start")) {
+      options = gssm::io::learnSettings(gssm::io::readScenario(data, cli.get("config"))).options;
+      options->start = cli.getDouble("start", 0, 1e12);
+    }
+    const gssm::io::LearnResult r = gssm::io::learnDataset(data, out, cli.get("config"), options);
+    std::cout << r.report.toString();
+    const std::string label = r.config.getString("scenario", "name", data);
+    std::cout << "figure: " << gssm::plot::writeLearningFigure(r.report, out, label) << "\n";
+    for (const auto& f : r.files) std::cout << "gssm-learn: wrote " << f << "\n";
+    return r.report.converged ? 0 : 4;
+  });
+}

@@ -1,0 +1,13 @@
+#pragma once
+// The figure of a noise learning (docs/DESIGN.md §10): the log-likelihood
+// per iteration, with the hand-given values' likelihood for comparison.
+#include <string>
+
+#include "gssm/learn/noise_learning.h"
+
+namespace gssm::plot {
+
+/// Writes dir/fig-learn-loglik.png; returns its path.
+std::string writeLearningFigure(const NoiseLearningReport& report, const std::string& dir, const std::string& label);
+
+}  // namespace gssm::plot

@@ -1,0 +1,104 @@
+#pragma once
+// Noise learnt from the log (docs/DESIGN.md §10): the noise levels a model
+// declares learnable (ParamSpec::learnable: its σs, the diagonals of its Q
+// and R) fitted by maximum likelihood from the measurements and inputs
+// alone, no truth. The likelihood is the prediction-error decomposition of
+// an ungated EKF pass, Σ_k log N(e_k; 0, S_k) (exact for a linear model),
+// maximized over log σ by Nelder–Mead with restarts; standard errors come
+// from the curvature of the log-likelihood at the maximum.
+//
+//   gssm::NoiseLearningOptions o;
+//   o.start = 1.0;                            // every σ from 1 in its unit
+//   auto learnt = gssm::learnNoise(model, data.measurements, data.inputs, data.t0, o);
+//   auto est = gssm::makeEstimator(*learnt.model, {gssm::Method::FixedLag});
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gssm/core/data.h"
+#include "gssm/model/model.h"
+#include "gssm/model/param_values.h"
+#include "gssm/solvers/ekf.h"
+
+namespace gssm {
+
+/// One fitted σ: a learnable Real parameter, or one diagonal entry of a
+/// learnable Matrix (its square root).
+struct LearntParameter {
+  std::string section;  ///< "model", or a sub-section ("channel.gps")
+  std::string key;      ///< "range_sd", "Q", "R"
+  int index = -1;       ///< diagonal entry of a Matrix parameter; −1 for a Real
+  double given = 0;     ///< the model's σ before learning
+  double start = 0;     ///< where learning started
+  double value = 0;     ///< the learnt σ
+  /// Of the learnt σ, from the curvature of the log-likelihood in log σ
+  /// (delta method); NaN where the curvature does not determine it.
+  double standard_error = std::numeric_limits<double>::quiet_NaN();
+  /// False when the log does not determine it: its relative standard error
+  /// exceeds 100%, or it trades off with another (|correlation| > 0.95).
+  bool identifiable = true;
+  std::string note;     ///< why it is flagged, naming the other parameter
+  /// "range_sd", "Q[1]", "channel.gps R[0]".
+  std::string name() const;
+};
+
+struct NoiseLearningOptions {
+  /// What to learn, by name ("range_sd", "Q" for every diagonal entry of Q,
+  /// "Q[1]" for one); empty: every learnable parameter of the model.
+  std::vector<std::string> parameters;
+  /// > 0: every learnt σ starts here (1.0: "one in its unit", so that the
+  /// result does not depend on hand-tuned values); 0: from the model's.
+  double start = 0;
+  /// Each σ is searched within this factor of its start. The likelihood
+  /// of a σ the log does not resolve can keep rising towards 0, where the
+  /// smoothers' information matrices lose their conditioning: it stops at
+  /// start/search_range, and is flagged.
+  double search_range = 1e4;
+  int max_evaluations = 4000;  ///< likelihood evaluations (EKF passes) in all
+  /// Converged when a Nelder–Mead restart from the best point gains less
+  /// than tolerance·(1 + |log-likelihood|).
+  double tolerance = 1e-7;
+  int max_restarts = 6;
+  /// Curvature and standard errors at the maximum (2p² further passes).
+  bool standard_errors = true;
+  /// The filter the likelihood is computed with (its gates are not applied:
+  /// a gated Gaussian likelihood grows without bound as σ → 0).
+  ExtendedKalmanFilterOptions ekf;
+  bool validate(std::string* why = nullptr) const;
+};
+
+struct NoiseLearningReport {
+  std::vector<LearntParameter> parameters;
+  /// The best log-likelihood after each Nelder–Mead iteration (never decreasing).
+  std::vector<double> log_likelihood;
+  double given_log_likelihood = 0;  ///< at the model's own values
+  double start_log_likelihood = 0;  ///< where learning started
+  double final_log_likelihood = 0;
+  int evaluations = 0;  ///< EKF passes
+  int iterations = 0;
+  int restarts = 0;
+  bool converged = false;  ///< false: stopped at max_evaluations
+  double seconds = 0;
+  std::size_t measurements = 0;
+  ParamValues values;                  ///< every parameter of the learnt model
+  std::shared_ptr<const Model> model;  ///< the learnt model
+  /// A few lines: each parameter's start, learnt value ± standard error.
+  std::string toString() const;
+};
+
+/// The prediction-error log-likelihood of the data under `model`: one EKF
+/// pass, every measurement taken (gates off). Throws NumericalError when the
+/// filter fails.
+double predictionErrorLogLikelihood(const Model& model, const std::vector<Measurement>& measurements,
+                                    const std::vector<Input>& inputs, double t0,
+                                    ExtendedKalmanFilterOptions ekf = {});
+
+/// Learns the model's noise from the data. Throws InvalidArgument for bad
+/// options, a model without a registered type, an unknown parameter name;
+/// NumericalError when the likelihood cannot be evaluated at the start.
+NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement>& measurements,
+                               const std::vector<Input>& inputs, double t0,
+                               const NoiseLearningOptions& options = {});
+
+}  // namespace gssm

@@ -1,0 +1,76 @@
+// gssm.learn: noise learnt from a log (docs/DESIGN.md §10), over a model and
+// a dataset, or over a dataset folder (what gssm-learn runs).
+#include "bindings.h"
+#include "gssm/io/learn_config.h"
+#include "gssm/learn/noise_learning.h"
+
+namespace gssm::python {
+
+namespace {
+void bindReport(py::module_& m) {
+  py::class_<LearntParameter>(m, "LearntParameter", "One learnt σ: its start, value and standard error.")
+      .def_property_readonly("name", &LearntParameter::name, "'range_sd', 'Q[1]', 'channel.gps R[0]'")
+      .def_readonly("section", &LearntParameter::section)
+      .def_readonly("key", &LearntParameter::key)
+      .def_readonly("index", &LearntParameter::index, "diagonal entry of a matrix; -1 for a σ")
+      .def_readonly("given", &LearntParameter::given, "the model's σ before learning")
+      .def_readonly("start", &LearntParameter::start)
+      .def_readonly("value", &LearntParameter::value, "the learnt σ")
+      .def_readonly("standard_error", &LearntParameter::standard_error, "NaN where the log does not determine it")
+      .def_readonly("identifiable", &LearntParameter::identifiable)
+      .def_readonly("note", &LearntParameter::note, "why it is flagged")
+      .def("__repr__", [](const LearntParameter& p) {
+        return "<gssm.LearntParameter " + p.name() + " = " + std::to_string(p.value) + ">";
+      });
+  py::class_<NoiseLearningReport>(m, "LearnReport", "What gssm.learn found.")
+      .def_readonly("parameters", &NoiseLearningReport::parameters)
+      .def_property_readonly("log_likelihood", [](const NoiseLearningReport& r) { return toArray(r.log_likelihood); },
+                             "the best log-likelihood after each iteration (never decreasing)")
+      .def_readonly("given_log_likelihood", &NoiseLearningReport::given_log_likelihood)
+      .def_readonly("start_log_likelihood", &NoiseLearningReport::start_log_likelihood)
+      .def_readonly("final_log_likelihood", &NoiseLearningReport::final_log_likelihood)
+      .def_readonly("evaluations", &NoiseLearningReport::evaluations, "EKF passes")
+      .def_readonly("iterations", &NoiseLearningReport::iterations)
+      .def_readonly("restarts", &NoiseLearningReport::restarts)
+      .def_readonly("converged", &NoiseLearningReport::converged)
+      .def_readonly("seconds", &NoiseLearningReport::seconds)
+      .def_property_readonly("model", [](const NoiseLearningReport& r) { return std::const_pointer_cast<Model>(r.model); },
+                             "the learnt model")
+      .def_property_readonly("params", [](const NoiseLearningReport& r) { return modelParams(*r.model); },
+                             "the learnt model's parameters, as its class's keywords")
+      .def("__str__", &NoiseLearningReport::toString);
+}
+
+NoiseLearningOptions learnOptions(const std::vector<std::string>& parameters, double start, double search_range,
+                                  int max_evaluations, double tolerance, int max_restarts, bool standard_errors) {
+  NoiseLearningOptions o;
+  o.parameters = parameters, o.start = start, o.search_range = search_range, o.max_evaluations = max_evaluations;
+  o.tolerance = tolerance, o.max_restarts = max_restarts, o.standard_errors = standard_errors;
+  return o;
+}
+}  // namespace
+
+void bindLearn(py::module_& m) {
+  bindReport(m);
+  m.def(
+      "_learn_model",
+      [](const std::shared_ptr<Model>& model, const PyDataset& d, const std::vector<std::string>& parameters,
+         double start, double search_range, int max_evaluations, double tolerance, int max_restarts,
+         bool standard_errors) {
+        const NoiseLearningOptions o =
+            learnOptions(parameters, start, search_range, max_evaluations, tolerance, max_restarts, standard_errors);
+        py::gil_scoped_release release;  // registered models are C++ (a Python model has no registered type)
+        return learnNoise(*model, d.data.measurements, d.data.inputs, d.data.t0, o);
+      },
+      py::arg("model"), py::arg("data"), py::arg("parameters"), py::arg("start"), py::arg("search_range"),
+      py::arg("max_evaluations"), py::arg("tolerance"), py::arg("max_restarts"), py::arg("standard_errors"));
+  m.def(
+      "_learn_folder",
+      [](const std::string& data, const std::string& out, const std::string& config) {
+        py::gil_scoped_release release;
+        return io::learnDataset(data, out, config).report;
+      },
+      py::arg("data"), py::arg("out"), py::arg("config"));
+}
+
+}  // namespace gssm::python

@@ -1,0 +1,65 @@
+"""gssm.learn: noise learnt from a log, the same as gssm-learn's and as the
+C++ library's, from a model and data or from a dataset folder."""
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+
+import gssm
+from conftest import run_app
+
+
+def test_learn_from_a_model_and_data_recovers_the_noise_it_was_drawn_with():
+    truth = gssm.models.Linear(A_c=[[0, 1], [0, 0]], C_c=[[1, 0]], Q=np.diag([0.25, 0.01]), R=[[0.25]], T=1.0,
+                               prior_state_mean=[0, 1], prior_state_cov=np.diag([4.0, 1.0]))
+    data = gssm.simulate(truth, seed=4, steps=800)
+    start = gssm.models.Linear(A_c=[[0, 1], [0, 0]], C_c=[[1, 0]], Q=np.eye(2), R=[[1.0]], T=1.0,
+                               prior_state_mean=[0, 1], prior_state_cov=np.diag([4.0, 1.0]))
+    r = gssm.learn(start, data, start=1.0)
+    assert r.converged
+    assert [p.name for p in r.parameters] == ["Q[0]", "Q[1]", "R[0]"]
+    for p, sigma in zip(r.parameters, [0.5, 0.1, 0.5]):
+        assert p.start == 1.0 and p.identifiable, p.note
+        assert abs(p.value - sigma) < 3 * p.standard_error, (p.name, p.value, p.standard_error)
+    assert np.all(np.diff(r.log_likelihood) >= 0)
+    assert r.final_log_likelihood == r.log_likelihood[-1] > r.start_log_likelihood
+    # The learnt model is a model like any other: its Q holds the learnt σs.
+    q = np.asarray(r.params["Q"])
+    assert q[0, 0] == pytest.approx(r.parameters[0].value ** 2, rel=1e-12)
+    run = gssm.run(r.model, data, method="ekf")
+    assert run.mean.shape[0] == len(data.t)
+
+
+def test_learn_names_what_it_cannot_learn():
+    model = gssm.models.Radar2D()
+    data = gssm.simulate("paper", seed=1, steps=20)
+    with pytest.raises(gssm.InvalidArgument, match="'range_sd' is not a learnable parameter of model 'radar_2d'"):
+        gssm.learn(model, data, parameters=["range_sd"])
+    with pytest.raises(gssm.InvalidArgument, match="out="):
+        gssm.learn("some/folder")
+
+
+def test_learn_a_folder_equals_gssm_learn(repo, tmp_path, gssm_learn):
+    data = os.path.join(repo, "datasets", "plaza2")
+    r = gssm.learn(data, out=str(tmp_path / "py"))
+    run_app(gssm_learn, "--data", data, "--out", str(tmp_path / "app"))
+    py = json.load(open(tmp_path / "py" / "learn.json"))
+    app = json.load(open(tmp_path / "app" / "learn.json"))
+    assert [p["learnt"] for p in py["parameters"]] == [p["learnt"] for p in app["parameters"]]
+    assert [p.value for p in r.parameters] == [p["learnt"] for p in py["parameters"]]
+    def without_timing(path):  # the summary line says how long it took
+        return [line for line in open(path) if "EKF passes" not in line]
+    assert without_timing(tmp_path / "py" / "scenario.ini") == without_timing(tmp_path / "app" / "scenario.ini")
+    rs = {p.name: p for p in r.parameters}["range_sd"]
+    assert 0.4 < rs.value < 0.7 and rs.identifiable and math.isfinite(rs.standard_error)
+
+
+def test_process_learns_when_asked_and_not_when_told_not_to(repo, tmp_path):
+    data = os.path.join(repo, "datasets", "plaza2")
+    on = gssm.process(data, str(tmp_path / "on"), method="ekf", figures=False)
+    assert on.learnt is not None and os.path.exists(tmp_path / "on" / "learn.json")
+    off = gssm.process(data, str(tmp_path / "off"), method="ekf", figures=False, learn=False)
+    assert off.learnt is None and not os.path.exists(tmp_path / "off" / "learn.json")
+    assert on.runs[0].mean[-1, 0] != off.runs[0].mean[-1, 0]

@@ -1,0 +1,157 @@
+#include "gssm/io/learn_config.h"
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "gssm/core/error.h"
+#include "gssm/io/config.h"
+#include "gssm/io/json_text.h"
+
+namespace gssm::io {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> learnIniKeys() {
+  return {"enabled", "parameters", "start", "max_evaluations", "tolerance", "max_restarts", "standard_errors"};
+}
+
+LearnSettings learnSettings(const IniDocument& ini) {
+  LearnSettings s;
+  if (!ini.hasSection("learn")) return s;
+  ini.requireOnlyKeys("learn", learnIniKeys());
+  NoiseLearningOptions& o = s.options;
+  s.enabled = ini.getBool("learn", "enabled", false);
+  std::istringstream words(ini.getString("learn", "parameters", ""));
+  for (std::string w; words >> w;) o.parameters.push_back(w);
+  o.start = ini.getDouble("learn", "start", o.start);
+  o.max_evaluations = static_cast<int>(ini.getInt("learn", "max_evaluations", o.max_evaluations));
+  o.tolerance = ini.getDouble("learn", "tolerance", o.tolerance);
+  o.max_restarts = static_cast<int>(ini.getInt("learn", "max_restarts", o.max_restarts));
+  o.standard_errors = ini.getBool("learn", "standard_errors", o.standard_errors);
+  std::string why;
+  if (!o.validate(&why)) {
+    std::string key = "start";  // the key the message is about
+    for (const auto& k : learnIniKeys())
+      if (why.find(k) != std::string::npos) key = k;
+    throw InputError(ini.where("learn", key) + ": " + why);
+  }
+  return s;
+}
+
+namespace {
+// The INI text of each learnt key's new value ("0.55", "[0.1 0; 0 0.2]").
+std::map<std::pair<std::string, std::string>, std::string> learntValues(const NoiseLearningReport& r) {
+  std::map<std::pair<std::string, std::string>, std::string> out;
+  IniDocument scratch;
+  for (const auto& p : r.parameters) {
+    if (p.index < 0) scratch.set(p.section, p.key, p.value);
+    else scratch.set(p.section, p.key, r.values.matrix(p.section, p.key));
+    out[{p.section, p.key}] = scratch.getString(p.section, p.key);
+  }
+  return out;
+}
+
+std::vector<std::string> linesOf(const IniDocument& input) {
+  std::vector<std::string> lines;
+  std::ifstream in(input.source(), std::ios::binary);
+  if (!in) {  // not from a file: its serialization
+    std::istringstream ss(input.toString());
+    for (std::string l; std::getline(ss, l);) lines.push_back(l);
+    return lines;
+  }
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::string header(const NoiseLearningReport& r) {
+  std::ostringstream os;
+  os << "# Noise learnt from the log by gssm (prediction-error maximum likelihood, docs/DESIGN.md §10);\n"
+     << "# data files are the dataset's: gssm-process --data <dataset> --config <this file>\n";
+  std::istringstream summary(r.toString());
+  for (std::string l; std::getline(summary, l);) os << "#   " << l << "\n";
+  os << "# log-likelihood per iteration:";
+  const std::size_t n = r.log_likelihood.size(), every = std::max<std::size_t>(1, n / 40);
+  for (std::size_t i = 0; i < n; i += every) os << (i % (every * 8) == 0 ? "\n#  " : "") << " " << r.log_likelihood[i];
+  if (n) os << "\n#   final " << r.log_likelihood.back();
+  return os.str() + "\n\n";
+}
+}  // namespace
+
+std::string learntScenarioText(const IniDocument& input, const NoiseLearningReport& r) {
+  std::vector<std::string> lines = linesOf(input);
+  std::map<int, std::vector<std::string>> after;  // lines to insert after a line (0: at the end)
+  auto put = [&](const std::string& section, const std::string& key, const std::string& value) {
+    const int line = input.lineOf(section, key);
+    if (line > 0 && line <= static_cast<int>(lines.size())) {
+      lines[static_cast<std::size_t>(line - 1)] = key + " = " + value;
+    } else if (const int last = input.lastLineOf(section); last > 0) {
+      after[last].push_back(key + " = " + value);
+    } else {
+      after[0].push_back("[" + section + "]"), after[0].push_back(key + " = " + value);
+    }
+  };
+  for (const auto& [where, value] : learntValues(r)) put(where.first, where.second, value);
+  put("learn", "enabled", "false");  // learnt already: the file reproduces the run as it is
+  std::string out = header(r);
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    out += lines[i] + "\n";
+    for (const auto& l : after[static_cast<int>(i + 1)]) out += l + "\n";
+  }
+  for (const auto& l : after[0]) out += (l.front() == '[' ? "\n" : "") + l + "\n";
+  return out;
+}
+
+std::string learnReportJson(const NoiseLearningReport& r, const std::string& dataset) {
+  std::ostringstream os;
+  os << "{\n  \"dataset\": " << jsonQuoted(dataset) << ",\n  \"method\": \"prediction-error maximum likelihood (EKF)\""
+     << ",\n  \"measurements\": " << r.measurements << ",\n  \"converged\": " << (r.converged ? "true" : "false")
+     << ",\n  \"evaluations\": " << r.evaluations << ",\n  \"iterations\": " << r.iterations
+     << ",\n  \"restarts\": " << r.restarts << ",\n  \"seconds\": " << jsonNumber(r.seconds)
+     << ",\n  \"log_likelihood\": {\"given\": " << jsonNumber(r.given_log_likelihood)
+     << ", \"start\": " << jsonNumber(r.start_log_likelihood) << ", \"final\": " << jsonNumber(r.final_log_likelihood)
+     << "},\n  \"parameters\": [";
+  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
+    const LearntParameter& p = r.parameters[i];
+    os << (i ? "," : "") << "\n    {\"name\": " << jsonQuoted(p.name()) << ", \"section\": " << jsonQuoted(p.section)
+       << ", \"key\": " << jsonQuoted(p.key) << ", \"index\": " << p.index << ", \"given\": " << jsonNumber(p.given)
+       << ", \"start\": " << jsonNumber(p.start) << ", \"learnt\": " << jsonNumber(p.value)
+       << ", \"standard_error\": " << jsonNumber(p.standard_error)
+       << ", \"identifiable\": " << (p.identifiable ? "true" : "false") << ", \"note\": " << jsonQuoted(p.note) << "}";
+  }
+  os << "\n  ],\n  \"log_likelihood_trace\": [";
+  for (std::size_t i = 0; i < r.log_likelihood.size(); ++i) os << (i ? ", " : "") << jsonNumber(r.log_likelihood[i]);
+  os << "]\n}\n";
+  return os.str();
+}
+
+LearnResult learnAndWrite(const Model& model, const IniDocument& input, const Dataset& dataset,
+                          const std::string& out_dir, const NoiseLearningOptions& options) {
+  std::error_code ec;
+  if (!dataset.dir.empty() && fs::exists(out_dir) && fs::equivalent(out_dir, dataset.dir, ec))
+    throw InvalidArgument("the output folder " + out_dir +
+                          " is the dataset's: the learnt scenario.ini would replace its own; choose another");
+  LearnResult out;
+  out.report = learnNoise(model, dataset.measurements, dataset.inputs, dataset.t0, options);
+  fs::create_directories(out_dir);
+  const std::string ini = (fs::path(out_dir) / "scenario.ini").string();
+  const std::string text = learntScenarioText(input, out.report);
+  std::ofstream(ini, std::ios::binary) << text;
+  out.config = IniDocument::parse(text, ini);
+  const std::string json = (fs::path(out_dir) / "learn.json").string();
+  std::ofstream(json, std::ios::binary) << learnReportJson(out.report, dataset.dir);
+  out.files = {ini, json};
+  return out;
+}
+
+LearnResult learnDataset(const std::string& data_dir, const std::string& out_dir, const std::string& config,
+                         const std::optional<NoiseLearningOptions>& options) {
+  const IniDocument ini = readScenario(data_dir, config);
+  const std::unique_ptr<Model> model = makeModel(ini, data_dir);
+  Dataset dataset;
+  readDatasetData(data_dir, *model, dataset, BadRows::Throw, &ini);
+  return learnAndWrite(*model, ini, dataset, out_dir, options ? *options : learnSettings(ini).options);
+}
+
+}  // namespace gssm::io

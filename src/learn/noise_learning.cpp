@@ -1,0 +1,318 @@
+#include "gssm/learn/noise_learning.h"
+
+#include <Eigen/Eigenvalues>
+#include <chrono>
+#include <cmath>
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include "gssm/core/error.h"
+#include "gssm/factors/problem.h"
+#include "gssm/model/registry.h"
+#include "learn/nelder_mead.h"
+
+namespace gssm {
+
+std::string LearntParameter::name() const {
+  std::string n = section == "model" ? key : section + " " + key;
+  return index < 0 ? n : n + "[" + std::to_string(index) + "]";
+}
+
+bool NoiseLearningOptions::validate(std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = "NoiseLearningOptions: " + msg;
+    return false;
+  };
+  if (!(start >= 0) || !std::isfinite(start)) return fail("start must be 0 (the model's values) or a σ > 0");
+  if (max_evaluations < 10) return fail("max_evaluations must be at least 10");
+  if (!(tolerance > 0) || tolerance >= 1) return fail("tolerance must be in (0, 1)");
+  if (max_restarts < 0) return fail("max_restarts must be >= 0");
+  if (!(search_range > 1) || !std::isfinite(search_range)) return fail("search_range must be a factor > 1");
+  return true;  // the EKF options are checked against the model when the filter is made
+}
+
+double predictionErrorLogLikelihood(const Model& model, const std::vector<Measurement>& measurements,
+                                    const std::vector<Input>& inputs, double t0, ExtendedKalmanFilterOptions ekf) {
+  ekf.use_gates = false;
+  ExtendedKalmanFilter filter(model, ekf, t0);
+  for (const ScheduledStep& step : stepSchedule(measurements, inputs, t0)) {
+    filter.predict(step.t, inputAt(model, inputs, filter.time()));
+    for (std::size_t i : step.measurements) filter.update(measurements[i]);
+  }
+  return filter.logLikelihood();
+}
+
+namespace {
+
+
+// The spec declaring [section] key: the section itself or its sub-section prefix ("channel.gps" → "channel").
+const ParamSpec* specOf(const ModelType& type, const std::string& section, const std::string& key) {
+  if (const ParamSpec* p = type.param(section, key)) return p;
+  const auto dot = section.find('.');
+  return dot == std::string::npos ? nullptr : type.param(section.substr(0, dot), key);
+}
+
+bool selected(const LearntParameter& p, const std::vector<std::string>& names) {
+  if (names.empty()) return true;
+  LearntParameter whole = p;
+  whole.index = -1;
+  for (const auto& n : names)
+    if (n == p.name() || n == whole.name()) return true;
+  return false;
+}
+
+// Every learnable σ the values hold, with its given value (zero variances are not learnt).
+std::vector<LearntParameter> learnableParameters(const ModelType& type, const ParamValues& values) {
+  std::vector<LearntParameter> out;
+  auto add = [&out](const std::string& section, const std::string& key, int index, double given) {
+    LearntParameter p;
+    p.section = section, p.key = key, p.index = index, p.given = given;
+    out.push_back(p);
+  };
+  for (const auto& [section, key] : values.keys()) {
+    const ParamSpec* spec = specOf(type, section, key);
+    if (!spec || !spec->learnable) continue;
+    if (spec->kind == ParamKind::Real) {
+      add(section, key, -1, values.real(section, key));
+      continue;
+    }
+    const Eigen::MatrixXd M = values.matrix(section, key);
+    for (Eigen::Index i = 0; i < std::min(M.rows(), M.cols()); ++i)
+      if (M(i, i) > 0) add(section, key, static_cast<int>(i), std::sqrt(M(i, i)));
+  }
+  return out;
+}
+
+std::vector<LearntParameter> chosenParameters(const ModelType& type, const ParamValues& values,
+                                              const NoiseLearningOptions& o) {
+  const std::vector<LearntParameter> all = learnableParameters(type, values);
+  std::vector<LearntParameter> out;
+  for (const auto& p : all)
+    if (selected(p, o.parameters)) out.push_back(p);
+  for (const auto& n : o.parameters) {
+    bool known = false;
+    for (const auto& p : out) known = known || selected(p, {n});
+    if (known) continue;
+    std::string list;
+    for (const auto& p : all) list += (list.empty() ? "" : ", ") + p.name();
+    throw InvalidArgument("NoiseLearningOptions: '" + n + "' is not a learnable parameter of model '" + type.name +
+                          "' (learnable: " + (list.empty() ? "none" : list) + ")");
+  }
+  if (out.empty()) throw InvalidArgument("model '" + type.name + "' declares no learnable noise parameter");
+  for (auto& p : out) p.start = o.start > 0 ? o.start : p.given;
+  return out;
+}
+
+// The values with the chosen σs set to exp(θ): a Real directly; a Matrix as
+// D M D with D = diag(σ_new / σ_given) on its learnt entries (correlations kept).
+ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParameter>& ps, const Eigen::VectorXd& theta) {
+  ParamValues v = base;
+  std::map<std::pair<std::string, std::string>, Eigen::VectorXd> scales;
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    const LearntParameter& p = ps[i];
+    const double sigma = std::exp(theta[static_cast<Eigen::Index>(i)]);
+    if (p.index < 0) {
+      v.real(p.section, p.key, sigma);
+      continue;
+    }
+    auto& d = scales[{p.section, p.key}];
+    if (d.size() == 0) d = Eigen::VectorXd::Ones(base.matrix(p.section, p.key).rows());
+    d[p.index] = sigma / p.given;
+  }
+  for (const auto& [where, d] : scales)
+    v.matrix(where.first, where.second, d.asDiagonal() * base.matrix(where.first, where.second) * d.asDiagonal());
+  return v;
+}
+
+struct Objective {
+  const std::string& type;
+  const ParamValues& base;
+  const std::vector<LearntParameter>& params;
+  const std::vector<Measurement>& measurements;
+  const std::vector<Input>& inputs;
+  double t0;
+  const ExtendedKalmanFilterOptions& ekf;
+  Eigen::VectorXd lo, hi;  // the search range of each log σ
+  int evaluations = 0;
+
+  // The log-likelihood at θ = log σ; −∞ outside the domain or where the filter fails.
+  double logLikelihood(const Eigen::VectorXd& theta) {
+    ++evaluations;
+    if (!theta.allFinite()) return -std::numeric_limits<double>::infinity();
+    try {  // beyond the search range: the value at its end (flat)
+      const Eigen::VectorXd clamped = theta.cwiseMax(lo).cwiseMin(hi);
+      const auto model = withSigmas(base, params, clamped).build(type);
+      const double l = predictionErrorLogLikelihood(*model, measurements, inputs, t0, ekf);
+      return std::isfinite(l) ? l : -std::numeric_limits<double>::infinity();
+    } catch (const NumericalError&) {
+      return -std::numeric_limits<double>::infinity();
+    }
+  }
+};
+
+// Nelder–Mead from θ0, restarted from its best point with a fresh simplex
+// until a restart gains less than the tolerance (a collapsed simplex is not
+// proof of a maximum). A σ that reaches the end of its search range is held
+// there for the restarts that follow (the simplex then spans the others).
+Eigen::VectorXd maximize(Objective& obj, const Eigen::VectorXd& theta0, const NoiseLearningOptions& o,
+                         NoiseLearningReport& r) {
+  Eigen::VectorXd theta = theta0;
+  std::vector<Eigen::Index> free(static_cast<std::size_t>(theta.size()));
+  std::iota(free.begin(), free.end(), Eigen::Index{0});
+  auto full = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd t = theta;
+    for (std::size_t i = 0; i < free.size(); ++i) t[free[i]] = x[static_cast<Eigen::Index>(i)];
+    return t;
+  };
+  auto minus = [&](const Eigen::VectorXd& x) { return -obj.logLikelihood(full(x)); };
+  auto trace = [&r](double best) { r.log_likelihood.push_back(-best); };
+  double best = -std::numeric_limits<double>::infinity();
+  double step = 1.0;  // a factor e on every σ: from a generic start the optimum can be decades away
+  for (r.restarts = 0; !free.empty(); ++r.restarts) {
+    Eigen::VectorXd x(static_cast<Eigen::Index>(free.size()));
+    for (std::size_t i = 0; i < free.size(); ++i) x[static_cast<Eigen::Index>(i)] = theta[free[i]];
+    const int budget = o.max_evaluations - obj.evaluations;
+    const auto nm = internal::nelderMead(minus, x, step, budget, o.tolerance, std::sqrt(o.tolerance), trace);  // ℓ is quadratic in log σ near the top
+    r.iterations += nm.iterations;
+    const double gain = -nm.value - best;
+    if (-nm.value > best) theta = full(nm.x), best = -nm.value;
+    r.converged = nm.converged && gain <= o.tolerance * (1.0 + std::abs(best));
+    if (r.converged || !nm.converged || r.restarts >= o.max_restarts) break;
+    free.erase(std::remove_if(free.begin(), free.end(),
+                              [&](Eigen::Index k) { return theta[k] <= obj.lo[k] + 0.1 || theta[k] >= obj.hi[k] - 0.1; }),
+               free.end());
+    step = 0.25;
+  }
+  r.final_log_likelihood = best;
+  return theta.cwiseMax(obj.lo).cwiseMin(obj.hi);
+}
+
+// −∂²ℓ/∂θ² over the free parameters (those inside their search range) by
+// central differences of the log-likelihood at the maximum.
+Eigen::MatrixXd observedInformation(Objective& obj, const Eigen::VectorXd& theta, double l0,
+                                    const std::vector<Eigen::Index>& free) {
+  const auto n = static_cast<Eigen::Index>(free.size());
+  const double h = 1e-2;  // in log σ: 1%
+  Eigen::MatrixXd I(n, n);
+  auto at = [&](Eigen::Index i, double si, Eigen::Index j, double sj) {
+    Eigen::VectorXd t = theta;
+    t[free[static_cast<std::size_t>(i)]] += si * h;
+    t[free[static_cast<std::size_t>(j)]] += sj * h;
+    return obj.logLikelihood(t);
+  };
+  for (Eigen::Index i = 0; i < n; ++i) {
+    I(i, i) = -(at(i, 1, i, 0) - 2 * l0 + at(i, -1, i, 0)) / (h * h);
+    for (Eigen::Index j = 0; j < i; ++j)
+      I(i, j) = I(j, i) = -(at(i, 1, j, 1) - at(i, 1, j, -1) - at(i, -1, j, 1) + at(i, -1, j, -1)) / (4 * h * h);
+  }
+  return I;
+}
+
+// The pseudo-inverse of the information; a parameter on a flat or upward
+// direction of the likelihood is flagged.
+Eigen::MatrixXd covarianceOf(const Eigen::MatrixXd& info, std::vector<LearntParameter*>& ps) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (info + info.transpose()));
+  const Eigen::VectorXd& lambda = es.eigenvalues();
+  const double floor = 1e-9 * std::max(1.0, lambda.cwiseAbs().maxCoeff());
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(info.rows(), info.cols());
+  for (Eigen::Index k = 0; k < lambda.size(); ++k) {
+    const Eigen::VectorXd v = es.eigenvectors().col(k);
+    if (lambda[k] > floor) {
+      cov += v * v.transpose() / lambda[k];
+      continue;
+    }
+    for (Eigen::Index i = 0; i < v.size(); ++i)
+      if (std::abs(v[i]) > 0.3) ps[static_cast<std::size_t>(i)]->identifiable = false,
+                                ps[static_cast<std::size_t>(i)]->note = "the likelihood is flat along it";
+  }
+  return cov;
+}
+
+// Standard errors of the free parameters (delta method: se(σ) = σ·se(log σ))
+// and the flags of what the log does not determine.
+void standardErrors(const Eigen::MatrixXd& info, std::vector<LearntParameter*> ps) {
+  const Eigen::MatrixXd cov = covarianceOf(info, ps);
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    LearntParameter& p = *ps[i];
+    const auto a = static_cast<Eigen::Index>(i);
+    if (!p.identifiable) continue;
+    p.standard_error = p.value * std::sqrt(cov(a, a));
+    if (std::sqrt(cov(a, a)) > 1.0) p.identifiable = false, p.note = "relative standard error above 100%";
+    for (std::size_t j = 0; j < ps.size() && p.identifiable; ++j) {
+      const auto b = static_cast<Eigen::Index>(j);
+      const double rho = j == i || !(cov(b, b) > 0) ? 0 : cov(a, b) / std::sqrt(cov(a, a) * cov(b, b));
+      if (std::abs(rho) <= 0.95) continue;
+      std::ostringstream os;
+      os << "trades off with " << ps[j]->name() << " (correlation " << rho << "): only their joint effect is determined";
+      p.identifiable = false, p.note = os.str();
+    }
+  }
+}
+}  // namespace
+
+NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement>& measurements,
+                               const std::vector<Input>& inputs, double t0, const NoiseLearningOptions& o) {
+  std::string why;
+  if (!o.validate(&why)) throw InvalidArgument(why);
+  const auto started = std::chrono::steady_clock::now();
+  const ModelType* type = modelTypeOf(model);
+  if (!type) throw InvalidArgument("learnNoise: model '" + model.name() + "' has no registered type, so no learnable parameters");
+  NoiseLearningReport r;
+  const ParamValues base = ParamValues::of(model);
+  r.parameters = chosenParameters(*type, base, o);
+  r.measurements = measurements.size();
+  Objective obj{type->name, base, r.parameters, measurements, inputs, t0, o.ekf, {}, {}};
+  Eigen::VectorXd given(r.parameters.size()), theta0(r.parameters.size());
+  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
+    given[static_cast<Eigen::Index>(i)] = std::log(r.parameters[i].given);
+    theta0[static_cast<Eigen::Index>(i)] = std::log(r.parameters[i].start);
+  }
+  obj.lo = theta0.array() - std::log(o.search_range);
+  obj.hi = theta0.array() + std::log(o.search_range);
+  r.given_log_likelihood = obj.logLikelihood(given);
+  r.start_log_likelihood = obj.logLikelihood(theta0);
+  if (!std::isfinite(r.start_log_likelihood))
+    throw NumericalError("learnNoise: the EKF fails at the starting noise (" + base.where("model", r.parameters[0].key) +
+                         "...): start from other values ([learn] start) or check the data");
+  const Eigen::VectorXd theta = maximize(obj, theta0, o, r);
+  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
+    r.parameters[i].value = std::exp(theta[static_cast<Eigen::Index>(i)]);
+    const auto k = static_cast<Eigen::Index>(i);
+    if (theta[k] < obj.lo[k] + 0.1 || theta[k] > obj.hi[k] - 0.1)
+      r.parameters[i].identifiable = false,
+      r.parameters[i].note = theta[k] < obj.lo[k] + 0.1 ? "at the low end of its search range: the log does not resolve it from 0"
+                                  : "at the high end of its search range";
+  }
+  std::vector<Eigen::Index> free;
+  std::vector<LearntParameter*> free_params;
+  for (std::size_t i = 0; i < r.parameters.size(); ++i)
+    if (r.parameters[i].identifiable)
+      free.push_back(static_cast<Eigen::Index>(i)), free_params.push_back(&r.parameters[i]);
+  if (o.standard_errors && !free.empty())
+    standardErrors(observedInformation(obj, theta, r.final_log_likelihood, free), free_params);
+  r.values = withSigmas(base, r.parameters, theta);
+  r.model = r.values.build(type->name);
+  r.evaluations = obj.evaluations;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return r;
+}
+
+std::string NoiseLearningReport::toString() const {
+  std::ostringstream os;
+  os << "noise learnt by prediction-error maximum likelihood from " << measurements << " measurements: log-likelihood "
+     << start_log_likelihood << " -> " << final_log_likelihood << " (at the given values " << given_log_likelihood
+     << "), " << evaluations << " EKF passes, " << restarts << " restarts, " << (converged ? "converged" : "NOT converged")
+     << ", " << seconds << " s\n";
+  for (const auto& p : parameters) {
+    os << "  " << p.name() << ": " << p.start << " -> " << p.value;
+    if (std::isfinite(p.standard_error)) os << " ± " << p.standard_error;
+    os << " (given " << p.given << ")";
+    if (!p.identifiable) os << "  [not identifiable: " << p.note << "]";
+    os << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace gssm

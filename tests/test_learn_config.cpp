@@ -1,0 +1,84 @@
+// [learn] and the learnt scenario.ini (docs/DESIGN.md §10): the input's own
+// lines and comments kept, the learnt values in place, the model rebuilt
+// from the file equal to the learnt one; bad keys named by file and line.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "gssm/core/error.h"
+#include "gssm/io/config.h"
+#include "gssm/io/learn_config.h"
+#include "gssm/model/param_values.h"
+#include "reference_kalman.h"
+
+namespace gssm::io {
+namespace {
+
+const char* kScenario = R"([scenario]
+name = cv
+[model]
+type = linear
+# a constant-velocity track: position measured
+A_c = [0 1; 0 0]
+C_c = [1 0]
+T = 1
+Q = [1 0; 0 1]
+R = [1]
+[prior]
+state_mean = [0 1]
+state_cov = [4 0; 0 1]
+[learn]
+enabled = true
+start = 1.0
+)";
+
+std::string writeFile(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / "gssm_learn_config";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(LearnConfig, TheLearntScenarioKeepsTheInputsLinesAndRebuildsTheLearntModel) {
+  const IniDocument ini = IniDocument::load(writeFile("cv.ini", kScenario));
+  const LearnSettings s = learnSettings(ini);
+  EXPECT_TRUE(s.enabled);
+  EXPECT_EQ(s.options.start, 1.0);
+  const auto model = makeModel(ini);
+  const SimulatedRun run = simulate(*model, SimulationSpec{}, testing::normalSampler(2));
+  const NoiseLearningReport r = learnNoise(*model, run.measurements, {}, 0.0, s.options);
+  const std::string text = learntScenarioText(ini, r);
+  EXPECT_NE(text.find("# a constant-velocity track: position measured\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("# log-likelihood per iteration:"), std::string::npos) << text;
+  const IniDocument learnt = IniDocument::parse(text, "learnt.ini");
+  EXPECT_FALSE(learnSettings(learnt).enabled);
+  EXPECT_EQ(learnt.getString("model", "A_c"), "[0 1; 0 0]");  // untouched lines as they were
+  EXPECT_LT(learnt.lineOf("model", "Q"), learnt.lineOf("model", "R"));  // in place, in order
+  const ParamValues a = ParamValues::of(*makeModel(learnt)), b = ParamValues::of(*r.model);
+  for (const auto& [section, key] : b.keys()) EXPECT_TRUE(*a.find(section, key) == *b.find(section, key)) << key;
+}
+
+TEST(LearnConfig, BadLearnKeysAreNamedByFileAndLine) {
+  std::string text = kScenario;
+  text += "maximum_evaluations = 10\n";
+  try {
+    learnSettings(IniDocument::parse(text, "bad.ini"));
+    FAIL() << "a typo must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.ini"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("maximum_evaluations"), std::string::npos) << e.what();
+  }
+  text = kScenario;
+  text.replace(text.find("start = 1.0"), 11, "start = -1");
+  try {
+    learnSettings(IniDocument::parse(text, "neg.ini"));
+    FAIL() << "a negative start must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("neg.ini:16: [learn] start"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace gssm::io
