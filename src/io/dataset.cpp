@@ -198,9 +198,16 @@ void readInputs(const std::string& path, const IniDocument& ini, const Model& mo
   if (kind != "rates" && kind != "increments")
     throw InputError(ini.source() + ": [dataset] input_kind = '" + kind + "': expected rates or increments");
   double prev = out.t0;
-  for (std::size_t r = 0; r < in.rows.size(); ++r) {
+  std::size_t first = 0;  // rows before the start describe motion before the run: dropped, listed
+  for (; first < in.rows.size() && in.rows[first][static_cast<std::size_t>(tc)] <= out.t0; ++first) {
+    if (first > 0) requireIncreasing(in, first, in.rows[first - 1][static_cast<std::size_t>(tc)], in.rows[first][static_cast<std::size_t>(tc)]);
+    out.dropped.push_back(in.source + ":" + std::to_string(in.line_of_row[first]) + ": time " +
+                          formatDouble(in.rows[first][static_cast<std::size_t>(tc)]) + " is not after the start " +
+                          formatDouble(out.t0) + " (dropped: before the run)");
+  }
+  for (std::size_t r = first; r < in.rows.size(); ++r) {
     const double t = in.rows[r][static_cast<std::size_t>(tc)];
-    if (r > 0 || kind == "increments" || t < prev) requireIncreasing(in, r, prev, t);  // rates may start at t0
+    if (r > first || kind == "increments" || t < prev) requireIncreasing(in, r, prev, t);
     Eigen::VectorXd u(model.dims().nu);
     for (std::size_t i = 0; i < cols.size(); ++i) u[static_cast<Eigen::Index>(i)] = in.rows[r][static_cast<std::size_t>(cols[i])];
     if (kind == "increments") {
@@ -299,8 +306,11 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
     if (problem.empty() && strict && !out.measurements.empty() && t < out.measurements.back().t)
       problem = "column 't': time " + formatDouble(t) + " is before the previous row's " +
                 formatDouble(out.measurements.back().t) + " ([dataset] out_of_order = error)";
-    if (problem.empty() && !(t > out.t0))
-      problem = "column 't': time " + formatDouble(t) + " is not after the start " + formatDouble(out.t0);
+    if (problem.empty() && !(t > out.t0)) {  // before the run (a log whose truth starts later): dropped, listed
+      out.dropped.push_back(m.source + ":" + std::to_string(line) + ": time " + formatDouble(t) +
+                            " is not after the start " + formatDouble(out.t0) + " (dropped: before the run)");
+      continue;
+    }
     if (!problem.empty()) {
       const std::string msg = m.source + ":" + std::to_string(line) + ": " + problem;
       if (bad_rows == BadRows::Throw) throw InputError(msg);
@@ -342,10 +352,10 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0
   readStartAndRows(ini, out);
   out.inputs.clear();
+  out.dropped.clear();
   if (ini.has("dataset", "inputs")) readInputs(file("inputs"), ini, model, out);
   out.measurements.clear();
   out.row_errors.clear();
-  out.dropped.clear();
   out.late_rows = 0;
   out.max_lateness = 0;
   if (ini.has("dataset", "measurements")) readMeasurements(file("measurements"), ini, model, out, bad_rows);

@@ -14,7 +14,8 @@ namespace gssm::io {
 namespace fs = std::filesystem;
 
 std::vector<std::string> learnIniKeys() {
-  return {"enabled", "parameters", "start", "max_evaluations", "tolerance", "max_restarts", "standard_errors"};
+  return {"enabled",   "parameters",   "start",          "search_range",
+          "max_evaluations", "tolerance", "max_restarts", "standard_errors"};
 }
 
 LearnSettings learnSettings(const IniDocument& ini) {
@@ -26,6 +27,7 @@ LearnSettings learnSettings(const IniDocument& ini) {
   std::istringstream words(ini.getString("learn", "parameters", ""));
   for (std::string w; words >> w;) o.parameters.push_back(w);
   o.start = ini.getDouble("learn", "start", o.start);
+  o.search_range = ini.getDouble("learn", "search_range", o.search_range);
   o.max_evaluations = static_cast<int>(ini.getInt("learn", "max_evaluations", o.max_evaluations));
   o.tolerance = ini.getDouble("learn", "tolerance", o.tolerance);
   o.max_restarts = static_cast<int>(ini.getInt("learn", "max_restarts", o.max_restarts));

@@ -150,6 +150,16 @@ r = process("--data", bad, "--method", "ekf", "--out", os.path.join(work, "o4"))
 check(r.returncode != 0 and "odometry.csv:1: no column 'delta_heading'" in r.stderr,
       "a missing column is named: " + r.stderr.strip()[-200:])
 
+# A log whose truth starts later than its ranges and odometry (start_time =
+# truth): the rows before the start are dropped and listed, not an error.
+late = corrupt("truth.csv", lambda l: l.__delitem__(slice(1, 3)))
+r = process("--data", late, "--method", "ekf", "--out", os.path.join(work, "o6"))
+m6 = json.load(open(os.path.join(work, "o6", "metrics.json")))
+dropped = [s for s in m6["skipped"] if "before the run" in s]
+check(r.returncode == 0 and not m6["partial"] and any("ranges.csv:2:" in s for s in dropped)
+      and any("odometry.csv:2:" in s for s in dropped),
+      "rows before the truth's start are dropped and listed (%d), the rest processed" % len(dropped))
+
 ini = open(os.path.join(data, "scenario.ini")).read().replace("channel_prefix = range_", "channel_prefix = rnge_")
 cfg = os.path.join(work, "bad-prefix.ini")
 open(cfg, "w").write(ini)

@@ -17,7 +17,7 @@ namespace gssm::io {
 ///   enabled = true | false     gssm-process learns before estimating (default false)
 ///   parameters = NAMES         what to learn (default: every learnable σ of the model)
 ///   start = SIGMA              every σ starts here (default 0: the [model] values)
-///   max_evaluations, tolerance, max_restarts, standard_errors
+///   search_range, max_evaluations, tolerance, max_restarts, standard_errors
 struct LearnSettings {
   bool enabled = false;
   NoiseLearningOptions options;
