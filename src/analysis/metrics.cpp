@@ -20,6 +20,18 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
+void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference) {
+  if (reference.size() != m.constants.size())
+    throw InvalidArgument("compareConstants: a reference of " + std::to_string(reference.size()) + " constants for " +
+                          std::to_string(m.constants.size()));
+  m.constants_reference = reference;
+  double sum = 0;
+  m.constants_referenced = 0;
+  for (Eigen::Index i = 0; i < reference.size(); ++i)
+    if (std::isfinite(reference[i])) sum += std::pow(m.constants[i] - reference[i], 2), ++m.constants_referenced;
+  m.constants_reference_rms = m.constants_referenced ? std::sqrt(sum / static_cast<double>(m.constants_referenced)) : NAN;
+}
+
 RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth* truth) {
   RunMetrics m;
   m.method = run.method;

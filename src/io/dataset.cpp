@@ -342,14 +342,39 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
   }
 }
 
+// [dataset] constants_reference: a calibration file of the model's own
+// columns, turned into the constants it implies along the (raw) truth.
+void readConstantsReference(const std::string& path, const IniDocument& ini, const Model& model, Dataset& out) {
+  const std::vector<std::string> names = model.referenceColumns();
+  if (names.empty())
+    throw InputError(ini.where("dataset", "constants_reference") + ": model '" + model.name() +
+                     "' reads no calibration reference");
+  if (!out.truth) throw InputError(ini.where("dataset", "constants_reference") + ": needs [dataset] truth");
+  const CsvTable table = readCsv(path);
+  std::vector<int> cols;
+  for (const auto& n : names) cols.push_back(requireColumn(table, n, "[dataset] constants_reference"));
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(table.rows.size()), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t r = 0; r < table.rows.size(); ++r)
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      rows(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = table.rows[r][static_cast<std::size_t>(cols[c])];
+  try {
+    out.constants_reference = model.referenceConstants(rows, *out.truth);
+  } catch (const InputError& e) {
+    throw InputError(table.source + ": " + e.what());
+  }
+}
+
 // One CSV per sensor stream, as the config's [dataset] describes.
 void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
   ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
                                   "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
-                                  "truth_interpolate", "start_time", "rows", "drop_at_or_below", "out_of_order"});
+                                  "truth_interpolate", "start_time", "rows", "drop_at_or_below", "out_of_order",
+                                  "constants_reference"});
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   out.truth.reset();
   if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0
+  out.constants_reference.reset();
+  if (ini.has("dataset", "constants_reference")) readConstantsReference(file("constants_reference"), ini, model, out);
   readStartAndRows(ini, out);
   out.inputs.clear();
   out.dropped.clear();

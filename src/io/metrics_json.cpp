@@ -44,6 +44,10 @@ std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& 
     if (!m.constant_names.empty() && m.constants.size()) {
       os << "      \"constants\": " << perState(m.constant_names, m.constants) << ",\n";
       os << "      \"constants_sd\": " << perState(m.constant_names, m.constants_sd) << ",\n";
+      if (m.constants_referenced > 0)
+        os << "      \"constants_reference\": " << perState(m.constant_names, m.constants_reference)
+           << ",\n      \"constants_reference_rms\": " << num(m.constants_reference_rms)
+           << ",\n      \"constants_referenced\": " << m.constants_referenced << ",\n";
     }
     os << "      \"downweighted\": " << m.downweighted << ",\n";
     os << "      \"rejected\": " << m.rejected << ",\n";

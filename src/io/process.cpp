@@ -135,6 +135,7 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   for (const Method method : methods) {
     r.runs.push_back(runMethod(o, *model, r, options, method, cb));
     r.metrics.push_back(computeMetrics(*model, r.runs.back(), truth));
+    if (r.dataset.constants_reference) compareConstants(r.metrics.back(), *r.dataset.constants_reference);
     r.files.push_back((fs::path(o.out_dir) / RunFiles::estimatesName(method)).string());
     if (cb.finished) cb.finished(r.runs.back(), r.metrics.back());
   }

@@ -1,5 +1,6 @@
 #include "gssm/models/planar_rigid_body.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "gssm/core/error.h"
@@ -94,6 +95,33 @@ std::vector<Eigen::Vector2d> PlanarRigidBody::bodyPoints(const Eigen::VectorXd& 
   const double c = std::cos(xc[2]), s = std::sin(xc[2]);
   std::vector<Eigen::Vector2d> out;
   for (const auto& l : p_.tags) out.emplace_back(xc[0] + c * l.x() - s * l.y(), xc[1] + s * l.x() + c * l.y());
+  return out;
+}
+
+Eigen::VectorXd PlanarRigidBody::referenceConstants(const Eigen::MatrixXd& rows, const Truth& truth) const {
+  Eigen::VectorXd out = Eigen::VectorXd::Constant(dims().nb, std::numeric_limits<double>::quiet_NaN());
+  if (i_bias_ < 0 || truth.states.empty()) return out;
+  const Eigen::VectorXd xb0 = priorConstants().mean;  // biases 0, scale 1: h is the geometric range
+  for (Eigen::Index r = 0; r < rows.rows(); ++r) {
+    const auto tag = std::find(p_.tag_ids.begin(), p_.tag_ids.end(), static_cast<int>(rows(r, 0)));
+    const auto anchor = std::find(p_.anchor_ids.begin(), p_.anchor_ids.end(), static_cast<int>(rows(r, 1)));
+    if (tag == p_.tag_ids.end() || anchor == p_.anchor_ids.end())
+      throw InputError("calibration reference row " + std::to_string(r + 1) + ": link (" +
+                       std::to_string(static_cast<int>(rows(r, 0))) + ", " + std::to_string(static_cast<int>(rows(r, 1))) +
+                       ") is not in the tags and anchors");
+    const int c = channelOf(static_cast<std::size_t>(tag - p_.tag_ids.begin()),
+                            static_cast<std::size_t>(anchor - p_.anchor_ids.begin()));
+    double sum = 0;
+    for (const auto& row : truth.states) {  // the truth's components into x_c (velocities do not enter h)
+      Eigen::VectorXd xc = Eigen::VectorXd::Zero(6);
+      for (Eigen::Index i = 0; i < row.size(); ++i) {
+        const int k = truth.components.empty() ? static_cast<int>(i) : truth.components[static_cast<std::size_t>(i)];
+        if (k < 6) xc[k] = row[i];
+      }
+      sum += h(c, xc, xb0)[0];
+    }
+    out[biasIndex(c)] = rows(r, 2) + rows(r, 3) * sum / static_cast<double>(truth.states.size());
+  }
   return out;
 }
 

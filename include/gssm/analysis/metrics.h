@@ -23,6 +23,11 @@ struct RunMetrics {
   double position_rmse = NAN, position_max = NAN, position_final = NAN;
   std::vector<std::string> constant_names;  ///< x_b's
   Eigen::VectorXd constants, constants_sd;  ///< at the last row
+  /// A calibration reference of the constants (NaN: none for that one) and
+  /// the RMS of constants − reference over those it gives (compareConstants).
+  Eigen::VectorXd constants_reference;
+  double constants_reference_rms = NAN;
+  std::size_t constants_referenced = 0;
   std::size_t downweighted = 0;             ///< see OfflineRun
   std::int64_t rejected = 0;
   double latency_median = 0, latency_p99 = 0;  ///< per update, seconds
@@ -34,6 +39,10 @@ struct RunMetrics {
 /// Matches rows to truth by time (runErrors); throws InvalidArgument if an
 /// estimate time has no truth row.
 RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth* truth);
+
+/// Fills the reference fields of `m` from `reference` (size n_b, NaN where
+/// it says nothing); InvalidArgument on a size mismatch.
+void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference);
 
 /// Percentile (0..100) of a sample, by linear interpolation; 0 for empty.
 double percentile(std::vector<double> v, double p);

@@ -26,6 +26,9 @@ struct Dataset {
   std::vector<Measurement> measurements;
   std::vector<Input> inputs;  ///< inputs.csv (t,<input names>), if the model has inputs
   std::optional<Truth> truth;
+  /// The constants a calibration file implies ([dataset] constants_reference,
+  /// Model::referenceConstants; NaN where it says nothing): for judging only.
+  std::optional<Eigen::VectorXd> constants_reference;
   /// Bad rows of measurements.csv (malformed number, NaN, wrong field count,
   /// time not increasing), in file order. With BadRows::Stop only the rows
   /// before the first one are kept; with Skip every good row is kept.
@@ -60,6 +63,7 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
 ///       without channel_column the default channel)
 ///     truth = FILE, truth_columns = NAMES (stacked components it gives)
 ///     start_time = truth | NUMBER (t0), rows = measurements | inputs
+///     constants_reference = FILE (a calibration of the constants, judged against)
 void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
                      BadRows bad_rows = BadRows::Throw, const IniDocument* config = nullptr);
 

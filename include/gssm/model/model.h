@@ -8,10 +8,12 @@
 //
 // The same model object drives the EKF, the batch solver and the smoothers.
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "gssm/core/data.h"
 #include "gssm/core/gaussian.h"
 #include "gssm/core/robust_loss.h"
 
@@ -130,6 +132,16 @@ class Model {
   virtual std::vector<Eigen::Vector2d> bodyPoints(const Eigen::VectorXd& /*xc*/) const { return {}; }
   /// Their names (one per point), e.g. "tag 0".
   virtual std::vector<std::string> bodyPointNames() const { return {}; }
+
+  /// A calibration reference of the constants, for judging estimates (no
+  /// estimator reads it): the columns of the reference file this model
+  /// understands (none by default), and the constants those rows imply
+  /// along the true trajectory `truth` (full x_c rows; NaN for a constant
+  /// without a reference). Throws InputError naming the row at fault.
+  virtual std::vector<std::string> referenceColumns() const { return {}; }
+  virtual Eigen::VectorXd referenceConstants(const Eigen::MatrixXd& /*rows*/, const Truth& /*truth*/) const {
+    return Eigen::VectorXd::Constant(dims().nb, std::numeric_limits<double>::quiet_NaN());
+  }
 
   /// All state names in the stacked order [x_c; x_b].
   std::vector<std::string> stackedStateNames() const;

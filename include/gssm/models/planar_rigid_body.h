@@ -48,6 +48,11 @@ class PlanarRigidBody final : public Model {
   /// The tags in the world frame: p + R(yaw)·l_i.
   std::vector<Eigen::Vector2d> bodyPoints(const Eigen::VectorXd& xc) const override;
   std::vector<std::string> bodyPointNames() const override;
+  /// A calibration file's rows (tag, anchor, bias, slope: range error =
+  /// bias + slope·distance): each link's bias at its mean true distance
+  /// along `truth`, the bias-only constant the calibration implies.
+  std::vector<std::string> referenceColumns() const override { return {"tag", "anchor", "bias", "slope"}; }
+  Eigen::VectorXd referenceConstants(const Eigen::MatrixXd& rows, const Truth& truth) const override;
   /// The channel of link (tag i, anchor j), by their positions in the lists.
   int channelOf(std::size_t tag, std::size_t anchor) const { return static_cast<int>(tag * p_.anchors.size() + anchor); }
   /// Index in x_b of link c's bias, −1 without link biases.

@@ -34,10 +34,17 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
                                          const std::string& scenario_label,
                                          const std::optional<PlanView>& plan = std::nullopt);
 
+/// fig-constants-vs-reference.png: the run's final constants ±2σ against a
+/// calibration reference (NaN entries left out); returns its path.
+std::string writeConstantsReferenceFigure(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
+                                          const std::string& dir, const std::string& label);
+
 /// The figures of a processed dataset (gssm-process's, gssm.process's):
 /// writeRunFigures with a plan view when the model has px and py (its
 /// landmarks, and the dead reckoning when the rows are at inputs), and the
-/// learning's log-likelihood figure when the noise was learnt.
+/// learning's log-likelihood figure when the noise was learnt, and the
+/// constants against their calibration reference when the dataset has one
+/// (the batch run's, else the last run's).
 std::vector<std::string> writeProcessFigures(const io::ProcessResult& result, const std::string& dir);
 
 }  // namespace gssm::plot

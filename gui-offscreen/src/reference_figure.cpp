@@ -1,0 +1,37 @@
+#include <cmath>
+#include <filesystem>
+
+#include "gssm/plot/figure.h"
+#include "gssm/plot/run_figures.h"
+
+namespace gssm::plot {
+
+std::string writeConstantsReferenceFigure(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
+                                          const std::string& dir, const std::string& label) {
+  const int nb = model.dims().nb;
+  const Eigen::VectorXd mean = run.rows.back().mean.tail(nb);
+  const Eigen::VectorXd sd = run.rows.back().covariance.diagonal().tail(nb).cwiseSqrt();
+  Figure fig;
+  fig.title = label + ": " + methodName(run.method) + " constants (band: ±2 sd) against the calibration reference";
+  fig.xlabel = "constant, in the estimates' column order (" + model.names().constants.front() + " ... " +
+               model.names().constants.back() + ")";
+  fig.ylabel = "value";
+  fig.robust_quantile = 0;
+  Band band{{}, {}, {}, paletteColor(0)};
+  Series est{methodName(run.method), {}, {}, paletteColor(0)}, ref{"calibration reference", {}, {}, paletteColor(1)};
+  ref.dashed = true;
+  for (int i = 0; i < nb; ++i) {
+    if (!std::isfinite(reference[i])) continue;
+    const double x = static_cast<double>(i);
+    band.x.push_back(x), band.lo.push_back(mean[i] - 2 * sd[i]), band.hi.push_back(mean[i] + 2 * sd[i]);
+    est.x.push_back(x), est.y.push_back(mean[i]);
+    ref.x.push_back(x), ref.y.push_back(reference[i]);
+  }
+  fig.bands.push_back(std::move(band));
+  fig.series = {std::move(est), std::move(ref)};
+  const std::string path = (std::filesystem::path(dir) / "fig-constants-vs-reference.png").string();
+  savePng(fig, path);
+  return path;
+}
+
+}  // namespace gssm::plot
