@@ -235,3 +235,39 @@ TEST(ParamValues, AModelRebuildsFromItsValues) {
 
 }  // namespace
 }  // namespace gssm
+
+namespace gssm {
+namespace {
+
+TEST(NoiseLearning, AnOutlierMixtureKeepsGrossErrorsOutOfTheLearntNoise) {
+  // 5% of the measurements 10–40 σ long (multipath): the Gaussian
+  // likelihood explains them with a larger R; the bounded mixture learns
+  // them as outliers and R as it was drawn.
+  SimulatedRun run = simulateRun(cvWithBias(0.25, 0.01, 0.25), 1500, 21);
+  std::mt19937 rng(22);
+  std::uniform_real_distribution<double> u01;
+  int outliers = 0;
+  for (auto& m : run.measurements)
+    if (u01(rng) < 0.05) m.y[0] += 5 + 15 * u01(rng), ++outliers;
+  NoiseLearningOptions o;
+  o.start = 1.0;
+  const NoiseLearningReport gaussian = learnNoise(cvWithBias(1, 1, 1), run.measurements, {}, 0.0, o);
+  o.outliers = true;
+  const NoiseLearningReport mixture = learnNoise(cvWithBias(1, 1, 1), run.measurements, {}, 0.0, o);
+  const LearntParameter& rg = gaussian.parameters[2];
+  const LearntParameter& rm = mixture.parameters[2];
+  ASSERT_EQ(rm.name(), "R[0]");
+  EXPECT_GT(rg.value, 2 * 0.5) << gaussian.toString();  // inflated by the outliers
+  EXPECT_LT(std::abs(rm.value - 0.5), 3 * rm.standard_error) << mixture.toString();
+  EXPECT_NEAR(mixture.outlier_probability, static_cast<double>(outliers) / run.measurements.size(), 0.02)
+      << mixture.toString();
+  EXPECT_GT(mixture.mixture_from, 0u);
+  for (std::size_t i = mixture.mixture_from + 1; i < mixture.log_likelihood.size(); ++i)
+    EXPECT_GE(mixture.log_likelihood[i], mixture.log_likelihood[i - 1]);
+  EXPECT_GT(mixture.final_log_likelihood, mixture.gaussian_log_likelihood);
+  std::cout << "R σ drawn 0.5: Gaussian " << rg.value << ", mixture " << rm.value << " ± " << rm.standard_error
+            << ", ε " << mixture.outlier_probability << " (" << outliers << " outliers)\n";
+}
+
+}  // namespace
+}  // namespace gssm

@@ -14,7 +14,7 @@ namespace gssm::io {
 namespace fs = std::filesystem;
 
 std::vector<std::string> learnIniKeys() {
-  return {"enabled",   "parameters",   "start",          "search_range",
+  return {"enabled",   "parameters",   "start",        "search_range",   "outliers",
           "max_evaluations", "tolerance", "max_restarts", "standard_errors"};
 }
 
@@ -28,6 +28,7 @@ LearnSettings learnSettings(const IniDocument& ini) {
   for (std::string w; words >> w;) o.parameters.push_back(w);
   o.start = ini.getDouble("learn", "start", o.start);
   o.search_range = ini.getDouble("learn", "search_range", o.search_range);
+  o.outliers = ini.getBool("learn", "outliers", o.outliers);
   o.max_evaluations = static_cast<int>(ini.getInt("learn", "max_evaluations", o.max_evaluations));
   o.tolerance = ini.getDouble("learn", "tolerance", o.tolerance);
   o.max_restarts = static_cast<int>(ini.getInt("learn", "max_restarts", o.max_restarts));
@@ -113,7 +114,9 @@ std::string learnReportJson(const NoiseLearningReport& r, const std::string& dat
      << ",\n  \"restarts\": " << r.restarts << ",\n  \"seconds\": " << jsonNumber(r.seconds)
      << ",\n  \"log_likelihood\": {\"given\": " << jsonNumber(r.given_log_likelihood)
      << ", \"start\": " << jsonNumber(r.start_log_likelihood) << ", \"final\": " << jsonNumber(r.final_log_likelihood)
-     << "},\n  \"parameters\": [";
+     << ", \"gaussian\": " << jsonNumber(r.gaussian_log_likelihood) << "},\n  \"outlier_probability\": "
+     << jsonNumber(r.outlier_probability) << ",\n  \"outlier_stage_from\": " << r.mixture_from
+     << ",\n  \"parameters\": [";
   for (std::size_t i = 0; i < r.parameters.size(); ++i) {
     const LearntParameter& p = r.parameters[i];
     os << (i ? "," : "") << "\n    {\"name\": " << jsonQuoted(p.name()) << ", \"section\": " << jsonQuoted(p.section)

@@ -134,7 +134,11 @@ struct Objective {
   const std::vector<Input>& inputs;
   double t0;
   const ExtendedKalmanFilterOptions& ekf;
-  Eigen::VectorXd lo, hi;  // the search range of each log σ
+  Eigen::VectorXd lo, hi;  // the search range of each log σ (and of logit ε)
+  /// With the outlier mixture, θ's last entry is logit ε and these are the
+  /// channels' uniform log densities.
+  bool mixture = false;
+  std::vector<double> outlier_log_density;
   int evaluations = 0;
 
   // The log-likelihood at θ = log σ; −∞ outside the domain or where the filter fails.
@@ -143,8 +147,11 @@ struct Objective {
     if (!theta.allFinite()) return -std::numeric_limits<double>::infinity();
     try {  // beyond the search range: the value at its end (flat)
       const Eigen::VectorXd clamped = theta.cwiseMax(lo).cwiseMin(hi);
-      const auto model = withSigmas(base, params, clamped).build(type);
-      const double l = predictionErrorLogLikelihood(*model, measurements, inputs, t0, ekf);
+      const auto n = static_cast<Eigen::Index>(params.size());
+      const auto model = withSigmas(base, params, clamped.head(n)).build(type);
+      ExtendedKalmanFilterOptions e = ekf;
+      if (mixture) e.outlier_probability = 1.0 / (1.0 + std::exp(-clamped[n])), e.outlier_log_density = outlier_log_density;
+      const double l = predictionErrorLogLikelihood(*model, measurements, inputs, t0, e);
       return std::isfinite(l) ? l : -std::numeric_limits<double>::infinity();
     } catch (const NumericalError&) {
       return -std::numeric_limits<double>::infinity();
@@ -252,6 +259,43 @@ void standardErrors(const Eigen::MatrixXd& info, std::vector<LearntParameter*> p
 }
 }  // namespace
 
+namespace {
+// Each channel's uniform outlier density: 1 / the volume its measurements span.
+std::vector<double> outlierLogDensities(const Model& model, const std::vector<Measurement>& ms) {
+  const auto channels = static_cast<std::size_t>(model.numChannels());
+  std::vector<Eigen::VectorXd> lo(channels), hi(channels);
+  for (const auto& m : ms) {
+    auto c = static_cast<std::size_t>(m.channel);
+    lo[c] = lo[c].size() ? lo[c].cwiseMin(m.y).eval() : m.y;
+    hi[c] = hi[c].size() ? hi[c].cwiseMax(m.y).eval() : m.y;
+  }
+  std::vector<double> out(channels, 0.0);
+  for (std::size_t c = 0; c < channels; ++c)
+    if (lo[c].size()) out[c] = -(hi[c] - lo[c]).array().max(1e-9).log().sum();
+  return out;
+}
+
+// The learnt values, the flags of σs at the end of their range, the
+// standard errors of the others.
+void finish(Objective& obj, const Eigen::VectorXd& theta, const NoiseLearningOptions& o, NoiseLearningReport& r) {
+  std::vector<Eigen::Index> free;
+  std::vector<LearntParameter*> free_params;
+  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    LearntParameter& p = r.parameters[i];
+    p.value = std::exp(theta[k]);
+    if (theta[k] < obj.lo[k] + 0.1 || theta[k] > obj.hi[k] - 0.1)
+      p.identifiable = false, p.note = theta[k] < obj.lo[k] + 0.1
+                                           ? "at the low end of its search range: the log does not resolve it from 0"
+                                           : "at the high end of its search range";
+    else
+      free.push_back(k), free_params.push_back(&p);
+  }
+  if (o.standard_errors && !free.empty())
+    standardErrors(observedInformation(obj, theta, r.final_log_likelihood, free), free_params);
+}
+}  // namespace
+
 NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement>& measurements,
                                const std::vector<Input>& inputs, double t0, const NoiseLearningOptions& o) {
   std::string why;
@@ -263,36 +307,36 @@ NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement
   const ParamValues base = ParamValues::of(model);
   r.parameters = chosenParameters(*type, base, o);
   r.measurements = measurements.size();
-  Objective obj{type->name, base, r.parameters, measurements, inputs, t0, o.ekf, {}, {}};
-  Eigen::VectorXd given(r.parameters.size()), theta0(r.parameters.size());
-  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
-    given[static_cast<Eigen::Index>(i)] = std::log(r.parameters[i].given);
-    theta0[static_cast<Eigen::Index>(i)] = std::log(r.parameters[i].start);
+  Objective obj{type->name, base, r.parameters, measurements, inputs, t0, o.ekf, {}, {}, false, {}};
+  const auto n = static_cast<Eigen::Index>(r.parameters.size());
+  Eigen::VectorXd given(n), theta(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    given[i] = std::log(r.parameters[static_cast<std::size_t>(i)].given);
+    theta[i] = std::log(r.parameters[static_cast<std::size_t>(i)].start);
   }
-  obj.lo = theta0.array() - std::log(o.search_range);
-  obj.hi = theta0.array() + std::log(o.search_range);
+  obj.lo = theta.array() - std::log(o.search_range);
+  obj.hi = theta.array() + std::log(o.search_range);
   r.given_log_likelihood = obj.logLikelihood(given);
-  r.start_log_likelihood = obj.logLikelihood(theta0);
+  r.start_log_likelihood = obj.logLikelihood(theta);
   if (!std::isfinite(r.start_log_likelihood))
     throw NumericalError("learnNoise: the EKF fails at the starting noise (" + base.where("model", r.parameters[0].key) +
                          "...): start from other values ([learn] start) or check the data");
-  const Eigen::VectorXd theta = maximize(obj, theta0, o, r);
-  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
-    r.parameters[i].value = std::exp(theta[static_cast<Eigen::Index>(i)]);
-    const auto k = static_cast<Eigen::Index>(i);
-    if (theta[k] < obj.lo[k] + 0.1 || theta[k] > obj.hi[k] - 0.1)
-      r.parameters[i].identifiable = false,
-      r.parameters[i].note = theta[k] < obj.lo[k] + 0.1 ? "at the low end of its search range: the log does not resolve it from 0"
-                                  : "at the high end of its search range";
+  theta = maximize(obj, theta, o, r);  // Gaussian first: from a generic start the mixture's ε would absorb everything
+  r.gaussian_log_likelihood = r.final_log_likelihood;
+  if (o.outliers) {
+    r.mixture_from = r.log_likelihood.size();
+    obj.mixture = true;
+    obj.outlier_log_density = outlierLogDensities(model, measurements);
+    Eigen::VectorXd with_eps(n + 1), lo(n + 1), hi(n + 1);
+    with_eps << theta, std::log(0.01 / 0.99);
+    lo << obj.lo, std::log(1e-6), hi << obj.hi, 0.0;  // ε in [1e-6, 0.5]
+    obj.lo = lo, obj.hi = hi;
+    with_eps = maximize(obj, with_eps, o, r);
+    r.outlier_probability = 1.0 / (1.0 + std::exp(-with_eps[n]));
+    theta = with_eps;
   }
-  std::vector<Eigen::Index> free;
-  std::vector<LearntParameter*> free_params;
-  for (std::size_t i = 0; i < r.parameters.size(); ++i)
-    if (r.parameters[i].identifiable)
-      free.push_back(static_cast<Eigen::Index>(i)), free_params.push_back(&r.parameters[i]);
-  if (o.standard_errors && !free.empty())
-    standardErrors(observedInformation(obj, theta, r.final_log_likelihood, free), free_params);
-  r.values = withSigmas(base, r.parameters, theta);
+  finish(obj, theta, o, r);
+  r.values = withSigmas(base, r.parameters, theta.head(n));
   r.model = r.values.build(type->name);
   r.evaluations = obj.evaluations;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -305,6 +349,9 @@ std::string NoiseLearningReport::toString() const {
      << start_log_likelihood << " -> " << final_log_likelihood << " (at the given values " << given_log_likelihood
      << "), " << evaluations << " EKF passes, " << restarts << " restarts, " << (converged ? "converged" : "NOT converged")
      << ", " << seconds << " s\n";
+  if (mixture_from > 0)
+    os << "  outliers: a fraction " << outlier_probability << " of the measurements (Gaussian-only log-likelihood "
+       << gaussian_log_likelihood << ")\n";
   for (const auto& p : parameters) {
     os << "  " << p.name() << ": " << p.start << " -> " << p.value;
     if (std::isfinite(p.standard_error)) os << " ± " << p.standard_error;

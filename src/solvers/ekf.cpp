@@ -20,6 +20,7 @@ bool ExtendedKalmanFilterOptions::validate(int nb, std::string* why) const {
   if (constant_process_noise.size() != 0 && constant_process_noise.size() != nb)
     return fail("constant_process_noise needs " + std::to_string(nb) + " entries (one per constant), got " +
                 std::to_string(constant_process_noise.size()));
+  if (!(outlier_probability >= 0 && outlier_probability < 1)) return fail("outlier_probability must be in [0, 1)");
   for (Eigen::Index i = 0; i < constant_process_noise.size(); ++i)
     if (!(constant_process_noise[i] >= 0) || !std::isfinite(constant_process_noise[i]))
       return fail("constant_process_noise entry " + std::to_string(i) + " must be a finite variance >= 0");
@@ -72,6 +73,17 @@ void ExtendedKalmanFilter::predict(double t, const Eigen::VectorXd& u) {
 
 void ExtendedKalmanFilter::update(const Eigen::VectorXd& y) { update(Measurement{t_, y}); }
 
+namespace {
+// log((1 − ε)·N + ε·u) from log N and log u without underflow, and the
+// inlier responsibility w = (1 − ε)·N / that.
+std::pair<double, double> mixture(double log_normal, double epsilon, double log_uniform) {
+  if (!(epsilon > 0)) return {log_normal, 1.0};
+  const double a = std::log1p(-epsilon) + log_normal, b = std::log(epsilon) + log_uniform;
+  const double hi = std::max(a, b), lp = hi + std::log(std::exp(a - hi) + std::exp(b - hi));
+  return {lp, std::exp(a - lp)};
+}
+}  // namespace
+
 bool ExtendedKalmanFilter::update(const Measurement& m) {
   const ModelDims& d = model_->dims();
   const MeasurementChannel& ch = model_->channel(m.channel);
@@ -99,6 +111,28 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
     ++rejected_;
     return false;
   }
+  // log N(e; 0, S) = −½ (eᵀS⁻¹e + log det S + m log 2π), log det S from S's Cholesky factor.
+  const double log_det_S = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
+  const double log_normal = -0.5 * (nis + log_det_S + static_cast<double>(ch.dim()) * std::log(2.0 * M_PI));
+  const auto [log_p, w] = mixture(log_normal, options_.outlier_probability, outlierLogDensity(m.channel));
+  commitUpdate(H, S, llt, innov, w);
+  nis_ = nis;
+  log_likelihood_ += log_p;
+  return true;
+}
+
+double ExtendedKalmanFilter::outlierLogDensity(int channel) const {
+  if (!(options_.outlier_probability > 0)) return 0;
+  if (static_cast<std::size_t>(channel) >= options_.outlier_log_density.size())
+    throw InvalidArgument("ExtendedKalmanFilter: outlier_probability > 0 needs outlier_log_density for channel " +
+                          std::to_string(channel));
+  return options_.outlier_log_density[static_cast<std::size_t>(channel)];
+}
+
+// The update with inlier weight w (1: the Kalman update): the moments of the
+// mixture w·N(inlier update) + (1 − w)·N(no update).
+void ExtendedKalmanFilter::commitUpdate(const Eigen::MatrixXd& H, const Eigen::MatrixXd& S,
+                                        const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& innov, double w) {
   const Eigen::MatrixXd HP = H * P_;                        // m × n
   const Eigen::MatrixXd K = llt.solve(HP).transpose();       // P Hᵀ S⁻¹ (P, S symmetric)
   // Joseph form (I − KH) P (I − KH)ᵀ + K R Kᵀ, expanded as
@@ -111,19 +145,16 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   } else {
     P = P_ - K * HP;
   }
+  const Eigen::VectorXd dz = K * innov;
+  if (w < 1.0) P = w * P + (1.0 - w) * P_ + (w * (1.0 - w)) * dz * dz.transpose();
   P = 0.5 * (P + P.transpose());
   Eigen::LLT<Eigen::MatrixXd> pcheck(P);
   if (pcheck.info() != Eigen::Success || !P.allFinite())
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
                          ": the updated covariance is not positive definite (filter unchanged)");
-  z_ += K * innov;
+  z_ += w * dz;
   wrapAngles(z_, model_->angleStates());
   P_ = std::move(P);
-  nis_ = nis;
-  // log N(e; 0, S) = −½ (eᵀS⁻¹e + log det S + m log 2π), log det S from S's Cholesky factor.
-  const double log_det_S = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
-  log_likelihood_ -= 0.5 * (nis + log_det_S + static_cast<double>(ch.dim()) * std::log(2.0 * M_PI));
-  return true;
 }
 
 Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,

@@ -60,6 +60,10 @@ struct NoiseLearningOptions {
   /// than tolerance·(1 + |log-likelihood|).
   double tolerance = 1e-7;
   int max_restarts = 6;
+  /// After the Gaussian maximum, learn again with each measurement an
+  /// outlier (uniform over its channel's span) with a learnt probability ε:
+  /// a bounded likelihood that gross errors do not inflate the σs with.
+  bool outliers = false;
   /// Curvature and standard errors at the maximum (2p² further passes).
   bool standard_errors = true;
   /// The filter the likelihood is computed with (its gates are not applied:
@@ -70,11 +74,16 @@ struct NoiseLearningOptions {
 
 struct NoiseLearningReport {
   std::vector<LearntParameter> parameters;
-  /// The best log-likelihood after each Nelder–Mead iteration (never decreasing).
+  /// The best log-likelihood after each Nelder–Mead iteration (never
+  /// decreasing within a stage; the outlier stage's is another likelihood).
   std::vector<double> log_likelihood;
   double given_log_likelihood = 0;  ///< at the model's own values
   double start_log_likelihood = 0;  ///< where learning started
   double final_log_likelihood = 0;
+  double gaussian_log_likelihood = 0;  ///< at the Gaussian stage's maximum
+  /// With `outliers`: the learnt ε, and where its stage starts in log_likelihood (0: no such stage).
+  double outlier_probability = 0;
+  std::size_t mixture_from = 0;
   int evaluations = 0;  ///< EKF passes
   int iterations = 0;
   int restarts = 0;

@@ -3,6 +3,7 @@
 // discretization"). One stacked state z = [x_c; x_b] evolves step by step
 // with x_b(k+1) = x_b(k); the constants are carried as a random walk with
 // zero (or a small, optional) process noise and marginalized every step.
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <string>
 
@@ -25,6 +26,14 @@ struct ExtendedKalmanFilterOptions {
   /// Apply the channels' EKF gates (false: every measurement updates, as the
   /// prediction-error likelihood of noise learning needs; not an INI key).
   bool use_gates = true;
+  /// A bounded outlier model (not an INI key; noise learning's): each
+  /// measurement is an inlier N(h, R) with probability 1 − ε or an outlier
+  /// of density exp(outlier_log_density[channel]) (uniform over its span)
+  /// with probability ε. The update then moves by the inlier
+  /// responsibility w (the moments of the two-component posterior) and the
+  /// log-likelihood counts the mixture. 0: plain Gaussian.
+  double outlier_probability = 0;
+  std::vector<double> outlier_log_density;
   bool validate(int nb, std::string* why = nullptr) const;
 };
 
@@ -68,6 +77,9 @@ class ExtendedKalmanFilter {
   void load(internal::ByteReader& in);
 
  private:
+  double outlierLogDensity(int channel) const;
+  void commitUpdate(const Eigen::MatrixXd& H, const Eigen::MatrixXd& S, const Eigen::LLT<Eigen::MatrixXd>& llt,
+                    const Eigen::VectorXd& innov, double w);
   const Model* model_;
   ExtendedKalmanFilterOptions options_;
   double t_;
