@@ -254,9 +254,9 @@ TEST(Checkpoint, ForeignModelVersionAndFileErrorsNameTheCause) {
   p.r *= 2;
   const models::Radar2D other(p);
   EXPECT_NE(errorOf([&] { restoreCheckpointBytes(other, bytes); }).find("other noise or prior"), std::string::npos);
-  std::string v3 = bytes;
-  v3[8] = 3;  // a newer format than this build reads
-  EXPECT_NE(errorOf([&] { restoreCheckpointBytes(radar, v3); }).find("format version 3, this build reads versions 1 to 2"),
+  std::string v4 = bytes;
+  v4[8] = 4;  // a newer format than this build reads
+  EXPECT_NE(errorOf([&] { restoreCheckpointBytes(radar, v4); }).find("format version 4, this build reads versions 1 to 3"),
             std::string::npos);
   EXPECT_NE(errorOf([&] { restoreCheckpoint(radar, "/nonexistent/run.ckpt"); }).find("cannot open checkpoint '/nonexistent/run.ckpt'"), std::string::npos);
   EXPECT_NE(errorOf([&] { restoreCheckpointBytes(radar, "GSSMCKPT"); }).find("truncated while reading format version"), std::string::npos);

@@ -53,6 +53,7 @@ class EstimatorOptions:
     method: str
     t0: float
     compute_nis: bool
+    drop_late: bool
     ekf: EkfOptions
     smoother: SmootherOptions
     batch: BatchOptions
@@ -98,6 +99,8 @@ class EstimatorReport:
     window: int
     ordering: Optional[str]
     measurements: int
+    late: int
+    late_dropped: int
     seconds: float
     iterations: int
     rejected: int

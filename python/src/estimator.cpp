@@ -157,7 +157,7 @@ void bindOptionGroups(py::module_& m) {
 py::tuple pickledOptions(const EstimatorOptions& o) {
   return py::make_tuple(std::string(methodName(o.method)), o.t0, o.compute_nis, optionDict(o.ekf), optionDict(o.smoother),
                         orderingName(o.incremental.ordering), o.fixed_lag.window, o.paper_window.window,
-                        optionDict(o.batch));
+                        optionDict(o.batch), o.drop_late);
 }
 
 EstimatorOptions unpickledOptions(const py::tuple& t) {
@@ -170,6 +170,7 @@ EstimatorOptions unpickledOptions(const py::tuple& t) {
   o.fixed_lag.window = t[6].cast<int>();
   o.paper_window.window = t[7].cast<int>();
   setOptions(o.batch, t[8]);
+  if (t.size() > 9) o.drop_late = t[9].cast<bool>();
   return o;
 }
 
@@ -184,6 +185,8 @@ void bindEstimatorOptions(py::module_& m) {
           [](EstimatorOptions& o, const std::string& s) { o.method = methodFromName(s); })
       .def_readwrite("t0", &EstimatorOptions::t0, "time of x_c(0)")
       .def_readwrite("compute_nis", &EstimatorOptions::compute_nis)
+      .def_readwrite("drop_late", &EstimatorOptions::drop_late,
+                     "drop and count a measurement too late to take (report.late_dropped) instead of refusing it")
       .def_readwrite("ekf", &EstimatorOptions::ekf)
       .def_readwrite("smoother", &EstimatorOptions::smoother)
       .def_readwrite("batch", &EstimatorOptions::batch)
@@ -256,6 +259,8 @@ py::dict reportDict(const EstimatorReport& r) {
   d["window"] = r.window;
   d["ordering"] = r.ordering ? py::object(py::str(orderingName(*r.ordering))) : py::object(py::none());
   d["measurements"] = r.measurements;
+  d["late"] = r.late;
+  d["late_dropped"] = r.late_dropped;
   d["seconds"] = r.seconds;
   d["iterations"] = r.iterations;
   d["rejected"] = r.rejected;
@@ -274,6 +279,8 @@ void bindEstimatorReport(py::module_& m) {
                                return py::str(orderingName(*r.ordering));
                              })
       .def_readonly("measurements", &EstimatorReport::measurements)
+      .def_readonly("late", &EstimatorReport::late, "measurements taken out of sequence, at a held state's time")
+      .def_readonly("late_dropped", &EstimatorReport::late_dropped, "late measurements dropped (drop_late)")
       .def_readonly("seconds", &EstimatorReport::seconds)
       .def_readonly("iterations", &EstimatorReport::iterations)
       .def_readonly("rejected", &EstimatorReport::rejected)

@@ -63,3 +63,4 @@ def test_process_learns_when_asked_and_not_when_told_not_to(repo, tmp_path):
     off = gssm.process(data, str(tmp_path / "off"), method="ekf", figures=False, learn=False)
     assert off.learnt is None and not os.path.exists(tmp_path / "off" / "learn.json")
     assert on.runs[0].mean[-1, 0] != off.runs[0].mean[-1, 0]
+

@@ -101,6 +101,8 @@ class ByteReader {
 /// once and calls it with FieldWriter{out} (on a copy) or FieldReader{in}.
 struct FieldWriter {
   ByteWriter& out;
+  /// The format written: always the newest (fields added later are read only from versions that have them).
+  static constexpr std::uint32_t version() { return ~std::uint32_t{0}; }
   void operator()(const double& v, const char*, bool = false) { out.f64(v); }
   void operator()(const int& v, const char*) { out.i32(v); }
   void operator()(const bool& v, const char*) { out.boolean(v); }
@@ -114,6 +116,7 @@ struct FieldWriter {
 
 struct FieldReader {
   ByteReader& in;
+  std::uint32_t version() const { return in.version(); }
   /// `allow_nonfinite`: ∞ or NaN are legitimate values of this field.
   void operator()(double& v, const char* what, bool allow_nonfinite = false) { v = in.f64(what, allow_nonfinite); }
   void operator()(int& v, const char* what) { v = in.i32(what); }

@@ -52,6 +52,7 @@ void fields(Io& io, EstimatorOptions& o) {  // after the method, which goes by n
   fields(io, o.smoother);
   io(o.t0, "t0");
   io(o.compute_nis, "compute_nis");
+  if (io.version() >= 3) io(o.drop_late, "drop_late");
 }
 
 template <class Io>
@@ -89,6 +90,8 @@ void Estimator::save(internal::ByteWriter& out) const {
   EstimatorReport r = report();  // formats a pending detail line
   internal::FieldWriter w{out};
   internal::fields(w, r);
+  out.i64(r.late);  // since format version 3
+  out.i64(r.late_dropped);
   saveState(out);
 }
 
@@ -103,6 +106,11 @@ void Estimator::load(internal::ByteReader& in) {
   EstimatorReport r = report_;  // method, window, ordering: from the options
   internal::FieldReader reader{in};
   internal::fields(reader, r);
+  if (in.version() >= 3) {
+    r.late = in.i64("report late measurements");
+    r.late_dropped = in.i64("report late measurements dropped");
+    if (r.late < 0 || r.late_dropped < 0) in.fail("late measurement counts: negative");
+  }
   // The base state first: the method's loadState checks itself against it.
   t_ = t;
   k_ = k;
@@ -186,7 +194,7 @@ void Estimator::addMeasurement(double t, const std::string& channel, const Eigen
 
 void Estimator::requireUsable(const Measurement& m) const {
   const double t = m.t;
-  if (!std::isfinite(t) || t < t_ || (t == t_ && k_ == 0)) {
+  if (!std::isfinite(t) || (t < t_ && !stateAt(t)) || (t == t_ && k_ == 0)) {
     std::ostringstream os;
     os << methodName() << ": measurement time " << t << " must be after the previous state (" << t_ << ")"
        << (k_ == 0 ? ", the start t0" : "");
@@ -206,8 +214,36 @@ void Estimator::requireUsable(const Measurement& m) const {
                                          std::to_string(t));
 }
 
+void Estimator::addLate(const Measurement& m) {
+  const std::optional<std::int64_t> k = stateAt(m.t);
+  if (!k && options_.drop_late) {
+    ++report_.late_dropped;
+    return;
+  }
+  if (!k) {
+    std::ostringstream os;
+    os << methodName() << ": measurement at t = " << m.t << " is before the newest state (t = " << t_ << ") and "
+       << (method() == Method::Incremental || method() == Method::FixedLag
+               ? "no state is at its time (between two states" +
+                     std::string(method() == Method::FixedLag ? ", or older than the window" : "") +
+                     "; a late measurement joins the state at its exact time)"
+               : "this method takes measurements in time order only")
+       << "; EstimatorOptions::drop_late drops and counts it instead";
+    throw InvalidArgument(os.str());
+  }
+  requireUsable(m);
+  doMeasurements(*k, &m, 1);
+  ++report_.late;
+  ++report_.measurements;
+}
+
 void Estimator::addMeasurement(const Measurement& m) {
   const auto start = std::chrono::steady_clock::now();
+  if (std::isfinite(m.t) && m.t < t_) {
+    addLate(m);
+    report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return;
+  }
   requireUsable(m);
   const double nis = options_.compute_nis ? innovationNis(m.t - t_, inputInForce(), m) : report_.nis;
   addAt(m.t, &m, 1);
@@ -219,7 +255,7 @@ void Estimator::addMeasurements(const std::vector<Measurement>& ms) { addMeasure
 
 void Estimator::addMeasurements(const Measurement* ms, std::size_t count) {
   if (count == 0) return;
-  if (options_.compute_nis) {
+  if (options_.compute_nis || (std::isfinite(ms[0].t) && ms[0].t < t_)) {  // late: each joins its state
     for (std::size_t i = 0; i < count; ++i) addMeasurement(ms[i]);
     return;
   }
@@ -353,6 +389,15 @@ class SmootherEstimator final : public Estimator {
   }
 
   StateEstimate current() override { return *smoothed(step()); }
+
+  std::optional<std::int64_t> stateAt(double t) const override {
+    const auto it = std::lower_bound(times_.begin(), times_.end(), t,
+                                     [](double a, double b) { return a < b && !sameTime(a, b); });
+    if (it == times_.end() || !sameTime(*it, t)) return std::nullopt;
+    const std::int64_t k = step() - static_cast<std::int64_t>(times_.end() - 1 - it);
+    if (k < 1 || !smoother_.contains(Key::state(k))) return std::nullopt;  // x_c(0) is the prior's
+    return k;
+  }
 
   std::optional<StateEstimate> smoothed(std::int64_t k) override {
     if (k < 0 || k > step() || step() - k >= static_cast<std::int64_t>(times_.size()) ||

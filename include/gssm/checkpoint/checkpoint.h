@@ -28,9 +28,10 @@
 
 namespace gssm {
 
-/// Version 2 added the EKF's count of gated measurements; version 1 files
-/// still restore (the count starts at 0).
-constexpr std::uint32_t kCheckpointVersion = 2;
+/// Version 2 added the EKF's count of gated measurements, version 3 the
+/// counts of late measurements and EstimatorOptions::drop_late; older files
+/// still restore (those start at 0 and false).
+constexpr std::uint32_t kCheckpointVersion = 3;
 
 /// What a checkpoint says about itself (filled by restore).
 struct CheckpointInfo {

@@ -46,6 +46,10 @@ struct EstimatorReport {
   int window = 0;
   std::optional<EliminationOrdering> ordering;
   std::int64_t measurements = 0;  ///< measurements processed
+  /// Measurements taken out of sequence (their time before the newest
+  /// state's, at a state the smoother still holds), and those dropped as too
+  /// late (EstimatorOptions::drop_late).
+  std::int64_t late = 0, late_dropped = 0;
   double seconds = 0;         ///< wall time of the last addMeasurement
   int iterations = 0;         ///< solver iterations of the last update (1 for the EKF)
   /// Measurements rejected by their channel's EKF gate so far (EKF only;
@@ -67,6 +71,9 @@ struct EstimatorOptions {
   double t0 = 0.0;            ///< time of x_c(0)
   /// Compute the NIS of every measurement (costs one covariance query per update).
   bool compute_nis = false;
+  /// A measurement too late to take (see Estimator::addMeasurement) is
+  /// dropped and counted in report().late_dropped instead of refused.
+  bool drop_late = false;
 
   ExtendedKalmanFilterOptions ekf;  ///< ekf  [ekf]
   SmootherOptions smoother;         ///< incremental, fixed-lag: relinearization  [smoother]
@@ -102,7 +109,14 @@ class Estimator {
   void addInput(double t, const Eigen::VectorXd& u);
   /// A measurement y at time t. After the newest state: a new step to t. At
   /// the newest state's time (after t0): attached to that state (multi-rate
-  /// sensors, several measurements per step).
+  /// sensors, several measurements per step). Before it (out of sequence:
+  /// a sensor's buffer, a late radio block): the smoothers attach it to the
+  /// state at its time when they still hold one (the incremental smoother:
+  /// any; the fixed lag: inside its window), re-eliminating only what it
+  /// touches, so the result is the one of the same data in order. A time
+  /// with no state (between two states, older than the window) and the EKF
+  /// and paper window: refused (InvalidArgument, estimator unchanged), or
+  /// dropped and counted with EstimatorOptions::drop_late.
   void addMeasurement(double t, const Eigen::VectorXd& y);
   /// A measurement on the model's channel called `channel` (several
   /// sensors: any rate, any interleaving, several at one time stamp).
@@ -165,6 +179,9 @@ class Estimator {
   /// addMeasurement's checks of one measurement (time, channel, values, R).
   void requireUsable(const Measurement& m) const;
   void addAt(double t, const Measurement* ms, std::size_t count);
+  /// The step of a held state at time t < time() that a late measurement
+  /// can join; none by default (the EKF and the paper window keep none).
+  virtual std::optional<std::int64_t> stateAt(double /*t*/) const { return std::nullopt; }
 
   const Model& model_;
   mutable EstimatorReport report_;
@@ -177,6 +194,8 @@ class Estimator {
   void advance(double t);  // process-only step to t
   /// NIS of y at a step dt after the current estimate (dt = 0: at it).
   double innovationNis(double dt, const Eigen::VectorXd& u, const Measurement& m);
+  /// A measurement before the newest state: joined to its state, or refused / dropped.
+  void addLate(const Measurement& m);
   Eigen::VectorXd inputInForce() const;
   double t_;            // time of the newest state
   std::int64_t k_ = 0;  // its step

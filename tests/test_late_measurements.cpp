@@ -1,0 +1,185 @@
+// Measurements out of sequence (a sensor's buffer, a radio writing blocks
+// late): the smoothers attach a late measurement to the state at its time
+// and end where the same data fed in order (and the batch solve) end; what
+// they cannot take is refused with the estimator unchanged, or dropped and
+// counted.
+#include <gtest/gtest.h>
+
+#include "gssm/analysis/offline.h"
+#include "gssm/checkpoint/checkpoint.h"
+#include "gssm/core/error.h"
+#include "gssm/estimator/estimator.h"
+#include "gssm/models/linear.h"
+#include "gssm/models/radar2d.h"
+#include "reference_kalman.h"
+
+namespace gssm {
+namespace {
+
+// Position and velocity, a constant bias on the position sensor "y", and a
+// second, unbiased position sensor "gps" read at the same instants.
+models::LinearModel twoSensors() {
+  models::LinearSystem s;
+  s.A_c = (Eigen::Matrix2d() << 0, 1, 0, 0).finished();
+  s.A_b = Eigen::MatrixXd::Zero(2, 1);
+  s.B = Eigen::MatrixXd::Zero(2, 0);
+  s.C_c = Eigen::RowVector2d(1, 0);
+  s.C_b = Eigen::MatrixXd::Ones(1, 1);
+  s.noise.T = 0.5;
+  s.noise.Q = Eigen::Vector2d(0.01, 0.04).asDiagonal();
+  s.noise.R = Eigen::MatrixXd::Constant(1, 1, 0.25);
+  s.noise.prior_state = {Eigen::Vector2d(0, 1), Eigen::Vector2d(4, 1).asDiagonal()};
+  s.noise.prior_constants = {Eigen::VectorXd::Zero(1), Eigen::MatrixXd::Constant(1, 1, 4.0)};
+  s.channels.push_back({"gps", Eigen::RowVector2d(1, 0), Eigen::MatrixXd::Zero(1, 1), Eigen::MatrixXd::Constant(1, 1, 1.0), {}});
+  return models::LinearModel(s);
+}
+
+struct Log {
+  std::vector<Measurement> in_order;  // y and gps of each instant, instant by instant
+  std::vector<Measurement> arrival;   // each gps reading `delay` instants late
+};
+
+Log twoSensorLog(const Model& m, int steps, int delay) {
+  SimulationSpec spec;
+  spec.steps = steps;
+  const SimulatedRun run = simulate(m, spec, testing::normalSampler(7));
+  auto draw = testing::normalSampler(8);
+  Log log;
+  std::vector<Measurement> gps;
+  for (const auto& y : run.measurements) {
+    const std::size_t k = static_cast<std::size_t>(std::llround(y.t / m.nominalStep()));
+    gps.push_back({y.t, Eigen::VectorXd::Constant(1, run.states[k][0] + draw()), 1, {}});
+    log.in_order.push_back(y);
+    log.in_order.push_back(gps.back());
+  }
+  for (std::size_t k = 0; k < run.measurements.size(); ++k) {
+    log.arrival.push_back(run.measurements[k]);
+    if (k >= static_cast<std::size_t>(delay)) log.arrival.push_back(gps[k - static_cast<std::size_t>(delay)]);
+  }
+  for (std::size_t k = gps.size() - static_cast<std::size_t>(delay); k < gps.size(); ++k) log.arrival.push_back(gps[k]);
+  return log;
+}
+
+std::unique_ptr<Estimator> feed(const Model& m, EstimatorOptions o, const std::vector<Measurement>& ms) {
+  auto est = makeEstimator(m, o);
+  for (const auto& x : ms) est->addMeasurement(x);
+  return est;
+}
+
+void expectNear(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double tol, const std::string& what) {
+  ASSERT_EQ(a.rows(), b.rows()) << what;
+  EXPECT_LE((a - b).cwiseAbs().maxCoeff(), tol * (1.0 + b.cwiseAbs().maxCoeff())) << what << "\n" << a << "\nvs\n" << b;
+}
+
+TEST(LateMeasurements, SmoothersFedOutOfOrderEndAsFedInOrderAndAsTheBatch) {
+  const auto m = twoSensors();
+  const Log log = twoSensorLog(m, 60, 4);
+  const OfflineRun batch = runOffline(m, {Method::Batch}, log.in_order);
+  for (Method method : {Method::Incremental, Method::FixedLag}) {
+    EstimatorOptions o(method);
+    o.fixed_lag.window = 10;
+    auto late = feed(m, o, log.arrival);
+    auto ordered = feed(m, o, log.in_order);
+    EXPECT_EQ(late->report().late, 59) << method;  // the last gps reading comes with its own instant
+    ASSERT_EQ(batch.rows.size(), 60u);  // one row per instant
+    EXPECT_EQ(late->report().measurements, 120) << method;
+    expectNear(late->current().mean, ordered->current().mean, 1e-9, methodName(method));
+    expectNear(late->current().covariance, ordered->current().covariance, 1e-9, methodName(method));
+    for (std::int64_t k = late->step() - 8; k <= late->step(); ++k)
+      expectNear(late->smoothed(k)->mean, ordered->smoothed(k)->mean, 1e-9, std::string(methodName(method)) + " x_c(k)");
+    if (method == Method::Incremental)  // the whole history equals the batch solve of all the data
+      for (std::int64_t k = 1; k <= late->step(); k += 7)
+        expectNear(late->smoothed(k)->mean, batch.rows[static_cast<std::size_t>(k - 1)].mean, 1e-8, "batch");
+  }
+}
+
+TEST(LateMeasurements, WhatCannotBeTakenIsRefusedUnchangedOrDroppedAndCounted) {
+  const auto m = twoSensors();
+  const Log log = twoSensorLog(m, 40, 12);  // older than a 10-state window
+  for (Method method : {Method::FixedLag, Method::Ekf, Method::PaperWindow}) {
+    EstimatorOptions o(method);
+    o.fixed_lag.window = o.paper_window.window = 10;
+    auto est = makeEstimator(m, o);
+    std::size_t i = 0;
+    for (; log.arrival[i].channel == 0; ++i) est->addMeasurement(log.arrival[i]);
+    const Eigen::VectorXd mean = est->current().mean;
+    const std::int64_t taken = est->report().measurements;
+    try {
+      est->addMeasurement(log.arrival[i]);
+      FAIL() << method << ": a measurement 12 states late must be refused";
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("is before the newest state"), std::string::npos) << e.what();
+      if (method == Method::FixedLag)
+        EXPECT_NE(std::string(e.what()).find("older than the window"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(est->current().mean, mean) << method;
+    EXPECT_EQ(est->report().measurements, taken) << method;
+    o.drop_late = true;
+    auto dropping = feed(m, o, log.arrival);
+    // Taken: every y, and the gps readings still at a held state's time: the
+    // fixed lag's window holds x_c(31..40) when the last readings arrive,
+    // the EKF and the paper window only the newest (x_c(40)).
+    const double first_taken = (method == Method::FixedLag ? 31 : 40) * m.nominalStep();
+    std::vector<Measurement> taken_only;
+    for (const auto& x : log.arrival)
+      if (x.channel == 0 || x.t >= first_taken - 1e-9) taken_only.push_back(x);
+    const std::int64_t expect_dropped = static_cast<std::int64_t>(log.arrival.size() - taken_only.size());
+    EXPECT_EQ(dropping->report().late_dropped, expect_dropped) << method;
+    EXPECT_EQ(dropping->report().measurements, static_cast<std::int64_t>(taken_only.size())) << method;
+    EXPECT_EQ(dropping->current().mean, feed(m, o, taken_only)->current().mean) << method;
+  }
+}
+
+TEST(LateMeasurements, ACheckpointTakenWithLateMeasurementsInFlightResumesExactly) {
+  const auto m = twoSensors();
+  const Log log = twoSensorLog(m, 50, 3);
+  for (Method method : {Method::Incremental, Method::FixedLag}) {
+    EstimatorOptions o(method);
+    o.fixed_lag.window = 10;
+    auto whole = feed(m, o, log.arrival);
+    auto first = makeEstimator(m, o);
+    const std::size_t half = log.arrival.size() / 2;
+    for (std::size_t i = 0; i < half; ++i) first->addMeasurement(log.arrival[i]);
+    auto resumed = restoreCheckpointBytes(m, checkpointBytes(*first));
+    EXPECT_EQ(resumed->report().late, first->report().late) << method;
+    for (std::size_t i = half; i < log.arrival.size(); ++i) resumed->addMeasurement(log.arrival[i]);
+    EXPECT_EQ(resumed->report().late, whole->report().late) << method;
+    EXPECT_EQ(resumed->current().mean, whole->current().mean) << method;
+  }
+}
+
+}  // namespace
+}  // namespace gssm
+
+namespace gssm {
+namespace {
+
+TEST(LateMeasurements, OnTheNonlinearRadarTheIteratedIncrementalEqualsTheBatch) {
+  // Two readings of each instant, the second arriving three instants late;
+  // iterated to convergence the incremental smoother is the batch MAP.
+  const models::Radar2D radar;
+  SimulationSpec spec;
+  spec.steps = 40;
+  const SimulatedRun run = simulate(radar, spec, testing::normalSampler(4));
+  auto draw = testing::normalSampler(5);
+  std::vector<Measurement> in_order, arrival, second;
+  for (const auto& y : run.measurements) {
+    second.push_back({y.t, y.y + Eigen::VectorXd::Constant(1, 3.0 * draw()), 0, {}});
+    in_order.push_back(y), in_order.push_back(second.back());
+  }
+  for (std::size_t k = 0; k < run.measurements.size(); ++k) {
+    arrival.push_back(run.measurements[k]);
+    if (k >= 3) arrival.push_back(second[k - 3]);
+  }
+  for (std::size_t k = second.size() - 3; k < second.size(); ++k) arrival.push_back(second[k]);
+  EstimatorOptions o(Method::Incremental);
+  o.smoother.iterate_to_convergence = true;
+  auto est = feed(radar, o, arrival);
+  const OfflineRun batch = runOffline(radar, {Method::Batch}, in_order);
+  ASSERT_EQ(batch.rows.size(), 40u);
+  for (std::int64_t k = 1; k <= est->step(); ++k)
+    expectNear(est->smoothed(k)->mean, batch.rows[static_cast<std::size_t>(k - 1)].mean, 1e-7, "x_c(k) and x_b");
+}
+
+}  // namespace
+}  // namespace gssm
