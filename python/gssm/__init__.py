@@ -122,8 +122,8 @@ def simulate(scenario="paper", seed=1, steps=400, **kwargs):
     return _gssm.io.simulate_model(scenario, seed, steps, **kwargs)
 
 
-def learn(model_or_folder, data=None, *, out=None, config=None, parameters=None, start=0.0, search_range=1e4,
-          max_evaluations=4000, tolerance=1e-7, max_restarts=6, standard_errors=True):
+def learn(model_or_folder, data=None, *, out=None, config=None, parameters=None, sigmas=None, start=0.0,
+          search_range=1e4, max_evaluations=4000, tolerance=1e-7, max_restarts=6, standard_errors=True):
     """Noise learnt from a log, no truth (docs/DESIGN.md §10): the σs the
     model declares learnable fitted by maximum likelihood (an ungated EKF's
     prediction errors, Nelder-Mead over log σ). Returns a gssm.LearnReport:
@@ -137,15 +137,29 @@ def learn(model_or_folder, data=None, *, out=None, config=None, parameters=None,
     out/scenario.ini (the input with the learnt values) and out/learn.json.
     parameters: names to learn ("range_sd", "Q", "Q[1]"; default every
     learnable one); start: every σ starts here (0: the model's values).
+
+    A model written in Python declares no parameters: pass a factory and
+    the σs it takes, sigmas={"q": 0.1, "r": 0.5} (the given values); it is
+    called as factory(q=..., r=...) for every likelihood evaluated:
+
+        report = gssm.learn(lambda q, r: MyModel(q, r), data, sigmas={"q": 0.1, "r": 0.5}, start=1.0)
     """
+    options = (float(start), float(search_range), int(max_evaluations), float(tolerance), int(max_restarts),
+               bool(standard_errors))
+    if callable(model_or_folder) and not isinstance(model_or_folder, models.Model):
+        if not sigmas:
+            raise InvalidArgument("gssm.learn(factory, data, sigmas={name: given σ, ...}): name the σs it takes")
+        names = list(sigmas)
+        factory = model_or_folder
+        return _gssm._learn_family(lambda s: factory(**dict(zip(names, (float(v) for v in s)))), names,
+                                   [float(sigmas[n]) for n in names], data, *options)
     if isinstance(model_or_folder, (str, os.PathLike)):
         if data is not None or out is None:
             raise InvalidArgument("gssm.learn(folder, out=DIR): a dataset folder takes out=, not data")
         return _gssm._learn_folder(str(model_or_folder), str(out), str(config or ""))
     if data is None:
         raise InvalidArgument("gssm.learn(model, data): the data to learn from (gssm.io.read_dataset, gssm.simulate)")
-    return _gssm._learn_model(model_or_folder, data, list(parameters or []), float(start), float(search_range),
-                              int(max_evaluations), float(tolerance), int(max_restarts), bool(standard_errors))
+    return _gssm._learn_model(model_or_folder, data, list(parameters or []), *options)
 
 
 def process(data, out, *, method="all", config=None, window=None, checkpoint_every=None, resume=None,

@@ -1,6 +1,7 @@
 // gssm.learn: noise learnt from a log (docs/DESIGN.md §10), over a model and
 // a dataset, or over a dataset folder (what gssm-learn runs).
 #include "bindings.h"
+#include "gssm/core/error.h"
 #include "gssm/io/learn_config.h"
 #include "gssm/learn/noise_learning.h"
 
@@ -63,6 +64,26 @@ void bindLearn(py::module_& m) {
         return learnNoise(*model, d.data.measurements, d.data.inputs, d.data.t0, o);
       },
       py::arg("model"), py::arg("data"), py::arg("parameters"), py::arg("start"), py::arg("search_range"),
+      py::arg("max_evaluations"), py::arg("tolerance"), py::arg("max_restarts"), py::arg("standard_errors"));
+  m.def(
+      "_learn_family",
+      [](const py::function& make, const std::vector<std::string>& names, const Eigen::VectorXd& given,
+         const PyDataset& d, double start, double search_range, int max_evaluations, double tolerance,
+         int max_restarts, bool standard_errors) {
+        NoiseFamily family;
+        family.names = names;
+        family.given = given;
+        // Called with the GIL held: a Python model's f and h are Python too.
+        family.make = [&make](const Eigen::VectorXd& sigmas) -> std::shared_ptr<const Model> {
+          auto model = make(sigmas).cast<std::shared_ptr<Model>>();
+          if (!model) throw InvalidArgument("gssm.learn: the model factory returned None");
+          return model;
+        };
+        const NoiseLearningOptions o =
+            learnOptions({}, start, search_range, max_evaluations, tolerance, max_restarts, standard_errors);
+        return learnNoise(family, d.data.measurements, d.data.inputs, d.data.t0, o);
+      },
+      py::arg("make"), py::arg("names"), py::arg("given"), py::arg("data"), py::arg("start"), py::arg("search_range"),
       py::arg("max_evaluations"), py::arg("tolerance"), py::arg("max_restarts"), py::arg("standard_errors"));
   m.def(
       "_learn_folder",

@@ -64,3 +64,19 @@ def test_process_learns_when_asked_and_not_when_told_not_to(repo, tmp_path):
     assert off.learnt is None and not os.path.exists(tmp_path / "off" / "learn.json")
     assert on.runs[0].mean[-1, 0] != off.runs[0].mean[-1, 0]
 
+
+
+def test_learn_a_model_written_in_python_through_its_factory():
+    def walk(q, r):
+        return gssm.models.PythonModel(lambda xc, xb, u, dt: xc, lambda xc, xb: xc[0], nc=1, ny=1,
+                                       Q=[[q * q]], R=[[r * r]], prior_state=([0.0], [[4.0]]),
+                                       jacobian_f=lambda xc, xb, u, dt: (np.eye(1), np.zeros((1, 0))),
+                                       jacobian_h=lambda xc, xb: (np.eye(1), np.zeros((1, 0))))
+    data = gssm.simulate(walk(0.3, 1.0), seed=9, steps=600)
+    r = gssm.learn(walk, data, sigmas={"q": 0.5, "r": 0.5}, start=1.0)
+    assert r.converged and [p.name for p in r.parameters] == ["q", "r"]
+    for p, truth in zip(r.parameters, [0.3, 1.0]):
+        assert p.given == 0.5 and p.start == 1.0
+        assert abs(p.value - truth) < 3 * p.standard_error, (p.name, p.value, p.standard_error)
+    with pytest.raises(gssm.InvalidArgument, match="sigmas="):
+        gssm.learn(walk, data)

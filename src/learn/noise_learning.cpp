@@ -127,9 +127,7 @@ ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParamete
 }
 
 struct Objective {
-  const std::string& type;
-  const ParamValues& base;
-  const std::vector<LearntParameter>& params;
+  const NoiseFamily& family;
   const std::vector<Measurement>& measurements;
   const std::vector<Input>& inputs;
   double t0;
@@ -147,8 +145,8 @@ struct Objective {
     if (!theta.allFinite()) return -std::numeric_limits<double>::infinity();
     try {  // beyond the search range: the value at its end (flat)
       const Eigen::VectorXd clamped = theta.cwiseMax(lo).cwiseMin(hi);
-      const auto n = static_cast<Eigen::Index>(params.size());
-      const auto model = withSigmas(base, params, clamped.head(n)).build(type);
+      const auto n = static_cast<Eigen::Index>(family.names.size());
+      const auto model = family.make(clamped.head(n).array().exp().matrix());
       ExtendedKalmanFilterOptions e = ekf;
       if (mixture) e.outlier_probability = 1.0 / (1.0 + std::exp(-clamped[n])), e.outlier_log_density = outlier_log_density;
       const double l = predictionErrorLogLikelihood(*model, measurements, inputs, t0, e);
@@ -296,37 +294,40 @@ void finish(Objective& obj, const Eigen::VectorXd& theta, const NoiseLearningOpt
 }
 }  // namespace
 
-NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement>& measurements,
+NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Measurement>& measurements,
                                const std::vector<Input>& inputs, double t0, const NoiseLearningOptions& o) {
   std::string why;
   if (!o.validate(&why)) throw InvalidArgument(why);
+  if (family.names.empty() || static_cast<Eigen::Index>(family.names.size()) != family.given.size() || !family.make)
+    throw InvalidArgument("learnNoise: a NoiseFamily needs one name and one given σ per parameter, and make");
   const auto started = std::chrono::steady_clock::now();
-  const ModelType* type = modelTypeOf(model);
-  if (!type) throw InvalidArgument("learnNoise: model '" + model.name() + "' has no registered type, so no learnable parameters");
   NoiseLearningReport r;
-  const ParamValues base = ParamValues::of(model);
-  r.parameters = chosenParameters(*type, base, o);
-  r.measurements = measurements.size();
-  Objective obj{type->name, base, r.parameters, measurements, inputs, t0, o.ekf, {}, {}, false, {}};
-  const auto n = static_cast<Eigen::Index>(r.parameters.size());
-  Eigen::VectorXd given(n), theta(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    given[i] = std::log(r.parameters[static_cast<std::size_t>(i)].given);
-    theta[i] = std::log(r.parameters[static_cast<std::size_t>(i)].start);
+  r.parameters = family.parameters;
+  for (std::size_t i = r.parameters.size(); i < family.names.size(); ++i) {  // undescribed: [model] <name>
+    LearntParameter p;
+    p.section = "model", p.key = family.names[i], p.given = family.given[static_cast<Eigen::Index>(i)];
+    p.start = o.start > 0 ? o.start : p.given;
+    r.parameters.push_back(p);
   }
+  r.measurements = measurements.size();
+  Objective obj{family, measurements, inputs, t0, o.ekf, {}, {}, false, {}};
+  const auto n = static_cast<Eigen::Index>(family.names.size());
+  Eigen::VectorXd theta(n);
+  for (Eigen::Index i = 0; i < n; ++i) theta[i] = std::log(r.parameters[static_cast<std::size_t>(i)].start);
   obj.lo = theta.array() - std::log(o.search_range);
   obj.hi = theta.array() + std::log(o.search_range);
-  r.given_log_likelihood = obj.logLikelihood(given);
+  r.given_log_likelihood = obj.logLikelihood(family.given.array().log().matrix());
   r.start_log_likelihood = obj.logLikelihood(theta);
   if (!std::isfinite(r.start_log_likelihood))
-    throw NumericalError("learnNoise: the EKF fails at the starting noise (" + base.where("model", r.parameters[0].key) +
-                         "...): start from other values ([learn] start) or check the data");
+    throw NumericalError("learnNoise: the EKF fails at the starting noise (" + family.names[0] +
+                         " = " + std::to_string(r.parameters[0].start) +
+                         ", ...): start from other values ([learn] start) or check the data");
   theta = maximize(obj, theta, o, r);  // Gaussian first: from a generic start the mixture's ε would absorb everything
   r.gaussian_log_likelihood = r.final_log_likelihood;
   if (o.outliers) {
     r.mixture_from = r.log_likelihood.size();
     obj.mixture = true;
-    obj.outlier_log_density = outlierLogDensities(model, measurements);
+    obj.outlier_log_density = outlierLogDensities(*family.make(family.given), measurements);
     Eigen::VectorXd with_eps(n + 1), lo(n + 1), hi(n + 1);
     with_eps << theta, std::log(0.01 / 0.99);
     lo << obj.lo, std::log(1e-6), hi << obj.hi, 0.0;  // ε in [1e-6, 0.5]
@@ -336,10 +337,34 @@ NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement
     theta = with_eps;
   }
   finish(obj, theta, o, r);
-  r.values = withSigmas(base, r.parameters, theta.head(n));
-  r.model = r.values.build(type->name);
+  r.model = family.make(theta.head(n).array().exp().matrix());
   r.evaluations = obj.evaluations;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return r;
+}
+
+NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement>& measurements,
+                               const std::vector<Input>& inputs, double t0, const NoiseLearningOptions& o) {
+  const ModelType* type = modelTypeOf(model);
+  if (!type)
+    throw InvalidArgument("learnNoise: model '" + model.name() +
+                          "' has no registered type, so no declared learnable parameters (pass a NoiseFamily)");
+  const ParamValues base = ParamValues::of(model);
+  NoiseFamily family;
+  family.parameters = chosenParameters(*type, base, o);
+  family.given.resize(static_cast<Eigen::Index>(family.parameters.size()));
+  for (std::size_t i = 0; i < family.parameters.size(); ++i) {
+    family.names.push_back(family.parameters[i].name());
+    family.given[static_cast<Eigen::Index>(i)] = family.parameters[i].given;
+  }
+  const std::string type_name = type->name;
+  family.make = [&base, &family, type_name](const Eigen::VectorXd& sigmas) -> std::shared_ptr<const Model> {
+    return withSigmas(base, family.parameters, sigmas.array().log().matrix()).build(type_name);
+  };
+  NoiseLearningReport r = learnNoise(family, measurements, inputs, t0, o);
+  Eigen::VectorXd sigmas(static_cast<Eigen::Index>(r.parameters.size()));
+  for (std::size_t i = 0; i < r.parameters.size(); ++i) sigmas[static_cast<Eigen::Index>(i)] = r.parameters[i].value;
+  r.values = withSigmas(base, r.parameters, sigmas.array().log().matrix());
   return r;
 }
 

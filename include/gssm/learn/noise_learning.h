@@ -11,6 +11,7 @@
 //   o.start = 1.0;                            // every σ from 1 in its unit
 //   auto learnt = gssm::learnNoise(model, data.measurements, data.inputs, data.t0, o);
 //   auto est = gssm::makeEstimator(*learnt.model, {gssm::Method::FixedLag});
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -102,6 +103,23 @@ struct NoiseLearningReport {
 double predictionErrorLogLikelihood(const Model& model, const std::vector<Measurement>& measurements,
                                     const std::vector<Input>& inputs, double t0,
                                     ExtendedKalmanFilterOptions ekf = {});
+
+/// The models of a noise family: `make(σ)` builds the model with the σs
+/// named `names` (a model without a registered type, a Python model).
+/// `parameters` (optional) describes each σ; by default each is a Real
+/// parameter [model] <name> started at `start` (or `given`).
+struct NoiseFamily {
+  std::vector<std::string> names;
+  Eigen::VectorXd given;  ///< the σs of the model as given
+  std::function<std::shared_ptr<const Model>(const Eigen::VectorXd& sigmas)> make;
+  std::vector<LearntParameter> parameters;
+};
+
+/// Learns the σs of a family of models from the data (options.parameters
+/// is not used: the family names what is learnt).
+NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Measurement>& measurements,
+                               const std::vector<Input>& inputs, double t0,
+                               const NoiseLearningOptions& options = {});
 
 /// Learns the model's noise from the data. Throws InvalidArgument for bad
 /// options, a model without a registered type, an unknown parameter name;
