@@ -105,14 +105,14 @@ std::vector<LearntParameter> chosenParameters(const ModelType& type, const Param
   return out;
 }
 
-// The values with the chosen σs set to exp(θ): a Real directly; a Matrix as
-// D M D with D = diag(σ_new / σ_given) on its learnt entries (correlations kept).
-ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParameter>& ps, const Eigen::VectorXd& theta) {
+// The values with the chosen σs set: a Real directly; a Matrix as D M D with
+// D = diag(σ_new / σ_given) on its learnt entries (correlations kept).
+ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParameter>& ps, const Eigen::VectorXd& sigmas) {
   ParamValues v = base;
   std::map<std::pair<std::string, std::string>, Eigen::VectorXd> scales;
   for (std::size_t i = 0; i < ps.size(); ++i) {
     const LearntParameter& p = ps[i];
-    const double sigma = std::exp(theta[static_cast<Eigen::Index>(i)]);
+    const double sigma = sigmas[static_cast<Eigen::Index>(i)];
     if (p.index < 0) {
       v.real(p.section, p.key, sigma);
       continue;
@@ -359,12 +359,12 @@ NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement
   }
   const std::string type_name = type->name;
   family.make = [&base, &family, type_name](const Eigen::VectorXd& sigmas) -> std::shared_ptr<const Model> {
-    return withSigmas(base, family.parameters, sigmas.array().log().matrix()).build(type_name);
+    return withSigmas(base, family.parameters, sigmas).build(type_name);
   };
   NoiseLearningReport r = learnNoise(family, measurements, inputs, t0, o);
   Eigen::VectorXd sigmas(static_cast<Eigen::Index>(r.parameters.size()));
   for (std::size_t i = 0; i < r.parameters.size(); ++i) sigmas[static_cast<Eigen::Index>(i)] = r.parameters[i].value;
-  r.values = withSigmas(base, r.parameters, sigmas.array().log().matrix());
+  r.values = withSigmas(base, r.parameters, sigmas);
   return r;
 }
 
