@@ -2,10 +2,14 @@
 // epoch, 24 link-bias constants): each streaming estimator fed the first
 // 2000 epochs, an epoch as one update (Estimator::addMeasurements) or range
 // by range; the median and p99 of the epoch times as counters (seconds), in
-// one run so the ratios to the EKF share the machine's state.
+// one run so the ratios to the EKF share the machine's state; and the
+// resident memory the estimator grew by per epoch (memory per step).
 #include <benchmark/benchmark.h>
 
+#include <unistd.h>
+
 #include <chrono>
+#include <fstream>
 
 #include "gssm/analysis/metrics.h"
 #include "gssm/estimator/estimator.h"
@@ -13,6 +17,14 @@
 #include "gssm/io/dataset.h"
 
 namespace {
+
+// Resident memory now (bytes), from /proc/self/statm.
+double residentBytes() {
+  std::ifstream statm("/proc/self/statm");
+  double size = 0, resident = 0;
+  statm >> size >> resident;
+  return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
+}
 
 struct Log {
   std::unique_ptr<gssm::Model> model;
@@ -47,7 +59,10 @@ void streamEpochs(benchmark::State& state, gssm::Method method, bool grouped) {
   gssm::EstimatorOptions o = log.options;
   o.method = method;
   std::vector<double> times;
+  times.reserve(log.epochs.size() * 4);
+  double grown = 0;
   for (auto _ : state) {
+    const double before = residentBytes();
     auto est = gssm::makeEstimator(*log.model, o);
     for (const auto& epoch : log.epochs) {
       const auto t0 = std::chrono::steady_clock::now();
@@ -57,7 +72,9 @@ void streamEpochs(benchmark::State& state, gssm::Method method, bool grouped) {
       times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
     benchmark::DoNotOptimize(est->current().mean.data());
+    grown = residentBytes() - before;
   }
+  state.counters["rss_bytes_per_epoch"] = grown / static_cast<double>(log.epochs.size());
   state.counters["epoch_median_s"] = gssm::percentile(times, 50);
   state.counters["epoch_p99_s"] = gssm::percentile(times, 99);
   state.counters["epochs"] = static_cast<double>(times.size());
