@@ -149,3 +149,29 @@ TEST(DatasetLayouts, RowsWrittenLateAreReadInTimeOrderAndCounted) {
   }
   EXPECT_EQ(read(strict, io::BadRows::Stop).measurements.size(), 7u);
 }
+
+TEST(DatasetLayouts, RowsBeforeTheStartAreDroppedAndListedButARateMayStartAtIt) {
+  // start_time = 1: the range at 0.5 and the odometry increment ending at 1
+  // describe the time before the run (dropped, listed); a rate row at 1 is
+  // the input from the start on (kept).
+  for (const std::string kind : {"increments", "rates"}) {
+    const std::string dir = writeBeaconLog("before_start_" + kind, {0.5, 1.2, 1.4},
+                                           "inputs = odometry.csv\ninput_columns = v w\ninput_kind = " + kind +
+                                               "\nstart_time = 1\n");
+    std::ofstream(fs::path(dir) / "odometry.csv") << "t,v,w\n1,0.1,0\n1.1,0.1,0\n1.3,0.1,0\n";
+    const io::Dataset d = read(dir);
+    ASSERT_EQ(d.measurements.size(), 2u) << kind;
+    EXPECT_EQ(d.measurements.front().t, 1.2) << kind;
+    const std::size_t dropped_inputs = kind == "increments" ? 1 : 0;
+    ASSERT_EQ(d.dropped.size(), 1 + dropped_inputs) << kind;
+    EXPECT_NE(d.dropped.back().find("ranges.csv:2: time 0.5 is not after the start 1 (dropped: before the run)"),
+              std::string::npos) << d.dropped.back();
+    if (kind == "increments") {
+      EXPECT_NE(d.dropped.front().find("odometry.csv:2:"), std::string::npos) << d.dropped.front();
+      EXPECT_EQ(d.inputs.front().t, 1.0);  // the increment over (1, 1.1], held from the start
+    } else {
+      EXPECT_EQ(d.inputs.front().t, 1.0);  // the rate from the start on
+      EXPECT_EQ(d.inputs.size(), 3u);
+    }
+  }
+}

@@ -198,8 +198,11 @@ void readInputs(const std::string& path, const IniDocument& ini, const Model& mo
   if (kind != "rates" && kind != "increments")
     throw InputError(ini.source() + ": [dataset] input_kind = '" + kind + "': expected rates or increments");
   double prev = out.t0;
-  std::size_t first = 0;  // rows before the start describe motion before the run: dropped, listed
-  for (; first < in.rows.size() && in.rows[first][static_cast<std::size_t>(tc)] <= out.t0; ++first) {
+  // Rows before the start describe motion before the run: dropped, listed
+  // (increments ending at t0 too; a rate may start at t0).
+  auto before = [&](double t) { return kind == "increments" ? t <= out.t0 : t < out.t0; };
+  std::size_t first = 0;
+  for (; first < in.rows.size() && before(in.rows[first][static_cast<std::size_t>(tc)]); ++first) {
     if (first > 0) requireIncreasing(in, first, in.rows[first - 1][static_cast<std::size_t>(tc)], in.rows[first][static_cast<std::size_t>(tc)]);
     out.dropped.push_back(in.source + ":" + std::to_string(in.line_of_row[first]) + ": time " +
                           formatDouble(in.rows[first][static_cast<std::size_t>(tc)]) + " is not after the start " +

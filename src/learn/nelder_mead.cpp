@@ -19,8 +19,13 @@ struct Simplex {
     for (std::size_t i : order) xs.push_back(x[i]), fs.push_back(f[i]);
     x.swap(xs), f.swap(fs);
   }
+  // Values within ftol, and points within xtol or the values identical to
+  // the last bit of ftol/1000: along a direction the function does not
+  // depend on (parameters that trade off exactly) the points never close up.
   bool collapsed(double ftol, double xtol) const {
-    if (!(f.back() - f.front() <= ftol * (1.0 + std::abs(f.front())))) return false;
+    const double spread = f.back() - f.front(), scale = 1.0 + std::abs(f.front());
+    if (!(spread <= ftol * scale)) return false;
+    if (spread <= 1e-3 * ftol * scale) return true;
     for (const auto& xi : x)
       if ((xi - x.front()).lpNorm<Eigen::Infinity>() > xtol) return false;
     return true;
