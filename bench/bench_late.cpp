@@ -9,26 +9,12 @@
 
 #include "gssm/estimator/estimator.h"
 #include "gssm/models/linear.h"
+#include "track_with_bias.h"
 
 namespace {
 
-gssm::models::LinearModel trackWithBias() {
-  gssm::models::LinearSystem s;
-  s.A_c = (Eigen::Matrix2d() << 0, 1, 0, 0).finished();
-  s.A_b = Eigen::MatrixXd::Zero(2, 1);
-  s.B = Eigen::MatrixXd::Zero(2, 0);
-  s.C_c = Eigen::RowVector2d(1, 0);
-  s.C_b = Eigen::MatrixXd::Ones(1, 1);
-  s.noise.T = 0.1;
-  s.noise.Q = Eigen::Vector2d(0.01, 0.04).asDiagonal();
-  s.noise.R = Eigen::MatrixXd::Constant(1, 1, 0.25);
-  s.noise.prior_state = {Eigen::Vector2d(0, 1), Eigen::Vector2d(4, 1).asDiagonal()};
-  s.noise.prior_constants = {Eigen::VectorXd::Zero(1), Eigen::MatrixXd::Constant(1, 1, 4.0)};
-  return gssm::models::LinearModel(s);
-}
-
 void lateMeasurement(benchmark::State& state, gssm::Method method) {
-  static const gssm::models::LinearModel model = trackWithBias();
+  static const gssm::models::LinearModel model(gssm::testing::trackWithBias(0.01, 0.04, 0.25, 0.1));
   const auto lateness = static_cast<std::int64_t>(state.range(0));
   gssm::EstimatorOptions o(method);
   o.fixed_lag.window = 10;

@@ -12,6 +12,7 @@
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
 #include "reference_kalman.h"
+#include "track_with_bias.h"
 
 namespace gssm {
 namespace {
@@ -19,17 +20,7 @@ namespace {
 // Position and velocity, a constant bias on the position sensor "y", and a
 // second, unbiased position sensor "gps" read at the same instants.
 models::LinearModel twoSensors() {
-  models::LinearSystem s;
-  s.A_c = (Eigen::Matrix2d() << 0, 1, 0, 0).finished();
-  s.A_b = Eigen::MatrixXd::Zero(2, 1);
-  s.B = Eigen::MatrixXd::Zero(2, 0);
-  s.C_c = Eigen::RowVector2d(1, 0);
-  s.C_b = Eigen::MatrixXd::Ones(1, 1);
-  s.noise.T = 0.5;
-  s.noise.Q = Eigen::Vector2d(0.01, 0.04).asDiagonal();
-  s.noise.R = Eigen::MatrixXd::Constant(1, 1, 0.25);
-  s.noise.prior_state = {Eigen::Vector2d(0, 1), Eigen::Vector2d(4, 1).asDiagonal()};
-  s.noise.prior_constants = {Eigen::VectorXd::Zero(1), Eigen::MatrixXd::Constant(1, 1, 4.0)};
+  models::LinearSystem s = testing::trackWithBias(0.01, 0.04, 0.25, 0.5);
   s.channels.push_back({"gps", Eigen::RowVector2d(1, 0), Eigen::MatrixXd::Zero(1, 1), Eigen::MatrixXd::Constant(1, 1, 1.0), {}});
   return models::LinearModel(s);
 }

@@ -14,24 +14,14 @@
 #include "gssm/models/linear.h"
 #include "gssm/models/range_beacon2d.h"
 #include "reference_kalman.h"
+#include "track_with_bias.h"
 
 namespace gssm {
 namespace {
 
 // A constant-velocity track measured with a constant bias: Q = diag(q1, q2), R = r.
 models::LinearModel cvWithBias(double q1, double q2, double r) {
-  models::LinearSystem s;
-  s.A_c = (Eigen::Matrix2d() << 0, 1, 0, 0).finished();
-  s.A_b = Eigen::MatrixXd::Zero(2, 1);
-  s.B = Eigen::MatrixXd::Zero(2, 0);
-  s.C_c = Eigen::RowVector2d(1, 0);
-  s.C_b = Eigen::MatrixXd::Ones(1, 1);
-  s.noise.T = 1.0;
-  s.noise.Q = Eigen::Vector2d(q1, q2).asDiagonal();
-  s.noise.R = Eigen::MatrixXd::Constant(1, 1, r);
-  s.noise.prior_state = {Eigen::Vector2d(0, 1), Eigen::Vector2d(4, 1).asDiagonal()};
-  s.noise.prior_constants = {Eigen::VectorXd::Constant(1, 0.5), Eigen::MatrixXd::Constant(1, 1, 1.0)};
-  return models::LinearModel(s);
+  return models::LinearModel(testing::trackWithBias(q1, q2, r, 1.0, 0.5, 1.0));
 }
 
 SimulatedRun simulateRun(const Model& m, int steps, unsigned seed) {
