@@ -417,6 +417,9 @@ void BayesTreeEngine::linearizeInputs(UpdatePlan& p) const {
       if (!known(k)) throw InvalidArgument("linear factor uses unknown variable " + k.toString());
     checkHoldable(lf, [] { return std::string("a linear factor"); });
   }
+  for (int s : p.update.remove)
+    if (s < 0 || static_cast<std::size_t>(s) >= slots_.size() || !slots_[static_cast<std::size_t>(s)].alive)
+      throw InvalidArgument("remove: factor slot " + std::to_string(s) + " is not a live factor");
   for (int s : p.update.relinearize) {
     const Slot& slot = slots_.at(static_cast<std::size_t>(s));
     if (slot.alive && slot.nonlinear)
@@ -447,12 +450,18 @@ void BayesTreeEngine::detachTop(UpdatePlan& p) const {
     for (const auto& k : lf.keys()) markUp(k);
   for (const auto& kv : p.relinearized)
     for (const auto& k : kv.second.keys()) markUp(k);
+  for (int s : p.update.remove)
+    for (const auto& k : slotKeys(slots_[static_cast<std::size_t>(s)])) markUp(k);
+  auto removed_slot = [&](int s) {
+    return std::find(p.update.remove.begin(), p.update.remove.end(), s) != p.update.remove.end();
+  };
 
   using Kind = InputSource::Kind;
   for (int c : p.removed_order) {
     const Clique& cl = cliques_[static_cast<std::size_t>(c)];
     p.keys.push_back(cl.frontal);
     for (int s : cl.owned) {
+      if (removed_slot(s)) continue;
       auto it = p.relinearized.find(s);
       p.inputs.push_back({it != p.relinearized.end() ? it->second.view() : slotView(slots_[static_cast<std::size_t>(s)]),
                           {Kind::Slot, s}});
@@ -664,6 +673,7 @@ Eigen::Index BayesTreeEngine::stackFactors(UpdatePlan& p, const EliminationQueue
 // cliques. Nothing here throws short of memory.
 void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
   model_ = p.model;
+  for (int s : p.update.remove) killSlot(s);
   commitFactors(p, counts);
   commitCliques(p);
   reattachOrphans(p);
@@ -1024,6 +1034,33 @@ void BayesTreeEngine::addToNewton(NewtonSystem& sys, const Values& x) const {
   }
 }
 
+void BayesTreeEngine::killSlot(int s) {
+  Slot& slot = slots_[static_cast<std::size_t>(s)];
+  for (const auto& k : slotKeys(slot)) {
+    if (k.isConstants()) continue;
+    Var* on = vars_.find(k);
+    if (!on) continue;
+    auto& v = on->slots;
+    v.erase(std::remove(v.begin(), v.end(), s), v.end());
+  }
+  releaseRecord(slot);
+  slot = Slot{};
+  free_slots_.push_back(s);
+  --slots_alive_;
+}
+
+std::vector<int> BayesTreeEngine::slotsBetween(const Key& a, const Key& b) const {
+  std::vector<int> out;
+  const Var* va = vars_.find(a);
+  if (!va || !vars_.contains(b)) return out;
+  for (int s : va->slots) {
+    const auto keys = slotKeys(slots_[static_cast<std::size_t>(s)]);
+    if (slots_[static_cast<std::size_t>(s)].alive && std::find(keys.begin(), keys.end(), b) != keys.end())
+      out.push_back(s);
+  }
+  return out;
+}
+
 void BayesTreeEngine::marginalizeLeaf(const Key& key) {
   const Var* var = vars_.find(key);
   if (!var) throw InvalidArgument("marginalize: no variable " + key.toString());
@@ -1034,20 +1071,7 @@ void BayesTreeEngine::marginalizeLeaf(const Key& key) {
                          " is not a leaf of the Bayes tree (internal ordering error)");
   const int parent = cl.parent;
   // Drop the factors this clique consumed; they are summarized by its marginal.
-  for (int s : cl.owned) {
-    Slot& slot = slots_[static_cast<std::size_t>(s)];
-    for (const auto& k : slotKeys(slot)) {
-      if (k.isConstants()) continue;
-      Var* on = vars_.find(k);
-      if (!on) continue;
-      auto& v = on->slots;
-      v.erase(std::remove(v.begin(), v.end(), s), v.end());
-    }
-    releaseRecord(slot);
-    slot = Slot{};
-    free_slots_.push_back(s);
-    --slots_alive_;
-  }
+  for (int s : cl.owned) killSlot(s);
   // Its marginal on the separator becomes a fixed linear prior (first-estimate
   // Jacobians), owned by the parent, which consumed it when it was eliminated.
   if (parent >= 0 && cl.mrows > 0) {

@@ -262,6 +262,10 @@ struct EngineUpdate {
   const std::vector<FactorPtr>* new_factors = nullptr;   ///< nonlinear factors
   const std::vector<LinearFactor>* new_linear = nullptr; ///< fixed linear factors
   std::vector<int> relinearize;  ///< factor slots to relinearize at the current estimate
+  /// Factor slots to remove: their variables' cliques and those above are
+  /// re-eliminated without them (a factor replaced, e.g. a process factor
+  /// split by a state inserted into the chain).
+  std::vector<int> remove;
   /// λ > 0 adds Levenberg–Marquardt rows √λ·diag(‖A_v‖)(δ_v − δ̂_v) to every
   /// variable eliminated (the iterate-to-convergence mode).
   double damping = 0.0;
@@ -326,6 +330,8 @@ class BayesTreeEngine {
   /// Appends the alive nonlinear slots whose keys include the state k to
   /// `out` (every factor touches the constants: that is nonlinearSlots()).
   void appendSlotsOf(const Key& k, std::vector<int>& out) const;
+  /// The live factor slots on both a and b (none when either is absent).
+  std::vector<int> slotsBetween(const Key& a, const Key& b) const;
   /// ½‖r‖² of every alive factor at the current estimate (nonlinear factors
   /// exactly, linear ones by their linear model).
   double cost() const;
@@ -415,6 +421,8 @@ class BayesTreeEngine {
   template <class Offsets>
   Eigen::SparseMatrix<double> pathConditionals(const std::vector<int>& path, const Offsets& off, Eigen::Index n) const;
   void commitFactors(UpdatePlan& plan, EngineCounts& counts);
+  /// Frees a slot: off its variables' lists, its record released.
+  void killSlot(int s);
   void commitCliques(UpdatePlan& plan);
   void reattachOrphans(const UpdatePlan& plan);
   void backSubstituteTop(const UpdatePlan& plan, EngineCounts& counts);

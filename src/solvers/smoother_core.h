@@ -13,7 +13,8 @@ class SmootherCore {
   /// One update: add, then relinearize the top (start-up), then a full check
   /// when the constants moved, or iterate to convergence. Strong guarantee for
   /// the add; a failed relinearization is skipped and noted in the report.
-  UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values);
+  UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values,
+                      const std::vector<int>& remove_slots = {});
   void fillSizes(UpdateReport& r) const;
   /// Checkpoint: the engine, the last report and the relinearization state.
   void save(internal::ByteWriter& out) const;

@@ -228,14 +228,17 @@ void SmootherCore::newtonPolishTree(UpdateReport& rep, internal::EngineCounts& c
   else if (!failure.empty()) rep.note = "Newton polish stopped: " + failure;
 }
 
-UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, const Values& new_values) {
+UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, const Values& new_values,
+                                  const std::vector<int>& remove_slots) {
   const auto start = std::chrono::steady_clock::now();
   UpdateReport rep;
   rep.new_factors = static_cast<int>(new_factors.size());
   rep.new_variables = static_cast<int>(new_values.size());
   internal::EngineCounts& counts = counts_;
   counts.clear();
-  engine.update(internal::EngineUpdate::adding(new_factors, new_values), counts);  // may throw: nothing changed
+  internal::EngineUpdate u = internal::EngineUpdate::adding(new_factors, new_values);
+  u.remove = remove_slots;
+  engine.update(u, counts);  // may throw: nothing changed
   rep.iterations = 1;
 
   if (!options.relinearize) {
@@ -311,6 +314,20 @@ IncrementalSmoother::IncrementalSmoother(SmootherOptions options, EliminationOrd
     : Smoother(std::make_unique<SmootherCore>(options, toMode(ordering))), ordering_(ordering) {}
 UpdateReport IncrementalSmoother::update(const std::vector<FactorPtr>& f, const Values& v) {
   return core_->update(f, v);
+}
+
+UpdateReport IncrementalSmoother::replace(const std::vector<std::pair<Key, Key>>& remove_between,
+                                          const std::vector<FactorPtr>& f, const Values& v) {
+  std::vector<int> slots;
+  for (const auto& [a, b] : remove_between) {
+    if (a.isConstants() || b.isConstants())
+      throw InvalidArgument("IncrementalSmoother::replace: name the factors to remove by two states, not x_b");
+    const std::vector<int> between = core_->engine.slotsBetween(a, b);
+    if (between.empty())
+      throw InvalidArgument("IncrementalSmoother::replace: no factor on both " + a.toString() + " and " + b.toString());
+    slots.insert(slots.end(), between.begin(), between.end());
+  }
+  return core_->update(f, v, slots);
 }
 const SmootherOptions& IncrementalSmoother::options() const { return core_->options; }
 

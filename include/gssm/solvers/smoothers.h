@@ -135,6 +135,13 @@ class IncrementalSmoother final : public Smoother {
   explicit IncrementalSmoother(SmootherOptions options = {},
                                EliminationOrdering ordering = EliminationOrdering::ConstrainedColamd);
   UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values) override;
+  /// Removes every factor on both states of each pair, then adds `new_factors`
+  /// and `new_values` in the same update (strong guarantee): the cliques of
+  /// the removed factors' variables and those above them are re-eliminated
+  /// without them. A process factor split by a state inserted between two
+  /// states is replaced this way. InvalidArgument when a pair has no factor.
+  UpdateReport replace(const std::vector<std::pair<Key, Key>>& remove_between, const std::vector<FactorPtr>& new_factors,
+                       const Values& new_values);
   const SmootherOptions& options() const;
   EliminationOrdering ordering() const { return ordering_; }
 
