@@ -11,6 +11,7 @@
 #include "gssm/estimator/estimator.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
+#include "gssm/models/range_beacon2d.h"
 #include "reference_kalman.h"
 #include "track_with_bias.h"
 
@@ -170,6 +171,98 @@ TEST(LateMeasurements, OnTheNonlinearRadarTheIteratedIncrementalEqualsTheBatch) 
   ASSERT_EQ(batch.rows.size(), 40u);
   for (std::int64_t k = 1; k <= est->step(); ++k)
     expectNear(est->smoothed(k)->mean, batch.rows[static_cast<std::size_t>(k - 1)].mean, 1e-7, "x_c(k) and x_b");
+}
+
+}  // namespace
+}  // namespace gssm
+
+namespace gssm {
+namespace {
+
+TEST(LateMeasurements, BetweenTwoStatesTheIncrementalSmootherInsertsAState) {
+  // gps read halfway between the y instants, each reading 3 instants late:
+  // the incremental smoother inserts a state at its time (the process factor
+  // there split in two) and ends as the run with every state from the start.
+  const auto m = twoSensors();
+  SimulationSpec spec;
+  spec.steps = 40;
+  const SimulatedRun run = simulate(m, spec, testing::normalSampler(11));
+  auto draw = testing::normalSampler(12);
+  std::vector<Measurement> in_order, arrival, gps;
+  for (std::size_t k = 0; k < run.measurements.size(); ++k) {
+    const double t = run.measurements[k].t + 0.5 * m.nominalStep();
+    const Eigen::VectorXd x = run.states[k + 1];  // (the truth between is not needed: any reading will do)
+    gps.push_back({t, Eigen::VectorXd::Constant(1, x[0] + draw()), 1, {}});
+  }
+  for (std::size_t k = 0; k < run.measurements.size(); ++k) {
+    in_order.push_back(run.measurements[k]);
+    if (k + 1 < run.measurements.size()) in_order.push_back(gps[k]);  // the last one would be after every y
+    arrival.push_back(run.measurements[k]);
+    if (k >= 4) arrival.push_back(gps[k - 4]);
+  }
+  for (std::size_t k = run.measurements.size() - 4; k + 1 < run.measurements.size(); ++k) arrival.push_back(gps[k]);
+  EstimatorOptions o(Method::Incremental);
+  auto late = feed(m, o, arrival);
+  auto ordered = feed(m, o, in_order);
+  EXPECT_EQ(late->report().late, 39);
+  EXPECT_EQ(late->report().measurements, 79);
+  expectNear(late->current().mean, ordered->current().mean, 1e-9, "newest state and x_b");
+  expectNear(late->current().covariance, ordered->current().covariance, 1e-9, "their covariance");
+  const OfflineRun batch = runOffline(m, {Method::Batch}, in_order);
+  for (std::int64_t k = 1; k <= late->step(); k += 3) {
+    const StateEstimate e = *late->smoothed(k);
+    const auto row = std::find_if(batch.rows.begin(), batch.rows.end(), [&](const EstimateRow& r) { return r.t == e.t; });
+    ASSERT_NE(row, batch.rows.end()) << e.t;
+    expectNear(e.mean, row->mean, 1e-8, "x_c at t = " + std::to_string(e.t) + " and x_b vs the batch");
+  }
+  // Saved and restored with inserted states in it: the same estimates, and it goes on.
+  auto restored = restoreCheckpointBytes(m, checkpointBytes(*late));
+  EXPECT_EQ(restored->current().mean, late->current().mean);
+  EXPECT_EQ(restored->report().late, 39);
+}
+
+}  // namespace
+}  // namespace gssm
+
+namespace gssm {
+namespace {
+
+TEST(LateMeasurements, AnInsertedStateCarriesTheOdometryOfTheIntervalItSplits) {
+  // RangeBeacon2D (odometry in): ranges between odometry rows, each 5 rows
+  // late; iterated to convergence the incremental smoother is the batch MAP
+  // of the same data, whose states sit at every odometry and range time.
+  models::RangeBeacon2D::Params p;
+  p.beacon_ids = {0, 1, 5, 6};
+  p.beacons = {{-33.6, 27.0}, {-68.9, 18.4}, {1.7, -5.8}, {-37.6, 69.2}};
+  p.start = Eigen::Vector3d(-34, 55, 0);
+  p.start_sd = Eigen::Vector3d(1, 1, 0.5);
+  const models::RangeBeacon2D m(p);
+  SimulationSpec spec;
+  spec.steps = 60;
+  spec.input = [](double, const Eigen::VectorXd&) { return Eigen::Vector2d(3.0, 0.1); };
+  spec.measure_every = 2;
+  spec.channels = {0, 1, 2, 3};
+  SimulatedRun run = simulate(m, spec, testing::normalSampler(31));
+  for (auto& r : run.measurements) r.t -= 0.04;  // between odometry rows (every 0.1 s)
+  EstimatorOptions o(Method::Incremental);
+  o.smoother.iterate_to_convergence = true;
+  auto est = makeEstimator(m, o);
+  std::size_t next_range = 0;
+  for (std::size_t i = 0; i < run.inputs.size(); ++i) {
+    est->addInput(run.inputs[i].t, run.inputs[i].u);
+    while (next_range < run.measurements.size() && run.measurements[next_range].t < run.inputs[i].t - 0.45)
+      est->addMeasurement(run.measurements[next_range++]);  // 5 rows late
+  }
+  while (next_range < run.measurements.size()) est->addMeasurement(run.measurements[next_range++]);
+  EXPECT_GT(est->report().late, 20);
+  const OfflineRun batch = runOffline(m, {Method::Batch}, run.measurements, run.inputs, {}, {}, RowTimes::Inputs);
+  for (std::int64_t k = 5; k <= est->step(); k += 9) {
+    const StateEstimate e = *est->smoothed(k);
+    const auto row = std::find_if(batch.rows.begin(), batch.rows.end(),
+                                  [&](const EstimateRow& r) { return std::abs(r.t - e.t) < 1e-9; });
+    ASSERT_NE(row, batch.rows.end()) << e.t;
+    expectNear(e.mean, row->mean, 1e-6, "pose and range scale at t = " + std::to_string(e.t));
+  }
 }
 
 }  // namespace

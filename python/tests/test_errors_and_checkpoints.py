@@ -30,8 +30,8 @@ def test_bad_input_is_named_and_changes_nothing(method, data):
     bad = [
         (lambda: est.add_measurement(data.t[20], [1.0, 2.0]), "dimension|size|2"),
         (lambda: est.add_measurement(data.t[20], [float("nan")]), "NaN|finite"),
-        # late, between two states (at a state's own time the smoothers take it)
-        (lambda: est.add_measurement(0.5 * (data.t[4] + data.t[5]), data.y[20]), "time|before|increas"),
+        # before the start (late measurements between states: the incremental inserts a state)
+        (lambda: est.add_measurement(data.t[0] - 1.0, data.y[20]), "time|before|increas|start"),
         (lambda: est.add_measurement(data.t[20], data.y[20], channel="gps"), "gps"),
     ]
     for call, pattern in bad:

@@ -115,7 +115,7 @@ Key ByteReader::key(const std::string& what) {
   const std::int64_t step = i64(what.c_str());
   if (kind > 1) fail(what + ": unknown variable kind " + std::to_string(kind));
   if (kind == 1 && step != 0) fail(what + ": the constants carry step 0, found " + std::to_string(step));
-  if (kind == 0 && (step < 0 || step > kMaxStep)) fail(what + ": step " + std::to_string(step) + " out of range");
+  if (kind == 0 && (step < -kMaxStep || step > kMaxStep)) fail(what + ": step " + std::to_string(step) + " out of range");
   return kind == 1 ? Key::constants() : Key::state(step);
 }
 std::vector<Key> ByteReader::keys(const std::string& what) {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <chrono>
 #include <deque>
+#include <map>
+#include <type_traits>
 #include <sstream>
 
 #include "core/byte_stream.h"
@@ -216,6 +218,11 @@ void Estimator::requireUsable(const Measurement& m) const {
 
 void Estimator::addLate(const Measurement& m) {
   const std::optional<std::int64_t> k = stateAt(m.t);
+  if (!k && m.t > options_.t0 && insertLate(m)) {
+    ++report_.late;
+    ++report_.measurements;
+    return;
+  }
   if (!k && options_.drop_late) {
     ++report_.late_dropped;
     return;
@@ -224,9 +231,10 @@ void Estimator::addLate(const Measurement& m) {
     std::ostringstream os;
     os << methodName() << ": measurement at t = " << m.t << " is before the newest state (t = " << t_ << ") and "
        << (method() == Method::Incremental || method() == Method::FixedLag
-               ? "no state is at its time (between two states" +
-                     std::string(method() == Method::FixedLag ? ", or older than the window" : "") +
-                     "; a late measurement joins the state at its exact time)"
+               ? std::string(method() == Method::FixedLag
+                                 ? "no state of the window is at its time (between two states, or older than the "
+                                   "window; the fixed lag takes a late measurement at a state's exact time)"
+                                 : "it is not after the start")
                : "this method takes measurements in time order only")
        << "; EstimatorOptions::drop_late drops and counts it instead";
     throw InvalidArgument(os.str());
@@ -391,6 +399,8 @@ class SmootherEstimator final : public Estimator {
   StateEstimate current() override { return *smoothed(step()); }
 
   std::optional<std::int64_t> stateAt(double t) const override {
+    for (const auto& [step, ins] : inserted_)
+      if (sameTime(ins.t, t)) return step;
     const auto it = std::lower_bound(times_.begin(), times_.end(), t,
                                      [](double a, double b) { return a < b && !sameTime(a, b); });
     if (it == times_.end() || !sameTime(*it, t)) return std::nullopt;
@@ -430,7 +440,9 @@ class SmootherEstimator final : public Estimator {
     report_.iterations = report_.smoother.iterations;
     markDetail();
     times_.push_back(times_.back() + dt);
+    if (model_.dims().nu > 0) inputs_.push_back(u);
     while (keep_times_ > 0 && times_.size() > keep_times_) times_.pop_front();
+    while (keep_times_ > 0 && inputs_.size() > keep_times_) inputs_.pop_front();
   }
   void doMeasurements(std::int64_t k, const Measurement* ms, std::size_t count) override {
     std::vector<FactorPtr> factors;
@@ -440,29 +452,111 @@ class SmootherEstimator final : public Estimator {
     markDetail();
   }
 
+  // Between two held states: x(t) inserted, the process factor between them
+  // replaced by two through it, the measurement on it (incremental only).
+  bool insertLate(const Measurement& m) override {
+    if constexpr (!std::is_same_v<Smoother, IncrementalSmoother>) {
+      return false;
+    } else {
+      const auto around = neighbours(m.t);
+      if (!around) return false;
+      const auto& [prev, next] = *around;
+      if (model_.dims().nu > 0 && next.u.size() == 0) return false;  // its input is unknown (an old checkpoint)
+      requireUsable(Measurement{time(), m.y, m.channel, m.R});   // values and channel, as in order
+      const Key x = Key::state(-(static_cast<std::int64_t>(inserted_.size()) + 1));
+      const Eigen::VectorXd u = model_.dims().nu > 0 ? next.u : Eigen::VectorXd(Eigen::VectorXd::Zero(0));
+      std::vector<FactorPtr> factors{std::make_shared<ProcessFactor>(model_, prev.key, x, u, m.t - prev.t),
+                                     std::make_shared<ProcessFactor>(model_, x, next.key, u, next.t - m.t),
+                                     std::make_shared<MeasurementFactor>(model_, x.step, m)};
+      const Eigen::VectorXd xb = model_.dims().nb ? smoother_.estimate(Key::constants())
+                                                  : Eigen::VectorXd(Eigen::VectorXd::Zero(0));
+      Values initial;
+      initial.insert(x, predictState(model_, smoother_.estimate(prev.key), xb, u, m.t - prev.t, x.step));
+      report_.smoother = smoother_.replace({{prev.key, next.key}}, factors, initial);  // transactional
+      report_.iterations = report_.smoother.iterations;
+      markDetail();
+      inserted_[x.step] = {m.t, u};
+      return true;
+    }
+  }
+
  private:
+  struct HeldState {
+    Key key;
+    double t;
+    Eigen::VectorXd u;  // the input over the interval ending at it (empty without inputs)
+  };
+  // The held states just before and after t (regular or inserted), when t lies strictly between two.
+  std::optional<std::pair<HeldState, HeldState>> neighbours(double t) const {
+    const auto it = std::upper_bound(times_.begin(), times_.end(), t);
+    if (it == times_.begin() || it == times_.end()) return std::nullopt;
+    const auto i = static_cast<std::size_t>(it - times_.begin());
+    auto regular = [&](std::size_t idx) {
+      const std::int64_t k = step() - static_cast<std::int64_t>(times_.size() - 1 - idx);
+      const std::size_t ui = inputs_.size() - (times_.size() - idx);  // inputs_ has one per state after the first
+      return HeldState{Key::state(k), times_[idx],
+                       model_.dims().nu > 0 && idx > 0 && ui < inputs_.size() ? inputs_[ui] : Eigen::VectorXd()};
+    };
+    HeldState prev = regular(i - 1), next = regular(i);
+    for (const auto& [step, ins] : inserted_) {  // a nearer inserted state
+      if (ins.t < t && ins.t > prev.t) prev = {Key::state(step), ins.t, ins.u};
+      if (ins.t > t && ins.t < next.t) next = {Key::state(step), ins.t, ins.u};
+    }
+    if (sameTime(prev.t, t) || sameTime(next.t, t)) return std::nullopt;
+    return std::make_pair(prev, next);
+  }
   void saveState(internal::ByteWriter& out) const override {
     smoother_.save(out);
     out.times(times_);
+    out.u64(inputs_.size());  // since format version 3
+    for (const auto& u : inputs_) out.vec(u);
+    out.u64(inserted_.size());
+    for (const auto& [step, ins] : inserted_) out.i64(step), out.f64(ins.t), out.vec(ins.u);
   }
   void loadState(internal::ByteReader& in) override {
     smoother_.load(in, model_);
     std::deque<double> times = in.times("state times");
+    std::deque<Eigen::VectorXd> inputs;
+    std::map<std::int64_t, Inserted> inserted;
+    if (in.version() >= 3) readInsertions(in, inputs, inserted);
     const auto held = static_cast<std::size_t>(step()) + 1;
     const std::size_t expect = keep_times_ ? std::min(held, keep_times_) : held;
     const bool nb = model_.dims().nb > 0;
     if (times.size() != expect || !sameTime(times.back(), time()) ||
-        smoother_.numVariables() != times.size() + (nb ? 1 : 0) ||
+        smoother_.numVariables() != times.size() + inserted.size() + (nb ? 1 : 0) ||
         !smoother_.contains(Key::state(step())) ||
         !smoother_.contains(Key::state(step() - static_cast<std::int64_t>(times.size()) + 1)) ||
         (nb && !smoother_.contains(Key::constants())))
       in.fail("the smoother's variables do not match step " + std::to_string(step()) + " and " +
               std::to_string(times.size()) + " state times");
     times_ = std::move(times);
+    inputs_ = std::move(inputs);
+    inserted_ = std::move(inserted);
+  }
+  struct Inserted {
+    double t;
+    Eigen::VectorXd u;
+  };
+  void readInsertions(internal::ByteReader& in, std::deque<Eigen::VectorXd>& inputs,
+                      std::map<std::int64_t, Inserted>& inserted) const {
+    const std::uint64_t n = in.u64("state inputs (count)");
+    if (n > static_cast<std::uint64_t>(step()) + 1) in.fail("state inputs: more than the states");
+    for (std::uint64_t i = 0; i < n; ++i) inputs.push_back(in.vec("state input"));
+    const std::uint64_t m = in.u64("inserted states (count)");
+    if (m > (std::uint64_t(1) << 40)) in.fail("inserted states: count out of range");
+    for (std::uint64_t i = 0; i < m; ++i) {
+      const std::int64_t key = in.i64("inserted state key");
+      const double t = in.f64("inserted state time");
+      if (key >= 0 || !smoother_.contains(Key::state(key)))
+        in.fail("inserted state " + std::to_string(key) + ": not an inserted state the smoother holds");
+      inserted[key] = {t, in.vec("inserted state input")};
+    }
   }
   Smoother smoother_;
   std::size_t keep_times_;   // 0: keep all
   std::deque<double> times_; // times of the states still held
+  std::deque<Eigen::VectorXd> inputs_;  // the input into each held state after the first (models with inputs)
+  std::map<std::int64_t, Inserted> inserted_;  // states inserted for late measurements, by (negative) key step
 };
 
 // ---- The paper's window re-solve (reproduction mode) -----------------------------

@@ -7,7 +7,8 @@ namespace {
 // names its channel (written only for channels other than 0, so
 // single-channel checkpoints keep their v1 bytes).
 enum class FactorTag : std::uint8_t {
-  Prior = 1, Process = 2, Measurement = 3, LinearGaussian = 4, MeasurementOnChannel = 5, PriorWithAngles = 6
+  Prior = 1, Process = 2, Measurement = 3, LinearGaussian = 4, MeasurementOnChannel = 5, PriorWithAngles = 6,
+  ProcessBetween = 7  // between any two states (an inserted one), since format version 3
 };
 
 void requireDim(ByteReader& in, const Model& model, const Key& k, Eigen::Index size, const std::string& what) {
@@ -24,8 +25,14 @@ void writeFactor(ByteWriter& out, const Factor& f) {
     out.gaussian({p->mean(), p->noise().covariance()});
     if (!p->angles().empty()) out.ints(p->angles());
   } else if (const auto* q = dynamic_cast<const ProcessFactor*>(&f)) {
-    out.u8(static_cast<std::uint8_t>(FactorTag::Process));
-    out.i64(q->keys()[0].step);
+    const bool chain = q->keys()[0].step >= 0 && q->keys()[1].step == q->keys()[0].step + 1;
+    out.u8(static_cast<std::uint8_t>(chain ? FactorTag::Process : FactorTag::ProcessBetween));
+    if (chain) {
+      out.i64(q->keys()[0].step);
+    } else {
+      out.key(q->keys()[0]);
+      out.key(q->keys()[1]);
+    }
     out.vec(q->input());
     out.f64(q->dt());
   } else if (const auto* m = dynamic_cast<const MeasurementFactor*>(&f)) {
@@ -69,10 +76,18 @@ FactorPtr readFactor(ByteReader& in, const Model& model, const std::string& what
       const double dt = in.f64(what + " dt");
       return std::make_shared<ProcessFactor>(model, k, u, dt);
     }
+    case FactorTag::ProcessBetween: {
+      const Key from = in.key(what + " from"), to = in.key(what + " to");
+      if (from.isConstants() || to.isConstants()) in.fail(what + ": a process factor joins two states");
+      const Eigen::VectorXd u = in.vec(what + " input");
+      const double dt = in.f64(what + " dt");
+      return std::make_shared<ProcessFactor>(model, from, to, u, dt);
+    }
     case FactorTag::Measurement:
     case FactorTag::MeasurementOnChannel: {
       const std::int64_t k = in.i64((what + " step").c_str());
-      if (k < 0 || k >= (std::int64_t(1) << 53)) in.fail(what + ": step " + std::to_string(k) + " out of range");
+      if (k <= -(std::int64_t(1) << 53) || k >= (std::int64_t(1) << 53))
+        in.fail(what + ": step " + std::to_string(k) + " out of range");
       const int channel = static_cast<FactorTag>(tag) == FactorTag::Measurement ? 0 : in.i32((what + " channel").c_str());
       if (channel < 0 || channel >= model.numChannels())
         in.fail(what + ": channel " + std::to_string(channel) + " but model '" + model.name() + "' has " +

@@ -114,6 +114,21 @@ ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::Ve
                         ? GaussianNoise(model.processNoiseOf(dt, u), "process noise of step " + std::to_string(k))
                         : model.processNoiseModel(dt, k)) {}
 
+namespace {
+// What every process factor checks: a positive step, the input's and the noise's sizes.
+void checkProcess(const Model& model, const Key& from, const Key& to, const Eigen::VectorXd& u, double dt,
+                  const GaussianNoise& noise) {
+  const std::string what = "process factor " + from.toString() + " -> " + to.toString();
+  if (!(dt > 0) || !std::isfinite(dt))
+    throw InvalidArgument(what + ": time step must be > 0, got " + std::to_string(dt));
+  requireVector(u, model.dims().nu, "input u of the " + what);
+  if (noise.dim() != model.dims().nc)
+    throw InvalidArgument(what + ": its noise covariance is " + std::to_string(noise.dim()) + " x " +
+                          std::to_string(noise.dim()) + ", the state has " + std::to_string(model.dims().nc) +
+                          " components");
+}
+}  // namespace
+
 ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt,
                              const GaussianNoise& noise)
     : Factor(withConstants(model, {Key::state(k), Key::state(k + 1)}), model.dims().nc),
@@ -121,16 +136,17 @@ ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::Ve
       u_(u),
       dt_(dt),
       noise_(noise) {
-  if (!(dt > 0) || !std::isfinite(dt))
-    throw InvalidArgument("process factor x_c(" + std::to_string(k) + ") -> x_c(" +
-                          std::to_string(k + 1) + "): time step must be > 0, got " +
-                          std::to_string(dt));
-  requireVector(u, model.dims().nu, "input u at step " + std::to_string(k));
-  if (noise.dim() != model.dims().nc)
-    throw InvalidArgument("process factor x_c(" + std::to_string(k) + ") -> x_c(" + std::to_string(k + 1) +
-                          "): its noise covariance is " + std::to_string(noise.dim()) + " x " +
-                          std::to_string(noise.dim()) + ", the state has " + std::to_string(model.dims().nc) +
-                          " components");
+  checkProcess(model, Key::state(k), Key::state(k + 1), u, dt, noise);
+}
+
+ProcessFactor::ProcessFactor(const Model& model, Key from, Key to, const Eigen::VectorXd& u, double dt)
+    : ProcessFactor(model, from, to, u, dt,
+                    GaussianNoise(model.processNoiseOf(dt, u), "process noise " + from.toString() + " -> " + to.toString())) {}
+
+ProcessFactor::ProcessFactor(const Model& model, Key from, Key to, const Eigen::VectorXd& u, double dt,
+                             const GaussianNoise& noise)
+    : Factor(withConstants(model, {from, to}), model.dims().nc), model_(&model), u_(u), dt_(dt), noise_(noise) {
+  checkProcess(model, from, to, u, dt, noise_);
 }
 
 void internal::processResidual(const Model& model, const Eigen::VectorXd& u, double dt, const GaussianNoise& noise,

@@ -99,6 +99,10 @@ double SlotFactor::linearizeRobustAt(const Model* model, const Eigen::VectorXd* 
   return 0.0;
 }
 
+FactorPtr SlotFactor::toProcessBetween(const Model* model, Key from, Key to) const {
+  return std::make_shared<ProcessFactor>(*model, from, to, step_.u, step_.dt, noise_);
+}
+
 FactorPtr SlotFactor::toFactorAt(const Model* model, std::int64_t step) const {
   switch (kind_) {
     case Kind::None: break;

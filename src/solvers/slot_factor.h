@@ -57,17 +57,16 @@ class SlotFactor {
     if (kind_ == Kind::Object) return object_->keys().size() == keys.size() &&
                                       std::equal(keys.begin(), keys.end(), object_->keys().begin());
     if (kind_ == Kind::None || keys.size() == 0) return false;
-    // x_c(k), then x_c(k+1) for a process factor, then x_b if there are constants.
+    // x_c(k), then for a process factor another state (x_c(k+1), or an
+    // inserted one on either side), then x_b if there are constants.
     const std::size_t states = kind_ == Kind::Process ? 2 : 1;
     if (keys.size() != states + (model->dims().nb > 0 ? 1 : 0)) return false;
-    const Key first = *keys.begin();
     std::size_t i = 0;
     for (const Key& k : keys) {
-      const Key expected = i < states ? Key::state(first.step + static_cast<std::int64_t>(i)) : Key::constants();
-      if (first.isConstants() || k != expected) return false;
+      if (k.isConstants() != (i >= states)) return false;
       ++i;
     }
-    return true;
+    return states == 1 || *keys.begin() != *(keys.begin() + 1);
   }
   /// What Factor::linearizeRobustAt returns for the factor it was made from,
   /// with its variables' values in key order.
@@ -77,6 +76,10 @@ class SlotFactor {
   /// one: curvature terms, checkpoints, messages.
   template <class Keys>
   FactorPtr toFactor(const Model* model, const Keys& keys) const {
+    if (kind_ == Kind::Process && keys.size() >= 2) {  // between any two states (an inserted one)
+      const Key from = *keys.begin(), to = *(keys.begin() + 1);
+      if (from.step < 0 || to.step != from.step + 1) return toProcessBetween(model, from, to);
+    }
     return toFactorAt(model, keys.size() > 0 ? keys.begin()->step : 0);
   }
 
@@ -91,6 +94,7 @@ class SlotFactor {
     double loss_scale;
   };
   FactorPtr toFactorAt(const Model* model, std::int64_t step) const;  // a model factor's at its first state's step
+  FactorPtr toProcessBetween(const Model* model, Key from, Key to) const;
   void reset();
   void copyFrom(const SlotFactor& o);
   void moveFrom(SlotFactor& o);

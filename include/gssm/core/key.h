@@ -15,7 +15,7 @@ enum class VariableKind : std::uint8_t { State = 0, Constants = 1 };
 /// (factors, separators, the variable index).
 struct Key {
   VariableKind kind : 1;
-  std::int64_t step : 63;  ///< step index for a State; 0 for Constants
+  std::int64_t step : 63;  ///< step index for a State (< 0: a state inserted later); 0 for Constants
 
   constexpr Key() : kind(VariableKind::State), step(0) {}
   constexpr Key(VariableKind k, std::int64_t s) : kind(k), step(s) {}
@@ -41,8 +41,9 @@ struct Key {
 
   /// "x_c(12)" or "x_b".
   std::string toString() const {
-    return isConstants() ? std::string("x_b (constants)")
-                         : "x_c(" + std::to_string(step) + ")";
+    if (isConstants()) return "x_b (constants)";
+    // Negative steps: states inserted into the chain for late measurements.
+    return step < 0 ? "x_c(inserted " + std::to_string(-step) + ")" : "x_c(" + std::to_string(step) + ")";
   }
 };
 

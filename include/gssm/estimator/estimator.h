@@ -113,10 +113,12 @@ class Estimator {
   /// a sensor's buffer, a late radio block): the smoothers attach it to the
   /// state at its time when they still hold one (the incremental smoother:
   /// any; the fixed lag: inside its window), re-eliminating only what it
-  /// touches, so the result is the one of the same data in order. A time
-  /// with no state (between two states, older than the window) and the EKF
-  /// and paper window: refused (InvalidArgument, estimator unchanged), or
-  /// dropped and counted with EstimatorOptions::drop_late.
+  /// touches, so the result is the one of the same data in order. Between
+  /// two states the incremental smoother inserts a state at its time (the
+  /// process factor between them split in two). Older than the fixed lag's
+  /// window, between two of its states, and for the EKF and paper window:
+  /// refused (InvalidArgument, estimator unchanged), or dropped and counted
+  /// with EstimatorOptions::drop_late.
   void addMeasurement(double t, const Eigen::VectorXd& y);
   /// A measurement on the model's channel called `channel` (several
   /// sensors: any rate, any interleaving, several at one time stamp).
@@ -182,6 +184,10 @@ class Estimator {
   /// The step of a held state at time t < time() that a late measurement
   /// can join; none by default (the EKF and the paper window keep none).
   virtual std::optional<std::int64_t> stateAt(double /*t*/) const { return std::nullopt; }
+  /// A late measurement at a time between two held states: a state inserted
+  /// there (the process factor between them split in two) carrying it.
+  /// False when the method cannot (default); strongly exception safe.
+  virtual bool insertLate(const Measurement& /*m*/) { return false; }
 
   const Model& model_;
   mutable EstimatorReport report_;

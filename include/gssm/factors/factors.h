@@ -83,6 +83,10 @@ class ProcessFactor final : public Factor {
   ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt);
   /// With an explicit noise model (a solver that held the factor as its numbers).
   ProcessFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& u, double dt, const GaussianNoise& noise);
+  /// Between any two states (a state inserted into the chain for a late
+  /// measurement: x_c(j) → x(t) → x_c(j+1)).
+  ProcessFactor(const Model& model, Key from, Key to, const Eigen::VectorXd& u, double dt);
+  ProcessFactor(const Model& model, Key from, Key to, const Eigen::VectorXd& u, double dt, const GaussianNoise& noise);
   void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                    std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
