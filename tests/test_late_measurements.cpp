@@ -179,7 +179,7 @@ TEST(LateMeasurements, OnTheNonlinearRadarTheIteratedIncrementalEqualsTheBatch) 
 namespace gssm {
 namespace {
 
-TEST(LateMeasurements, BetweenTwoStatesTheIncrementalSmootherInsertsAState) {
+TEST(LateMeasurements, BetweenTwoStatesTheSmoothersInsertAState) {
   // gps read halfway between the y instants, each reading 3 instants late:
   // the incremental smoother inserts a state at its time (the process factor
   // there split in two) and ends as the run with every state from the start.
@@ -201,6 +201,24 @@ TEST(LateMeasurements, BetweenTwoStatesTheIncrementalSmootherInsertsAState) {
     if (k >= 4) arrival.push_back(gps[k - 4]);
   }
   for (std::size_t k = run.measurements.size() - 4; k + 1 < run.measurements.size(); ++k) arrival.push_back(gps[k]);
+  // The fixed lag (window 12 regular states) takes them too: each is 4 instants late.
+  {
+    EstimatorOptions o(Method::FixedLag);
+    o.fixed_lag.window = 12;
+    auto late = feed(m, o, arrival);
+    EXPECT_EQ(late->report().late, 39);
+    EXPECT_EQ(late->report().late_dropped, 0);
+    // In order, the window holds the gps states too: compare with a long
+    // window, where marginalization has not yet reached what the late run
+    // still held; the newest estimate is exact either way (linear).
+    EstimatorOptions wide = o;
+    wide.fixed_lag.window = 200;
+    auto ordered = feed(m, wide, in_order);
+    expectNear(late->current().mean, ordered->current().mean, 1e-9, "fixed lag: newest state and x_b");
+    expectNear(late->current().covariance, ordered->current().covariance, 1e-9, "fixed lag: their covariance");
+    auto restored = restoreCheckpointBytes(m, checkpointBytes(*late));
+    EXPECT_EQ(restored->current().mean, late->current().mean);
+  }
   EstimatorOptions o(Method::Incremental);
   auto late = feed(m, o, arrival);
   auto ordered = feed(m, o, in_order);

@@ -33,7 +33,7 @@ def test_a_late_measurement_joins_its_state_in_the_smoothers_and_the_ekf_refuses
         ekf.add_measurement(data.t[0], data.y[0])
     options = gssm.make_options("ekf")
     options.drop_late = True
-    ekf = gssm.make_estimator(gssm.models.Radar2D(), options=options)
+    ekf = gssm.make_estimator(gssm.models.Radar2D(), "ekf", options=options)
     ekf.add_measurement(data.t[1], data.y[1])
     ekf.add_measurement(data.t[0], data.y[0])
     assert ekf.report().late_dropped == 1 and ekf.report().measurements == 1

@@ -232,8 +232,8 @@ void Estimator::addLate(const Measurement& m) {
     os << methodName() << ": measurement at t = " << m.t << " is before the newest state (t = " << t_ << ") and "
        << (method() == Method::Incremental || method() == Method::FixedLag
                ? std::string(method() == Method::FixedLag
-                                 ? "no state of the window is at its time (between two states, or older than the "
-                                   "window; the fixed lag takes a late measurement at a state's exact time)"
+                                 ? "it is older than the window (the fixed lag takes a late measurement at or "
+                                   "between the states it still holds)"
                                  : "it is not after the start")
                : "this method takes measurements in time order only")
        << "; EstimatorOptions::drop_late drops and counts it instead";
@@ -439,6 +439,7 @@ class SmootherEstimator final : public Estimator {
     report_.smoother = smoother_.update(factors, initial);  // transactional
     report_.iterations = report_.smoother.iterations;
     markDetail();
+    forgetMarginalized();
     times_.push_back(times_.back() + dt);
     if (model_.dims().nu > 0) inputs_.push_back(u);
     while (keep_times_ > 0 && times_.size() > keep_times_) times_.pop_front();
@@ -455,15 +456,13 @@ class SmootherEstimator final : public Estimator {
   // Between two held states: x(t) inserted, the process factor between them
   // replaced by two through it, the measurement on it (incremental only).
   bool insertLate(const Measurement& m) override {
-    if constexpr (!std::is_same_v<Smoother, IncrementalSmoother>) {
-      return false;
-    } else {
+    {
       const auto around = neighbours(m.t);
-      if (!around) return false;
+      if (!around || !smoother_.contains(around->first.key) || !smoother_.contains(around->second.key)) return false;
       const auto& [prev, next] = *around;
       if (model_.dims().nu > 0 && next.u.size() == 0) return false;  // its input is unknown (an old checkpoint)
       requireUsable(Measurement{time(), m.y, m.channel, m.R});   // values and channel, as in order
-      const Key x = Key::state(-(static_cast<std::int64_t>(inserted_.size()) + 1));
+      const Key x = Key::state(inserted_.empty() ? -1 : inserted_.begin()->first - 1);  // a key no state holds
       const Eigen::VectorXd u = model_.dims().nu > 0 ? next.u : Eigen::VectorXd(Eigen::VectorXd::Zero(0));
       std::vector<FactorPtr> factors{std::make_shared<ProcessFactor>(model_, prev.key, x, u, m.t - prev.t),
                                      std::make_shared<ProcessFactor>(model_, x, next.key, u, next.t - m.t),
@@ -478,6 +477,11 @@ class SmootherEstimator final : public Estimator {
       inserted_[x.step] = {m.t, u};
       return true;
     }
+  }
+  // Inserted states a fixed lag has marginalized are forgotten.
+  void forgetMarginalized() {
+    for (auto it = inserted_.begin(); it != inserted_.end();)
+      it = smoother_.contains(Key::state(it->first)) ? std::next(it) : inserted_.erase(it);
   }
 
  private:

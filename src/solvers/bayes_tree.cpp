@@ -1049,6 +1049,27 @@ void BayesTreeEngine::killSlot(int s) {
   --slots_alive_;
 }
 
+std::vector<Key> BayesTreeEngine::below(const Key& k) const {
+  std::vector<Key> out;
+  const Var* v = vars_.find(k);
+  if (!v) return out;
+  // Post-order over the subtree under k's clique (an explicit stack: a long
+  // subtree must not recurse deeply).
+  std::vector<std::pair<int, bool>> stack;
+  for (int ch : cliques_[static_cast<std::size_t>(v->clique)].children) stack.emplace_back(ch, false);
+  while (!stack.empty()) {
+    auto [c, expanded] = stack.back();
+    stack.pop_back();
+    if (expanded) {
+      out.push_back(cliques_[static_cast<std::size_t>(c)].frontal);
+      continue;
+    }
+    stack.emplace_back(c, true);
+    for (int ch : cliques_[static_cast<std::size_t>(c)].children) stack.emplace_back(ch, false);
+  }
+  return out;
+}
+
 std::vector<int> BayesTreeEngine::slotsBetween(const Key& a, const Key& b) const {
   std::vector<int> out;
   const Var* va = vars_.find(a);

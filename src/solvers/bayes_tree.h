@@ -330,6 +330,9 @@ class BayesTreeEngine {
   /// Appends the alive nonlinear slots whose keys include the state k to
   /// `out` (every factor touches the constants: that is nonlinearSlots()).
   void appendSlotsOf(const Key& k, std::vector<int>& out) const;
+  /// The frontal variables of the cliques below k's, leaves first (what must
+  /// be marginalized before k is a leaf).
+  std::vector<Key> below(const Key& k) const;
   /// The live factor slots on both a and b (none when either is absent).
   std::vector<int> slotsBetween(const Key& a, const Key& b) const;
   /// ½‖r‖² of every alive factor at the current estimate (nonlinear factors

@@ -316,15 +316,15 @@ UpdateReport IncrementalSmoother::update(const std::vector<FactorPtr>& f, const 
   return core_->update(f, v);
 }
 
-UpdateReport IncrementalSmoother::replace(const std::vector<std::pair<Key, Key>>& remove_between,
-                                          const std::vector<FactorPtr>& f, const Values& v) {
+UpdateReport Smoother::replace(const std::vector<std::pair<Key, Key>>& remove_between,
+                               const std::vector<FactorPtr>& f, const Values& v) {
   std::vector<int> slots;
   for (const auto& [a, b] : remove_between) {
     if (a.isConstants() || b.isConstants())
-      throw InvalidArgument("IncrementalSmoother::replace: name the factors to remove by two states, not x_b");
+      throw InvalidArgument("Smoother::replace: name the factors to remove by two states, not x_b");
     const std::vector<int> between = core_->engine.slotsBetween(a, b);
     if (between.empty())
-      throw InvalidArgument("IncrementalSmoother::replace: no factor on both " + a.toString() + " and " + b.toString());
+      throw InvalidArgument("Smoother::replace: no factor on both " + a.toString() + " and " + b.toString());
     slots.insert(slots.end(), between.begin(), between.end());
   }
   return core_->update(f, v, slots);
@@ -357,6 +357,15 @@ UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Val
   oldest_ = oldest;
   const auto start = std::chrono::steady_clock::now();
   while (oldest_ >= 0 && oldest_ < newest_ - options_.window + 1) {
+    // States inserted for late measurements next to it are eliminated before
+    // it (their keys sort first): marginalized first, leaves first.
+    for (const Key& k : core_->engine.below(Key::state(oldest_))) {
+      if (k.isConstants() || k.step >= 0)
+        throw NumericalError("FixedLagSmoother: " + k.toString() + " lies below " + Key::state(oldest_).toString() +
+                             " in the Bayes tree (internal ordering error)");
+      core_->engine.marginalizeLeaf(k);
+      ++rep.variables_marginalized;
+    }
     core_->engine.marginalizeLeaf(Key::state(oldest_));
     ++oldest_;
     ++rep.variables_marginalized;

@@ -114,11 +114,11 @@ class Estimator {
   /// state at its time when they still hold one (the incremental smoother:
   /// any; the fixed lag: inside its window), re-eliminating only what it
   /// touches, so the result is the one of the same data in order. Between
-  /// two states the incremental smoother inserts a state at its time (the
-  /// process factor between them split in two). Older than the fixed lag's
-  /// window, between two of its states, and for the EKF and paper window:
-  /// refused (InvalidArgument, estimator unchanged), or dropped and counted
-  /// with EstimatorOptions::drop_late.
+  /// two held states they insert a state at its time (the process factor
+  /// between them split in two). Older than the fixed lag's window, before
+  /// the start, and for the EKF and paper window: refused (InvalidArgument,
+  /// estimator unchanged), or dropped and counted with
+  /// EstimatorOptions::drop_late.
   void addMeasurement(double t, const Eigen::VectorXd& y);
   /// A measurement on the model's channel called `channel` (several
   /// sensors: any rate, any interleaving, several at one time stamp).

@@ -107,6 +107,16 @@ class Smoother {
   /// Strong exception guarantee: on throw the smoother is unchanged.
   virtual UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values) = 0;
 
+  /// Removes every factor on both states of each pair, then adds `new_factors`
+  /// and `new_values` in the same update (strong guarantee): the cliques of
+  /// the removed factors' variables and those above them are re-eliminated
+  /// without them. A process factor split by a state inserted between two
+  /// states is replaced this way (the new variables must not be newer
+  /// states: a fixed lag's window is not moved). InvalidArgument when a pair
+  /// has no factor.
+  UpdateReport replace(const std::vector<std::pair<Key, Key>>& remove_between, const std::vector<FactorPtr>& new_factors,
+                       const Values& new_values);
+
   bool contains(const Key& k) const;
   /// Current estimate of a variable (refreshes its root path first).
   Eigen::VectorXd estimate(const Key& k);
@@ -135,13 +145,6 @@ class IncrementalSmoother final : public Smoother {
   explicit IncrementalSmoother(SmootherOptions options = {},
                                EliminationOrdering ordering = EliminationOrdering::ConstrainedColamd);
   UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values) override;
-  /// Removes every factor on both states of each pair, then adds `new_factors`
-  /// and `new_values` in the same update (strong guarantee): the cliques of
-  /// the removed factors' variables and those above them are re-eliminated
-  /// without them. A process factor split by a state inserted between two
-  /// states is replaced this way. InvalidArgument when a pair has no factor.
-  UpdateReport replace(const std::vector<std::pair<Key, Key>>& remove_between, const std::vector<FactorPtr>& new_factors,
-                       const Values& new_values);
   const SmootherOptions& options() const;
   EliminationOrdering ordering() const { return ordering_; }
 
