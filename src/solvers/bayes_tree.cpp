@@ -629,6 +629,8 @@ Eigen::Index BayesTreeEngine::stackFactors(UpdatePlan& p, const EliminationQueue
   Eigen::Index r0 = 0;
   for (std::size_t id : q.pending_of[vi]) {
     const LinearView& f = q.pend[id];
+    if (q.pend_source[id]) p.fresh_owned.emplace_back(vi, *q.pend_source[id]);
+    if (f.rows() == 0) continue;  // an empty marginal: nothing to stack (and M(r0, ·) would be past its end)
     // Column by column (a packed marginal holds none of its zeros; M's are set).
     auto copyCol = [&](Eigen::Index from, Eigen::Index to) { copyDoubles(f.col(from), f.colLength(from), &M(r0, to)); };
     Eigen::Index col = 0;
@@ -639,7 +641,6 @@ Eigen::Index BayesTreeEngine::stackFactors(UpdatePlan& p, const EliminationQueue
     }
     copyCol(col, ncols);
     r0 += f.rows();
-    if (q.pend_source[id]) p.fresh_owned.emplace_back(vi, *q.pend_source[id]);
   }
   if (damp_rows == 0) return rows;
   // Marquardt rows pull δ_v toward its current value: √λ·D (δ_v − δ̂_v) = 0.
