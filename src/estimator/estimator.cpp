@@ -196,12 +196,17 @@ void Estimator::addMeasurement(double t, const std::string& channel, const Eigen
 
 void Estimator::requireUsable(const Measurement& m) const {
   const double t = m.t;
-  if (!std::isfinite(t) || (t < t_ && !stateAt(t)) || (t == t_ && k_ == 0)) {
+  if (!std::isfinite(t) || t < t_ || (t == t_ && k_ == 0)) {
     std::ostringstream os;
     os << methodName() << ": measurement time " << t << " must be after the previous state (" << t_ << ")"
        << (k_ == 0 ? ", the start t0" : "");
     throw InvalidArgument(os.str());
   }
+  requireValues(m);
+}
+
+void Estimator::requireValues(const Measurement& m) const {
+  const double t = m.t;
   if (m.channel < 0 || m.channel >= model_.numChannels())
     throw InvalidArgument(std::string(methodName()) + ": measurement at t = " + std::to_string(t) + " names channel " +
                           std::to_string(m.channel) + "; model '" + model_.name() + "' has " +
@@ -239,7 +244,7 @@ void Estimator::addLate(const Measurement& m) {
        << "; EstimatorOptions::drop_late drops and counts it instead";
     throw InvalidArgument(os.str());
   }
-  requireUsable(m);
+  requireValues(m);  // its time is a held state's
   doMeasurements(*k, &m, 1);
   ++report_.late;
   ++report_.measurements;
@@ -461,7 +466,7 @@ class SmootherEstimator final : public Estimator {
       if (!around || !smoother_.contains(around->first.key) || !smoother_.contains(around->second.key)) return false;
       const auto& [prev, next] = *around;
       if (model_.dims().nu > 0 && next.u.size() == 0) return false;  // its input is unknown (an old checkpoint)
-      requireUsable(Measurement{time(), m.y, m.channel, m.R});   // values and channel, as in order
+      requireValues(m);
       const Key x = Key::state(inserted_.empty() ? -1 : inserted_.begin()->first - 1);  // a key no state holds
       const Eigen::VectorXd u = model_.dims().nu > 0 ? next.u : Eigen::VectorXd(Eigen::VectorXd::Zero(0));
       std::vector<FactorPtr> factors{std::make_shared<ProcessFactor>(model_, prev.key, x, u, m.t - prev.t),

@@ -115,15 +115,16 @@ ProcessFactor::ProcessFactor(const Model& model, std::int64_t k, const Eigen::Ve
                         : model.processNoiseModel(dt, k)) {}
 
 namespace {
-// What every process factor checks: a positive step, the input's and the noise's sizes.
+// What every process factor checks: a positive step, the input's and the
+// noise's sizes. One is made per step: the message is built only on failure.
 void checkProcess(const Model& model, const Key& from, const Key& to, const Eigen::VectorXd& u, double dt,
                   const GaussianNoise& noise) {
-  const std::string what = "process factor " + from.toString() + " -> " + to.toString();
+  auto what = [&] { return "process factor " + from.toString() + " -> " + to.toString(); };
   if (!(dt > 0) || !std::isfinite(dt))
-    throw InvalidArgument(what + ": time step must be > 0, got " + std::to_string(dt));
-  requireVector(u, model.dims().nu, "input u of the " + what);
+    throw InvalidArgument(what() + ": time step must be > 0, got " + std::to_string(dt));
+  if (!validVector(u, model.dims().nu)) requireVector(u, model.dims().nu, "input u of the " + what());
   if (noise.dim() != model.dims().nc)
-    throw InvalidArgument(what + ": its noise covariance is " + std::to_string(noise.dim()) + " x " +
+    throw InvalidArgument(what() + ": its noise covariance is " + std::to_string(noise.dim()) + " x " +
                           std::to_string(noise.dim()) + ", the state has " + std::to_string(model.dims().nc) +
                           " components");
 }

@@ -33,15 +33,21 @@ bool NoiseLearningOptions::validate(std::string* why) const {
   return true;  // the EKF options are checked against the model when the filter is made
 }
 
-double predictionErrorLogLikelihood(const Model& model, const std::vector<Measurement>& measurements,
-                                    const std::vector<Input>& inputs, double t0, ExtendedKalmanFilterOptions ekf) {
+namespace {
+// The likelihood over a schedule computed once (learning evaluates hundreds).
+double logLikelihoodAlong(const Model& model, const std::vector<ScheduledStep>& schedule,
+                          const std::vector<Measurement>& measurements, const std::vector<Input>& inputs, double t0,
+                          ExtendedKalmanFilterOptions ekf) {
   ekf.use_gates = false;
   ExtendedKalmanFilter filter(model, ekf, t0);
-  for (const ScheduledStep& step : stepSchedule(measurements, inputs, t0)) {
-    filter.predict(step.t, inputAt(model, inputs, filter.time()));
-    for (std::size_t i : step.measurements) filter.update(measurements[i]);
-  }
+  filterAlong(filter, schedule, measurements, inputs);
   return filter.logLikelihood();
+}
+}  // namespace
+
+double predictionErrorLogLikelihood(const Model& model, const std::vector<Measurement>& measurements,
+                                    const std::vector<Input>& inputs, double t0, ExtendedKalmanFilterOptions ekf) {
+  return logLikelihoodAlong(model, stepSchedule(measurements, inputs, t0), measurements, inputs, t0, std::move(ekf));
 }
 
 namespace {
@@ -128,6 +134,7 @@ ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParamete
 
 struct Objective {
   const NoiseFamily& family;
+  const std::vector<ScheduledStep>& schedule;  // the states of the run, the same for every σ
   const std::vector<Measurement>& measurements;
   const std::vector<Input>& inputs;
   double t0;
@@ -149,7 +156,7 @@ struct Objective {
       const auto model = family.make(clamped.head(n).array().exp().matrix());
       ExtendedKalmanFilterOptions e = ekf;
       if (mixture) e.outlier_probability = 1.0 / (1.0 + std::exp(-clamped[n])), e.outlier_log_density = outlier_log_density;
-      const double l = predictionErrorLogLikelihood(*model, measurements, inputs, t0, e);
+      const double l = logLikelihoodAlong(*model, schedule, measurements, inputs, t0, e);
       return std::isfinite(l) ? l : -std::numeric_limits<double>::infinity();
     } catch (const NumericalError&) {
       return -std::numeric_limits<double>::infinity();
@@ -310,7 +317,8 @@ NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Meas
     r.parameters.push_back(p);
   }
   r.measurements = measurements.size();
-  Objective obj{family, measurements, inputs, t0, o.ekf, {}, {}, false, {}};
+  const std::vector<ScheduledStep> schedule = stepSchedule(measurements, inputs, t0);
+  Objective obj{family, schedule, measurements, inputs, t0, o.ekf, {}, {}, false, {}};
   const auto n = static_cast<Eigen::Index>(family.names.size());
   Eigen::VectorXd theta(n);
   for (Eigen::Index i = 0; i < n; ++i) theta[i] = std::log(r.parameters[static_cast<std::size_t>(i)].start);

@@ -157,6 +157,16 @@ void ExtendedKalmanFilter::commitUpdate(const Eigen::MatrixXd& H, const Eigen::M
   P_ = std::move(P);
 }
 
+void filterAlong(ExtendedKalmanFilter& filter, const std::vector<ScheduledStep>& schedule,
+                 const std::vector<Measurement>& measurements, const std::vector<Input>& inputs,
+                 const std::function<void()>& after) {
+  for (const ScheduledStep& step : schedule) {
+    filter.predict(step.t, inputAt(filter.model(), inputs, filter.time()));
+    for (std::size_t i : step.measurements) filter.update(measurements[i]);
+    if (after) after();
+  }
+}
+
 Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
                        const std::vector<Measurement>& measurements,
                        const std::vector<Input>& inputs, double t0) {
@@ -166,11 +176,8 @@ Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& op
   Values x;
   x.insert(Key::state(0), model.priorState().mean);
   std::int64_t k = 0;
-  for (const ScheduledStep& step : stepSchedule(measurements, inputs, t0)) {
-    ekf.predict(step.t, inputAt(model, inputs, ekf.time()));
-    for (std::size_t i : step.measurements) ekf.update(measurements[i]);
-    x.insert(Key::state(++k), ekf.mean().head(d.nc));
-  }
+  filterAlong(ekf, stepSchedule(measurements, inputs, t0), measurements, inputs,
+              [&] { x.insert(Key::state(++k), ekf.mean().head(d.nc)); });
   if (d.nb > 0) x.insert(Key::constants(), ekf.mean().tail(d.nb));
   return x;
 }

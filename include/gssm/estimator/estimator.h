@@ -180,6 +180,8 @@ class Estimator {
   void markDetail() { detail_stale_ = true; }
   /// addMeasurement's checks of one measurement (time, channel, values, R).
   void requireUsable(const Measurement& m) const;
+  /// requireUsable's checks but the time's (a late measurement's time is checked against the states held).
+  void requireValues(const Measurement& m) const;
   void addAt(double t, const Measurement* ms, std::size_t count);
   /// The step of a held state at time t < time() that a late measurement
   /// can join; none by default (the EKF and the paper window keep none).

@@ -5,6 +5,7 @@
 // zero (or a small, optional) process noise and marginalized every step.
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 
 #include <vector>
@@ -13,6 +14,7 @@
 #include "gssm/core/data.h"
 #include "gssm/model/model.h"
 #include "gssm/core/values.h"
+#include "gssm/factors/problem.h"
 
 namespace gssm {
 
@@ -89,6 +91,13 @@ class ExtendedKalmanFilter {
   double log_likelihood_ = 0.0;
   std::int64_t rejected_ = 0;
 };
+
+/// Runs `filter` over a step schedule (stepSchedule's): predicts to each
+/// step's time under the input in force, updates with its measurements, then
+/// calls `after` (when given). The one filter loop of an offline pass.
+void filterAlong(ExtendedKalmanFilter& filter, const std::vector<ScheduledStep>& schedule,
+                 const std::vector<Measurement>& measurements, const std::vector<Input>& inputs,
+                 const std::function<void()>& after = {});
 
 /// An initial guess for a batch solve from one EKF pass: x_c(k) from the
 /// filtered estimates, x_b from the filter's final estimate. From a poor
