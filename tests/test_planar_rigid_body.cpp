@@ -5,10 +5,14 @@
 // within their reported 2σ and the incremental smoother equals the batch.
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+#include <cstdio>
 #include <random>
 
 #include "gssm/analysis/offline.h"
+#include "gssm/core/error.h"
 #include "gssm/io/config.h"
+#include "gssm/learn/noise_learning.h"
 #include "gssm/model/simulation.h"
 #include "gssm/models/planar_rigid_body.h"
 #include "jacobian_check.h"
@@ -72,6 +76,7 @@ TEST(PlanarRigidBody, RoundTripsThroughItsIniForm) {
   PlanarRigidBody::Params p = uwbLayout();
   p.range_sd = 0.05;
   p.range_scale = true;
+  p.bias_common_sd = 0.4;
   const PlanarRigidBody model(p);
   io::IniDocument ini;
   io::writeModel(model, ini);
@@ -82,6 +87,26 @@ TEST(PlanarRigidBody, RoundTripsThroughItsIniForm) {
   EXPECT_EQ(again->stackedStateNames(), model.stackedStateNames());
   EXPECT_EQ(again->noise().Q, model.noise().Q);
   EXPECT_EQ(again->priorConstants().covariance, model.priorConstants().covariance);
+  EXPECT_EQ(q.bias_common_sd, 0.4);
+}
+
+// b_ij = c + d_ij marginalized: bias_sd²·I + bias_common_sd²·11ᵀ on the
+// biases, the range scale's prior untouched.
+TEST(PlanarRigidBody, CommonBiasPartIsInThePriorCovariance) {
+  PlanarRigidBody::Params p = uwbLayout();
+  p.bias_sd = 0.06;
+  p.bias_common_sd = 0.5;
+  p.range_scale = true;
+  p.range_scale_sd = 0.02;
+  const Eigen::MatrixXd P = PlanarRigidBody(p).priorConstants().covariance;
+  ASSERT_EQ(P.rows(), 25);
+  for (int i = 0; i < 25; ++i)
+    for (int j = 0; j < 25; ++j) {
+      const double expected = i == 24 || j == 24 ? (i == j ? 0.02 * 0.02 : 0.0) : 0.25 + (i == j ? 0.0036 : 0.0);
+      EXPECT_NEAR(P(i, j), expected, 1e-15) << i << ", " << j;
+    }
+  p.bias_common_sd = -0.1;
+  EXPECT_THROW(PlanarRigidBody{p}, gssm::InvalidArgument);
 }
 
 namespace {
@@ -146,4 +171,41 @@ TEST(PlanarRigidBody, IncrementalSmootherEqualsTheBatchOnTheLayout) {
   const Eigen::VectorXd& y = b.rows.back().mean;
   EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-6 * (1 + y.cwiseAbs().maxCoeff())) << (x - y).transpose();
   EXPECT_LT((a.rows.back().covariance - b.rows.back().covariance).cwiseAbs().maxCoeff(), 1e-8);
+}
+
+// EM for the links' spread (bias_sd, about a common part): the learnt σ is a
+// stationary point of the expected log prior at the batch posterior of x_b
+// computed here independently (dQ/dσ² = ½ tr(Σ⁻¹SΣ⁻¹) − ½ tr(Σ⁻¹) = 0 with
+// S = P + m mᵀ), and it recovers the spread the biases were drawn with.
+TEST(PlanarRigidBody, LinkBiasSpreadLearntByEmIsAStationaryPointOfTheExpectedLogPrior) {
+  PlanarRigidBody::Params truth = simulatedLayout();
+  truth.bias_sd = 0.06;
+  truth.bias_common_sd = 0.2;
+  const SimulatedRun run = layoutRun(PlanarRigidBody(truth), 11, 960);  // each link 40 times
+  PlanarRigidBody::Params given = truth;
+  given.bias_sd = 0.3;
+  NoiseLearningOptions o;
+  o.parameters = {"bias_sd"};
+  const NoiseLearningReport r = learnNoise(PlanarRigidBody(given), run.measurements, {}, 0.0, o);
+  ASSERT_EQ(r.parameters.size(), 1u);
+  EXPECT_EQ(r.parameters[0].method, "em");
+  EXPECT_TRUE(r.prior_converged);
+  EXPECT_EQ(r.evaluations, 0);  // no likelihood stage: only the prior was asked for
+  const double s = r.parameters[0].value;
+  given.bias_sd = s;
+  const OfflineRun batch = runOffline(PlanarRigidBody(given), EstimatorOptions(Method::Batch), run.measurements);
+  const Eigen::VectorXd m = batch.rows.back().mean.tail(24);
+  const Eigen::MatrixXd P = batch.rows.back().covariance.bottomRightCorner(24, 24);
+  const Eigen::MatrixXd Sigma = PlanarRigidBody(given).priorConstants().covariance;
+  const Eigen::MatrixXd Si = Sigma.inverse(), S = P + m * m.transpose();
+  const double gradient = 0.5 * (Si * S * Si).trace() - 0.5 * Si.trace();
+  EXPECT_LT(std::abs(gradient), 1e-3 * Si.trace()) << "σ = " << s;
+  // The spread of the drawn biases about their mean (what 24 draws show).
+  const Eigen::VectorXd b = run.constants;
+  const double spread = std::sqrt((b.array() - b.mean()).square().sum() / 23.0);
+  std::printf("bias_sd learnt %g ± %g in %d E-steps (drawn with %g, the 24 draws' spread %g), dQ/dσ² %g\n", s,
+              r.parameters[0].standard_error, r.prior_iterations, truth.bias_sd, spread, gradient);
+  EXPECT_NEAR(s, spread, 0.15 * spread);
+  EXPECT_LT(std::abs(s - truth.bias_sd), 3 * r.parameters[0].standard_error)
+      << s << " ± " << r.parameters[0].standard_error << ", drawn with " << truth.bias_sd;
 }

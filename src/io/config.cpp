@@ -118,6 +118,12 @@ void readBatch(const IniDocument& ini, BatchSolverOptions& o) {
 }
 }  // namespace
 
+BatchSolverOptions batchOptions(const IniDocument& ini) {
+  BatchSolverOptions o;
+  readBatch(ini, o);
+  return o;
+}
+
 Method parseMethod(const std::string& text, const std::string& where) {
   if (const auto m = methodNamed(text)) return *m;
   throw InputError(where + " = '" + text + "': unknown method (known: " + methodNameList() + ")");

@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 
 std::vector<std::string> learnIniKeys() {
   return {"enabled",   "parameters",   "start",        "search_range",   "outliers",
-          "max_evaluations", "tolerance", "max_restarts", "standard_errors"};
+          "max_evaluations", "tolerance", "max_restarts", "standard_errors", "prior_iterations", "prior_tolerance"};
 }
 
 LearnSettings learnSettings(const IniDocument& ini) {
@@ -33,6 +33,9 @@ LearnSettings learnSettings(const IniDocument& ini) {
   o.tolerance = ini.getDouble("learn", "tolerance", o.tolerance);
   o.max_restarts = static_cast<int>(ini.getInt("learn", "max_restarts", o.max_restarts));
   o.standard_errors = ini.getBool("learn", "standard_errors", o.standard_errors);
+  o.prior_iterations = static_cast<int>(ini.getInt("learn", "prior_iterations", o.prior_iterations));
+  o.prior_tolerance = ini.getDouble("learn", "prior_tolerance", o.prior_tolerance);
+  o.batch = batchOptions(ini);  // the E-steps solve as the run's batch does
   std::string why;
   if (!o.validate(&why)) {
     std::string key = "start";  // the key the message is about
@@ -70,7 +73,8 @@ std::vector<std::string> linesOf(const IniDocument& input) {
 
 std::string header(const NoiseLearningReport& r) {
   std::ostringstream os;
-  os << "# Noise learnt from the log by gssm (prediction-error maximum likelihood, docs/DESIGN.md §10);\n"
+  os << "# Noise learnt from the log by gssm (prediction-error maximum likelihood; the constants' prior by EM,\n"
+     << "# docs/DESIGN.md §10);\n"
      << "# data files are the dataset's: gssm-process --data <dataset> --config <this file>\n";
   std::istringstream summary(r.toString());
   for (std::string l; std::getline(summary, l);) os << "#   " << l << "\n";
@@ -116,11 +120,19 @@ std::string learnReportJson(const NoiseLearningReport& r, const std::string& dat
      << ", \"start\": " << jsonNumber(r.start_log_likelihood) << ", \"final\": " << jsonNumber(r.final_log_likelihood)
      << ", \"gaussian\": " << jsonNumber(r.gaussian_log_likelihood) << "},\n  \"outlier_probability\": "
      << jsonNumber(r.outlier_probability) << ",\n  \"outlier_stage_from\": " << r.mixture_from
+     << ",\n  \"constants_prior\": {\"method\": \"EM on the factor graph (batch posterior of x_b)\", \"e_steps\": "
+     << r.prior_iterations << ", \"converged\": " << (r.prior_converged ? "true" : "false")
+     << ", \"expected_log_prior\": [" << [&] {
+          std::string t;
+          for (std::size_t i = 0; i < r.prior_expected_log_prior.size(); ++i)
+            t += (i ? ", " : "") + jsonNumber(r.prior_expected_log_prior[i]);
+          return t;
+        }() << "]}"
      << ",\n  \"parameters\": [";
   for (std::size_t i = 0; i < r.parameters.size(); ++i) {
     const LearntParameter& p = r.parameters[i];
     os << (i ? "," : "") << "\n    {\"name\": " << jsonQuoted(p.name()) << ", \"section\": " << jsonQuoted(p.section)
-       << ", \"key\": " << jsonQuoted(p.key) << ", \"index\": " << p.index << ", \"given\": " << jsonNumber(p.given)
+       << ", \"key\": " << jsonQuoted(p.key) << ", \"index\": " << p.index << ", \"method\": " << jsonQuoted(p.method) << ", \"given\": " << jsonNumber(p.given)
        << ", \"start\": " << jsonNumber(p.start) << ", \"learnt\": " << jsonNumber(p.value)
        << ", \"standard_error\": " << jsonNumber(p.standard_error)
        << ", \"identifiable\": " << (p.identifiable ? "true" : "false") << ", \"note\": " << jsonQuoted(p.note) << "}";

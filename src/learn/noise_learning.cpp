@@ -11,6 +11,7 @@
 #include "gssm/core/error.h"
 #include "gssm/factors/problem.h"
 #include "gssm/model/registry.h"
+#include "learn/constants_prior.h"
 #include "learn/nelder_mead.h"
 
 namespace gssm {
@@ -30,6 +31,9 @@ bool NoiseLearningOptions::validate(std::string* why) const {
   if (!(tolerance > 0) || tolerance >= 1) return fail("tolerance must be in (0, 1)");
   if (max_restarts < 0) return fail("max_restarts must be >= 0");
   if (!(search_range > 1) || !std::isfinite(search_range)) return fail("search_range must be a factor > 1");
+  if (prior_iterations < 1) return fail("prior_iterations must be >= 1");
+  if (!(prior_tolerance > 0) || prior_tolerance >= 1) return fail("prior_tolerance must be in (0, 1)");
+  if (std::string b; !batch.validate(&b)) return fail(b);
   return true;  // the EKF options are checked against the model when the filter is made
 }
 
@@ -64,8 +68,11 @@ bool selected(const LearntParameter& p, const std::vector<std::string>& names) {
   if (names.empty()) return true;
   LearntParameter whole = p;
   whole.index = -1;
+  // A key of a top-level section also by itself ("bias_sd" for "prior bias_sd").
+  const bool top = p.section.find('.') == std::string::npos;
   for (const auto& n : names)
-    if (n == p.name() || n == whole.name()) return true;
+    if (n == p.name() || n == whole.name() || (top && (n == p.key || (p.index >= 0 && n == p.key + "[" + std::to_string(p.index) + "]"))))
+      return true;
   return false;
 }
 
@@ -82,6 +89,7 @@ std::vector<LearntParameter> learnableParameters(const ModelType& type, const Pa
     if (!spec || !spec->learnable) continue;
     if (spec->kind == ParamKind::Real) {
       add(section, key, -1, values.real(section, key));
+      if (spec->constants_prior) out.back().method = "em";
       continue;
     }
     const Eigen::MatrixXd M = values.matrix(section, key);
@@ -109,27 +117,6 @@ std::vector<LearntParameter> chosenParameters(const ModelType& type, const Param
   if (out.empty()) throw InvalidArgument("model '" + type.name + "' declares no learnable noise parameter");
   for (auto& p : out) p.start = o.start > 0 ? o.start : p.given;
   return out;
-}
-
-// The values with the chosen σs set: a Real directly; a Matrix as D M D with
-// D = diag(σ_new / σ_given) on its learnt entries (correlations kept).
-ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParameter>& ps, const Eigen::VectorXd& sigmas) {
-  ParamValues v = base;
-  std::map<std::pair<std::string, std::string>, Eigen::VectorXd> scales;
-  for (std::size_t i = 0; i < ps.size(); ++i) {
-    const LearntParameter& p = ps[i];
-    const double sigma = sigmas[static_cast<Eigen::Index>(i)];
-    if (p.index < 0) {
-      v.real(p.section, p.key, sigma);
-      continue;
-    }
-    auto& d = scales[{p.section, p.key}];
-    if (d.size() == 0) d = Eigen::VectorXd::Ones(base.matrix(p.section, p.key).rows());
-    d[p.index] = sigma / p.given;
-  }
-  for (const auto& [where, d] : scales)
-    v.matrix(where.first, where.second, d.asDiagonal() * base.matrix(where.first, where.second) * d.asDiagonal());
-  return v;
 }
 
 struct Objective {
@@ -301,6 +288,27 @@ void finish(Objective& obj, const Eigen::VectorXd& theta, const NoiseLearningOpt
 }
 }  // namespace
 
+namespace internal {
+ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParameter>& ps, const Eigen::VectorXd& sigmas) {
+  ParamValues v = base;
+  std::map<std::pair<std::string, std::string>, Eigen::VectorXd> scales;
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    const LearntParameter& p = ps[i];
+    const double sigma = sigmas[static_cast<Eigen::Index>(i)];
+    if (p.index < 0) {
+      v.real(p.section, p.key, sigma);
+      continue;
+    }
+    auto& d = scales[{p.section, p.key}];
+    if (d.size() == 0) d = Eigen::VectorXd::Ones(base.matrix(p.section, p.key).rows());
+    d[p.index] = sigma / p.given;
+  }
+  for (const auto& [where, d] : scales)
+    v.matrix(where.first, where.second, d.asDiagonal() * base.matrix(where.first, where.second) * d.asDiagonal());
+  return v;
+}
+}  // namespace internal
+
 NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Measurement>& measurements,
                                const std::vector<Input>& inputs, double t0, const NoiseLearningOptions& o) {
   std::string why;
@@ -359,29 +367,44 @@ NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement
                           "' has no registered type, so no declared learnable parameters (pass a NoiseFamily)");
   const ParamValues base = ParamValues::of(model);
   NoiseFamily family;
-  family.parameters = chosenParameters(*type, base, o);
-  family.given.resize(static_cast<Eigen::Index>(family.parameters.size()));
-  for (std::size_t i = 0; i < family.parameters.size(); ++i) {
-    family.names.push_back(family.parameters[i].name());
-    family.given[static_cast<Eigen::Index>(i)] = family.parameters[i].given;
-  }
+  std::vector<LearntParameter> prior;  // σs of the constants' prior: by EM after the noise
+  for (auto& p : chosenParameters(*type, base, o)) (p.method == "em" ? prior : family.parameters).push_back(p);
   const std::string type_name = type->name;
-  family.make = [&base, &family, type_name](const Eigen::VectorXd& sigmas) -> std::shared_ptr<const Model> {
-    return withSigmas(base, family.parameters, sigmas).build(type_name);
-  };
-  NoiseLearningReport r = learnNoise(family, measurements, inputs, t0, o);
-  Eigen::VectorXd sigmas(static_cast<Eigen::Index>(r.parameters.size()));
-  for (std::size_t i = 0; i < r.parameters.size(); ++i) sigmas[static_cast<Eigen::Index>(i)] = r.parameters[i].value;
-  r.values = withSigmas(base, r.parameters, sigmas);
+  NoiseLearningReport r;
+  if (family.parameters.empty()) {
+    r.values = base;
+    r.measurements = measurements.size();
+    r.converged = true;
+  } else {
+    family.given.resize(static_cast<Eigen::Index>(family.parameters.size()));
+    for (std::size_t i = 0; i < family.parameters.size(); ++i) {
+      family.names.push_back(family.parameters[i].name());
+      family.given[static_cast<Eigen::Index>(i)] = family.parameters[i].given;
+    }
+    family.make = [&base, &family, type_name](const Eigen::VectorXd& sigmas) -> std::shared_ptr<const Model> {
+      return internal::withSigmas(base, family.parameters, sigmas).build(type_name);
+    };
+    r = learnNoise(family, measurements, inputs, t0, o);
+    Eigen::VectorXd sigmas(static_cast<Eigen::Index>(r.parameters.size()));
+    for (std::size_t i = 0; i < r.parameters.size(); ++i) sigmas[static_cast<Eigen::Index>(i)] = r.parameters[i].value;
+    r.values = internal::withSigmas(base, r.parameters, sigmas);
+  }
+  if (!prior.empty()) internal::learnConstantsPrior(type_name, prior, measurements, inputs, t0, o, r);
+  if (!r.model) r.model = r.values.build(type_name);
   return r;
 }
 
 std::string NoiseLearningReport::toString() const {
   std::ostringstream os;
-  os << "noise learnt by prediction-error maximum likelihood from " << measurements << " measurements: log-likelihood "
-     << start_log_likelihood << " -> " << final_log_likelihood << " (at the given values " << given_log_likelihood
-     << "), " << evaluations << " EKF passes, " << restarts << " restarts, " << (converged ? "converged" : "NOT converged")
-     << ", " << seconds << " s\n";
+  if (evaluations > 0)
+    os << "noise learnt by prediction-error maximum likelihood from " << measurements << " measurements: log-likelihood "
+       << start_log_likelihood << " -> " << final_log_likelihood << " (at the given values " << given_log_likelihood
+       << "), " << evaluations << " EKF passes, " << restarts << " restarts, "
+       << (converged ? "converged" : "NOT converged") << ", " << seconds << " s\n";
+  if (prior_iterations > 0)
+    os << "constants' prior learnt by EM on the factor graph: " << prior_iterations << " E-steps (batch solves), "
+       << (prior_converged ? "converged" : "NOT converged") << ", expected log prior "
+       << prior_expected_log_prior.front() << " -> " << prior_expected_log_prior.back() << "\n";
   if (mixture_from > 0)
     os << "  outliers: a fraction " << outlier_probability << " of the measurements (Gaussian-only log-likelihood "
        << gaussian_log_likelihood << ")\n";
@@ -389,6 +412,7 @@ std::string NoiseLearningReport::toString() const {
     os << "  " << p.name() << ": " << p.start << " -> " << p.value;
     if (std::isfinite(p.standard_error)) os << " ± " << p.standard_error;
     os << " (given " << p.given << ")";
+    if (p.method == "em") os << " [EM]";
     if (!p.identifiable) os << "  [not identifiable: " << p.note << "]";
     os << "\n";
   }

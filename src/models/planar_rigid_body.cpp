@@ -46,6 +46,8 @@ ModelNoise bodyNoise(const PlanarRigidBody::Params& p) {
   for (double v : {p.accel_sd, p.yaw_accel_sd, p.range_sd, p.position_sd, p.yaw_sd, p.velocity_sd, p.omega_sd,
                    p.bias_sd, p.range_scale_sd, p.T})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("PlanarRigidBody: every σ and T must be > 0");
+  if (!(p.bias_common_sd >= 0) || !std::isfinite(p.bias_common_sd))
+    throw InvalidArgument("PlanarRigidBody: bias_common_sd must be >= 0 (0: the links' biases independent)");
   ModelNoise n;
   n.T = p.T;
   n.Q = whiteAcceleration(p.accel_sd, p.yaw_accel_sd, p.T);
@@ -57,7 +59,12 @@ ModelNoise bodyNoise(const PlanarRigidBody::Params& p) {
   const int nb = countConstants(p);
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(nb), bsd = Eigen::VectorXd::Constant(nb, p.bias_sd);
   if (p.range_scale) bmean[nb - 1] = 1, bsd[nb - 1] = p.range_scale_sd;
-  n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
+  Eigen::MatrixXd P = bsd.cwiseAbs2().asDiagonal();
+  // b_ij = c + d_ij: the part all links share (c ~ N(0, σ_c²)) marginalized
+  // out of the prior, so every link keeps its own node and its own factors.
+  const int nl = p.link_biases ? nb - (p.range_scale ? 1 : 0) : 0;
+  P.topLeftCorner(nl, nl).array() += p.bias_common_sd * p.bias_common_sd;
+  n.prior_constants = {bmean, P};
   return n;
 }
 }  // namespace
@@ -204,7 +211,8 @@ std::vector<ParamSpec> bodyParams() {
                   real("prior", "position_sd", "prior σ of px and py (m)"), real("prior", "yaw_sd", "prior σ of yaw"),
                   real("prior", "velocity_sd", "prior σ of vx, vy (m/s)"),
                   real("prior", "omega_sd", "prior σ of the yaw rate (rad/s)"),
-                  real("prior", "bias_sd", "prior σ of each link bias (mean 0), m"),
+                  learnablePrior(real("prior", "bias_sd", "prior σ of each link's own bias (about the common part), m")),
+                  real("prior", "bias_common_sd", "prior σ of a bias every link shares (0: none), m"),
                   real("prior", "range_scale_sd", "prior σ of the range scale (mean 1)")})
     p.push_back(q);
   return p;
@@ -240,7 +248,7 @@ PlanarRigidBody::Params readBody(const ParamSource& in) {
   }
   for (auto [key, value] : {std::pair{"position_sd", &p.position_sd}, {"yaw_sd", &p.yaw_sd},
                             {"velocity_sd", &p.velocity_sd}, {"omega_sd", &p.omega_sd}, {"bias_sd", &p.bias_sd},
-                            {"range_scale_sd", &p.range_scale_sd}})
+                            {"bias_common_sd", &p.bias_common_sd}, {"range_scale_sd", &p.range_scale_sd}})
     *value = in.real("prior", key, *value);
   return p;
 }
@@ -265,7 +273,7 @@ void writeBody(const PlanarRigidBody::Params& p, ParamSink& out) {
   out.vector("prior", "start", p.start);
   for (auto [key, value] : {std::pair{"position_sd", p.position_sd}, {"yaw_sd", p.yaw_sd},
                             {"velocity_sd", p.velocity_sd}, {"omega_sd", p.omega_sd}, {"bias_sd", p.bias_sd},
-                            {"range_scale_sd", p.range_scale_sd}})
+                            {"bias_common_sd", p.bias_common_sd}, {"range_scale_sd", p.range_scale_sd}})
     out.real("prior", key, value);
 }
 

@@ -3,7 +3,10 @@
 batch smoother's body-origin and yaw RMSE against the issue's targets, its 24
 learnt link biases against the source repository's calibration runs
 (bias + slope x the link's mean true distance, computed here from the truth),
-and the estimates' columns; the EKF runs over the whole log.
+and the estimates' columns; the links' spread learnt by EM before each run
+(learn.json, the learnt scenario.ini); the fixed lag's online estimates
+(each when its epoch arrives) against the online target; the EKF runs over
+the whole log.
 
     process_uwb.py BIN_DIR SOURCE_DIR WORK_DIR
 """
@@ -71,6 +74,18 @@ check(len(diff) == 24 and rms <= 0.020, "24 learnt link biases %.2f cm RMS from 
 header = open(os.path.join(out, "estimates-batch.csv")).readline().strip().split(",")
 check(header[:4] == ["t", "px", "py", "yaw"] and "bias_2_7" in header and "sd_bias_2_7" in header,
       "estimates columns t, px, py, yaw, bias_<tag>_<anchor> and their sd_")
+learnt = json.load(open(os.path.join(out, "learn.json")))
+spread = [p for p in learnt["parameters"] if p["key"] == "bias_sd"]
+check(len(spread) == 1 and spread[0]["method"] == "em" and learnt["constants_prior"]["converged"]
+      and 0 < spread[0]["learnt"] < spread[0]["start"],
+      "the links' spread learnt by EM first: bias_sd %.4f +- %.4f m" % (spread[0]["learnt"], spread[0]["standard_error"]))
+check("bias_sd = " in open(os.path.join(out, "scenario.ini")).read(), "the learnt scenario.ini written beside the estimates")
+r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--method", "fixed-lag", "--out", out],
+                   capture_output=True, text=True)
+f = json.load(open(os.path.join(out, "metrics.json")))["methods"]["fixed-lag"]
+check(r.returncode == 0 and f["position_error_m"]["rmse"] <= 0.057,
+      "fixed lag online (each estimate when its epoch arrives): origin RMSE %.2f cm <= 5.7 cm"
+      % (100 * f["position_error_m"]["rmse"]))
 r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--method", "ekf", "--out", out],
                    capture_output=True, text=True)
 e = json.load(open(os.path.join(out, "metrics.json")))["methods"]["ekf"]

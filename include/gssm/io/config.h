@@ -50,6 +50,8 @@ Method parseMethod(const std::string& text, const std::string& where);
 /// bad value is an InputError naming file, section and key.
 EstimatorOptions estimatorOptions(const IniDocument& ini, const Model& model,
                                   Method method = Method::FixedLag);
+/// The [batch] section's solver options alone (as estimatorOptions reads them).
+BatchSolverOptions batchOptions(const IniDocument& ini);
 /// Writes every method's settings into its section (the keys estimatorOptions
 /// reads; a wildfire threshold of ∞, the default, is left out).
 void writeEstimatorOptions(const EstimatorOptions& options, IniDocument& ini);

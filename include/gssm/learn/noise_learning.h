@@ -20,6 +20,7 @@
 #include "gssm/core/data.h"
 #include "gssm/model/model.h"
 #include "gssm/model/param_values.h"
+#include "gssm/solvers/batch_solver.h"
 #include "gssm/solvers/ekf.h"
 
 namespace gssm {
@@ -40,6 +41,10 @@ struct LearntParameter {
   /// exceeds 100%, or it trades off with another (|correlation| > 0.95).
   bool identifiable = true;
   std::string note;     ///< why it is flagged, naming the other parameter
+  /// How it was learnt: "likelihood" (the EKF's prediction-error
+  /// likelihood) or "em" (a σ of the constants' prior, by EM on the batch
+  /// posterior of x_b).
+  std::string method = "likelihood";
   /// "range_sd", "Q[1]", "channel.gps R[0]".
   std::string name() const;
 };
@@ -67,6 +72,13 @@ struct NoiseLearningOptions {
   bool outliers = false;
   /// Curvature and standard errors at the maximum (2p² further passes).
   bool standard_errors = true;
+  /// EM for the σs of the constants' prior (ParamSpec::constants_prior):
+  /// at most this many E-steps (batch solves); converged when no σ changes
+  /// by more than prior_tolerance, relative.
+  int prior_iterations = 20;
+  double prior_tolerance = 1e-3;
+  /// The batch solver of the E-steps.
+  BatchSolverOptions batch;
   /// The filter the likelihood is computed with (its gates are not applied:
   /// a gated Gaussian likelihood grows without bound as σ → 0).
   ExtendedKalmanFilterOptions ekf;
@@ -89,6 +101,12 @@ struct NoiseLearningReport {
   int iterations = 0;
   int restarts = 0;
   bool converged = false;  ///< false: stopped at max_evaluations
+  /// EM for the constants' prior (0 iterations: none learnt): the expected
+  /// complete-data log prior E[log p(x_b | σ)] after each M-step (never
+  /// decreasing for a fixed posterior), E-steps run, converged.
+  std::vector<double> prior_expected_log_prior;
+  int prior_iterations = 0;
+  bool prior_converged = false;
   double seconds = 0;
   std::size_t measurements = 0;
   ParamValues values;                  ///< every parameter of the learnt model

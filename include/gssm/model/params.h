@@ -42,6 +42,10 @@ struct ParamSpec {
   /// standard deviation (> 0, in its unit); a Matrix a covariance whose
   /// diagonal scales are fitted (each entry a variance, correlations kept).
   bool learnable = false;
+  /// A learnable σ of the constants' prior (their spread across links,
+  /// say): learnt by EM on the factor graph from the batch posterior of
+  /// x_b (docs/DESIGN.md §10), not by the filter's likelihood.
+  bool constants_prior = false;
   std::string pythonKey() const { return pythonKeyOf(section, key); }
 };
 
@@ -72,6 +76,12 @@ inline ParamSpec sections(std::string s, std::string k, std::string subsection, 
 /// The same declaration, marked as a noise level that can be learnt.
 inline ParamSpec learnable(ParamSpec p) {
   p.learnable = true;
+  return p;
+}
+/// The same declaration, marked as a σ of the constants' prior that can be
+/// learnt (by EM on the factor graph).
+inline ParamSpec learnablePrior(ParamSpec p) {
+  p.learnable = p.constants_prior = true;
   return p;
 }
 /// The same declaration, without a default: the source must give it.

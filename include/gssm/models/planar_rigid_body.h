@@ -36,7 +36,12 @@ class PlanarRigidBody final : public Model {
     double ekf_gate = 0;                    ///< EKF NIS gate of every range (0: none)
     Eigen::Vector3d start{0, 0, 0};         ///< prior mean of [px, py, yaw]
     double position_sd = 3.0, yaw_sd = M_PI, velocity_sd = 1.0, omega_sd = 1.0;  ///< prior σ
-    double bias_sd = 0.3;                   ///< prior σ of each bias (mean 0), m
+    /// Prior of the biases, mean 0: b_ij = c + d_ij with a part c every link
+    /// shares (σ bias_common_sd; UWB links all read long by antenna delay)
+    /// and each link's own part d_ij (σ bias_sd), i.e. covariance
+    /// bias_sd²·I + bias_common_sd²·11ᵀ (m).
+    double bias_sd = 0.3;
+    double bias_common_sd = 0.0;
     double range_scale_sd = 0.05;           ///< prior σ of the scale (mean 1)
   };
 

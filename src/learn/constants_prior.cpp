@@ -1,0 +1,120 @@
+#include "learn/constants_prior.h"
+
+#include <Eigen/Cholesky>
+#include <chrono>
+#include <cmath>
+
+#include "gssm/core/error.h"
+#include "gssm/factors/problem.h"
+#include "learn/nelder_mead.h"
+
+namespace gssm::internal {
+
+namespace {
+// −Q(σ) at θ = log σ (+∞ where the prior is not positive definite).
+struct ExpectedLogPrior {
+  const ParamValues& base;
+  const std::vector<LearntParameter>& params;
+  const std::string& type_name;
+  Eigen::VectorXd m;
+  Eigen::MatrixXd P;
+
+  double negative(const Eigen::VectorXd& theta) const {
+    if (!theta.allFinite()) return std::numeric_limits<double>::infinity();
+    try {
+      const Gaussian g = withSigmas(base, params, theta.array().exp().matrix()).build(type_name)->priorConstants();
+      const Eigen::LLT<Eigen::MatrixXd> llt(g.covariance);
+      if (llt.info() != Eigen::Success) return std::numeric_limits<double>::infinity();
+      const Eigen::VectorXd d = m - g.mean;
+      const Eigen::MatrixXd S = P + d * d.transpose();
+      const double logdet = 2 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
+      return 0.5 * (logdet + llt.solve(S).trace());
+    } catch (const Error&) {
+      return std::numeric_limits<double>::infinity();
+    }
+  }
+};
+
+// E-step: the batch posterior of x_b under `model`, from x (kept as the next start).
+void posteriorOfConstants(const Model& model, const std::vector<Measurement>& ms, const std::vector<Input>& inputs,
+                          double t0, const BatchSolverOptions& batch, Values& x, ExpectedLogPrior& q) {
+  const Problem p = buildProblem(model, ms, inputs, t0);
+  BatchSolver solver(batch);
+  solver.solve(p.graph, x);
+  q.m = x.at(Key::constants());
+  q.P = solver.marginalCovariance(Key::constants());
+}
+
+// Standard errors from the curvature of Q in log σ: the complete-data
+// information, so they are lower bounds (the batch posterior's own
+// uncertainty about x_b is small beside the spread when it matters).
+void standardErrorsOfQ(const ExpectedLogPrior& q, const Eigen::VectorXd& theta, std::vector<LearntParameter>& ps) {
+  const Eigen::Index n = theta.size();
+  const double h = 1e-3, f0 = q.negative(theta);
+  Eigen::MatrixXd H(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) {
+      Eigen::VectorXd a = theta, b = theta, c = theta, d = theta;
+      a[i] += h, a[j] += h, b[i] += h, b[j] -= h, c[i] -= h, c[j] += h, d[i] -= h, d[j] -= h;
+      H(i, j) = i == j ? (q.negative(a) - 2 * f0 + q.negative(d)) / (4 * h * h)
+                       : (q.negative(a) - q.negative(b) - q.negative(c) + q.negative(d)) / (4 * h * h);
+    }
+  const Eigen::LLT<Eigen::MatrixXd> llt(H);
+  if (llt.info() != Eigen::Success) {
+    for (auto& p : ps) p.identifiable = false, p.note = "the expected log prior is flat here";
+    return;
+  }
+  const Eigen::MatrixXd C = llt.solve(Eigen::MatrixXd::Identity(n, n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    LearntParameter& p = ps[static_cast<std::size_t>(i)];
+    p.standard_error = p.value * std::sqrt(C(i, i));
+    if (p.standard_error > p.value) p.identifiable = false, p.note = "relative standard error > 100%";
+  }
+}
+}  // namespace
+
+void learnConstantsPrior(const std::string& type_name, std::vector<LearntParameter> params,
+                         const std::vector<Measurement>& measurements, const std::vector<Input>& inputs, double t0,
+                         const NoiseLearningOptions& o, NoiseLearningReport& r) {
+  const auto started = std::chrono::steady_clock::now();
+  const ParamValues base = r.values;
+  const auto n = static_cast<Eigen::Index>(params.size());
+  Eigen::VectorXd theta(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    LearntParameter& p = params[static_cast<std::size_t>(i)];
+    p.start = o.start > 0 ? o.start : p.given;
+    if (!(p.start > 0))
+      throw InvalidArgument("learning " + p.name() + ": it is 0 in the model; give a start ([learn] start) or a value > 0");
+    theta[i] = std::log(p.start);
+  }
+  ExpectedLogPrior q{base, params, type_name, {}, {}};
+  std::shared_ptr<const Model> model = withSigmas(base, params, theta.array().exp().matrix()).build(type_name);
+  Values x = ekfInitialGuess(*model, o.ekf, measurements, inputs, t0);
+  r.prior_converged = false;
+  for (r.prior_iterations = 1; r.prior_iterations <= o.prior_iterations; ++r.prior_iterations) {
+    posteriorOfConstants(*model, measurements, inputs, t0, o.batch, x, q);
+    const NelderMeadResult m = nelderMead([&q](const Eigen::VectorXd& t) { return q.negative(t); }, theta, 0.5,
+                                          200 * static_cast<int>(n + 1), 1e-12, 1e-9);
+    const double change = ((m.x - theta).array().abs()).maxCoeff();  // in log σ: relative
+    theta = m.x;
+    r.prior_expected_log_prior.push_back(-m.value);
+    model = withSigmas(base, params, theta.array().exp().matrix()).build(type_name);
+    if (change <= o.prior_tolerance) {
+      r.prior_converged = true;
+      break;
+    }
+  }
+  r.prior_iterations = std::min(r.prior_iterations, o.prior_iterations);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    LearntParameter& p = params[static_cast<std::size_t>(i)];
+    p.value = std::exp(theta[i]);
+    p.method = "em";
+  }
+  if (o.standard_errors) standardErrorsOfQ(q, theta, params);
+  r.values = withSigmas(base, params, theta.array().exp().matrix());
+  r.model = model;
+  r.parameters.insert(r.parameters.end(), params.begin(), params.end());
+  r.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
+}  // namespace gssm::internal
