@@ -254,9 +254,11 @@ TEST(Checkpoint, ForeignModelVersionAndFileErrorsNameTheCause) {
   p.r *= 2;
   const models::Radar2D other(p);
   EXPECT_NE(errorOf([&] { restoreCheckpointBytes(other, bytes); }).find("other noise or prior"), std::string::npos);
-  std::string v4 = bytes;
-  v4[8] = 4;  // a newer format than this build reads
-  EXPECT_NE(errorOf([&] { restoreCheckpointBytes(radar, v4); }).find("format version 4, this build reads versions 1 to 3"),
+  std::string newer = bytes;
+  newer[8] = static_cast<char>(kCheckpointVersion + 1);  // a newer format than this build reads
+  EXPECT_NE(errorOf([&] { restoreCheckpointBytes(radar, newer); })
+                .find("format version " + std::to_string(kCheckpointVersion + 1) + ", this build reads versions 1 to " +
+                      std::to_string(kCheckpointVersion)),
             std::string::npos);
   EXPECT_NE(errorOf([&] { restoreCheckpoint(radar, "/nonexistent/run.ckpt"); }).find("cannot open checkpoint '/nonexistent/run.ckpt'"), std::string::npos);
   EXPECT_NE(errorOf([&] { restoreCheckpointBytes(radar, "GSSMCKPT"); }).find("truncated while reading format version"), std::string::npos);

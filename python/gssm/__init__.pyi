@@ -30,6 +30,7 @@ class SmootherOptions:
     relinearize: bool
     relinearize_threshold: float
     constants_check_sigmas: float
+    full_pass_growth: float
     max_local_iterations: int
     wildfire_threshold: float
     iterate_to_convergence: bool

@@ -32,6 +32,8 @@ class SmootherCore {
   double reEliminateUndamped(UpdateReport& rep, internal::EngineCounts& counts, double cost);
   void newtonPolishTree(UpdateReport& rep, internal::EngineCounts& counts, double cost);
   Eigen::VectorXd constants_at_last_check_;
+  // Variables held at the last full pass and added since (full_pass_growth).
+  std::int64_t held_at_last_pass_ = 0, added_since_pass_ = 0;
   // Per-update buffers kept for their capacity (not state: not saved).
   internal::EngineCounts counts_;
   std::vector<int> local_slots_;

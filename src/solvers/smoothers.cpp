@@ -42,6 +42,7 @@ bool SmootherOptions::validate(std::string* why) const {
   };
   if (!(relinearize_threshold > 0)) return fail("relinearize_threshold must be > 0");
   if (!(constants_check_sigmas > 0)) return fail("constants_check_sigmas must be > 0");
+  if (!(full_pass_growth >= 1) || !std::isfinite(full_pass_growth)) return fail("full_pass_growth must be >= 1");
   // Upper bounds: values beyond them only make an update run for minutes
   // (a checkpoint fuzzer found max_local_iterations = 4194307).
   if (max_local_iterations < 0 || max_local_iterations > 100)
@@ -240,6 +241,7 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
   u.remove = remove_slots;
   engine.update(u, counts);  // may throw: nothing changed
   rep.iterations = 1;
+  added_since_pass_ += static_cast<std::int64_t>(new_values.size());
 
   if (!options.relinearize) {
     // keep every linearization as added
@@ -270,11 +272,15 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
         const Eigen::VectorXd sd =
             engine.pathMarginalCovariance({Key::constants()}).diagonal().cwiseSqrt();
         const double moved = ((xb - constants_at_last_check_).cwiseAbs().array() / sd.array()).maxCoeff();
-        if (moved > options.constants_check_sigmas) {
+        const bool grown = static_cast<double>(added_since_pass_) >=
+                           (options.full_pass_growth - 1) * static_cast<double>(held_at_last_pass_);
+        if (moved > options.constants_check_sigmas && grown) {
           counts.variables_backsubstituted += engine.solveAll();
           relinearize(engine.nonlinearSlots(), options.relinearize_threshold, rep, counts);
           rep.relinearization_pass = true;
           constants_at_last_check_ = engine.estimate(Key::constants());
+          held_at_last_pass_ = static_cast<std::int64_t>(engine.numVariables());
+          added_since_pass_ = 0;
         }
       }
     }
@@ -383,6 +389,8 @@ void SmootherCore::save(internal::ByteWriter& out) const {
   UpdateReport copy = last;
   internal::fields(w, copy);
   out.vec(constants_at_last_check_);
+  out.i64(held_at_last_pass_);  // format 4
+  out.i64(added_since_pass_);
 }
 
 void SmootherCore::load(internal::ByteReader& in, const Model& model) {
@@ -393,9 +401,16 @@ void SmootherCore::load(internal::ByteReader& in, const Model& model) {
   internal::fields(reader, r);
   Eigen::VectorXd c = in.vec("constants at the last relinearization check");
   if (c.size() != 0 && c.size() != model.dims().nb) in.fail("constants at the last check have the wrong size");
+  std::int64_t held = 0, added = 0;
+  if (in.version() >= 4) {
+    held = in.i64("variables held at the last full pass");
+    added = in.i64("variables added since the last full pass");
+    if (held < 0 || added < 0) in.fail("negative variable counts of the full-pass schedule");
+  }
   engine = std::move(e);
   last = std::move(r);
   constants_at_last_check_ = std::move(c);
+  held_at_last_pass_ = held, added_since_pass_ = added;
 }
 
 void Smoother::save(internal::ByteWriter& out) const { core_->save(out); }

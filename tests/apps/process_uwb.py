@@ -4,7 +4,8 @@ batch smoother's body-origin and yaw RMSE against the issue's targets, its 24
 learnt link biases against the source repository's calibration runs
 (bias + slope x the link's mean true distance, computed here from the truth),
 and the estimates' columns; the links' spread learnt by EM before each run
-(learn.json, the learnt scenario.ini); the fixed lag's online estimates
+(learn.json, the learnt scenario.ini); the fixed lag's and the incremental
+smoother's online estimates
 (each when its epoch arrives) against the online target; the EKF runs over
 the whole log.
 
@@ -80,12 +81,13 @@ check(len(spread) == 1 and spread[0]["method"] == "em" and learnt["constants_pri
       and 0 < spread[0]["learnt"] < spread[0]["start"],
       "the links' spread learnt by EM first: bias_sd %.4f +- %.4f m" % (spread[0]["learnt"], spread[0]["standard_error"]))
 check("bias_sd = " in open(os.path.join(out, "scenario.ini")).read(), "the learnt scenario.ini written beside the estimates")
-r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--method", "fixed-lag", "--out", out],
-                   capture_output=True, text=True)
-f = json.load(open(os.path.join(out, "metrics.json")))["methods"]["fixed-lag"]
-check(r.returncode == 0 and f["position_error_m"]["rmse"] <= 0.057,
-      "fixed lag online (each estimate when its epoch arrives): origin RMSE %.2f cm <= 5.7 cm"
-      % (100 * f["position_error_m"]["rmse"]))
+for method in ("fixed-lag", "incremental"):
+    r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--method", method, "--out", out],
+                       capture_output=True, text=True)
+    f = json.load(open(os.path.join(out, "metrics.json")))["methods"][method]
+    check(r.returncode == 0 and f["position_error_m"]["rmse"] <= 0.057,
+          "%s online (each estimate when its epoch arrives): origin RMSE %.2f cm <= 5.7 cm"
+          % (method, 100 * f["position_error_m"]["rmse"]))
 r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--method", "ekf", "--out", out],
                    capture_output=True, text=True)
 e = json.load(open(os.path.join(out, "metrics.json")))["methods"]["ekf"]

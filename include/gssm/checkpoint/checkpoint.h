@@ -30,8 +30,10 @@ namespace gssm {
 
 /// Version 2 added the EKF's count of gated measurements, version 3 the
 /// counts of late measurements and EstimatorOptions::drop_late; older files
-/// still restore (those start at 0 and false).
-constexpr std::uint32_t kCheckpointVersion = 3;
+/// still restore (those start at 0 and false). Version 4 the smoothers'
+/// full-pass schedule (SmootherOptions::full_pass_growth and its counts;
+/// older files resume with growth 1, a pass whenever the constants moved).
+constexpr std::uint32_t kCheckpointVersion = 4;
 
 /// What a checkpoint says about itself (filled by restore).
 struct CheckpointInfo {

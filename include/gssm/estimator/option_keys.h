@@ -37,6 +37,7 @@ void optionKeys(Visitor& v, SmootherOptions& o) {
   v("relinearize", o.relinearize);
   v("relinearize_threshold", o.relinearize_threshold);
   v("constants_check_sigmas", o.constants_check_sigmas);
+  v("full_pass_growth", o.full_pass_growth);
   v("max_local_iterations", o.max_local_iterations);
   v("wildfire_threshold", o.wildfire_threshold);
   v("iterate_to_convergence", o.iterate_to_convergence);

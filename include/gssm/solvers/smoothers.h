@@ -66,6 +66,15 @@ struct SmootherOptions {
   /// are checked (an O(n) pass) when the constants moved more than this many
   /// of their marginal standard deviations since the last such pass.
   double constants_check_sigmas = 1.0;
+  /// A full pass costs O(n): every factor checked, and the tree
+  /// re-eliminated from the oldest relinearized factor up (with constants
+  /// in every factor, old factors' robust weights and poses move with
+  /// them). > 1: a pass runs only once the variables added since the last
+  /// one reach (growth − 1) times those held then — at most log_growth(n)
+  /// passes, O(n) work in all, amortized O(1) per update (the fixed lag,
+  /// whose n is its window, every (growth − 1)·window states). 1: whenever
+  /// the constants moved.
+  double full_pass_growth = 1.0;
   /// Relinearize-and-re-eliminate rounds on the top per update (start-up).
   int max_local_iterations = 3;
   /// Back-substitution descends into a subtree only while the solution
