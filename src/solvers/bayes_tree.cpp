@@ -74,15 +74,27 @@ class KeyTable {
 // few-column systems of one clique, where Eigen's general kernels spent
 // more on dispatch and workspace than on arithmetic (13% of a fixed-lag
 // update; 3×4: 32 vs 633 ns, 16×17: 1.0 vs 4.8 µs, 80×81: 113 vs 94 µs).
-void triangularize(Eigen::MatrixXd& M) {
+void triangularize(Eigen::MatrixXd& M, std::vector<Eigen::Index>& last) {
   const Eigen::Index rows = M.rows(), cols = M.cols(), n = std::min(rows, cols);
   if (rows * cols > 48 * 49) {  // large cliques: Eigen's blocked, vectorized QR (faster from ~60 columns)
     Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(M);
     return;
   }
+  // Rows below the last one whose first nonzero is at or left of column k
+  // are still zero there and were never touched (the stacked marginals of
+  // the children are triangular): the reflection for column k skips them.
+  // Only exact zeros are skipped, so the result is bit for bit the same.
+  last.assign(static_cast<std::size_t>(cols), -1);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    Eigen::Index lead = 0;
+    while (lead < cols && M(i, lead) == 0.0) ++lead;
+    if (lead < cols) last[static_cast<std::size_t>(lead)] = i;
+  }
+  for (Eigen::Index k = 1; k < cols; ++k)
+    last[static_cast<std::size_t>(k)] = std::max(last[static_cast<std::size_t>(k)], last[static_cast<std::size_t>(k - 1)]);
   for (Eigen::Index k = 0; k < n; ++k) {
     double* x = &M(k, k);
-    const Eigen::Index m = rows - k;
+    const Eigen::Index m = std::max<Eigen::Index>(last[static_cast<std::size_t>(k)] + 1 - k, 1);
     double tail = 0;
     for (Eigen::Index i = 1; i < m; ++i) tail += x[i] * x[i];
     if (tail <= std::numeric_limits<double>::min()) continue;  // already triangular here: τ = 0
@@ -582,7 +594,7 @@ void BayesTreeEngine::eliminateVariable(UpdatePlan& p, EliminationQueue& q, std:
   }
   const double scale = std::max(1e-300, M.leftCols(dv).cwiseAbs().maxCoeff());
   // In place: M becomes R (upper triangle) and the Householder vectors.
-  triangularize(M);
+  triangularize(M, scratch_.last_row);
   const Eigen::Index rk = std::min(rows, ncols + 1);
   M.topRows(rk).triangularView<Eigen::StrictlyLower>().setZero();
   const auto Rfull = M.topRows(rk);

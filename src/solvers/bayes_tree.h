@@ -476,6 +476,7 @@ class BayesTreeEngine {
     std::vector<double> product;  // backSubstitute's S·δ_sep, as long as the widest frontal
     std::vector<Eigen::MatrixXd> J;  // a factor's Jacobian blocks, copied into its Ab
     Eigen::MatrixXd stacked;  // a clique's [A | b] while it is triangularized
+    std::vector<Eigen::Index> last_row;  // triangularize's: the last row each column's reflection reaches
     std::vector<Key> separator;
     std::vector<std::vector<std::size_t>> pending_of;  // eliminateTop's queue, per ordering entry
     std::vector<LinearView> pend;                      // eliminateTop's inputs, then the marginals it makes
