@@ -134,12 +134,21 @@ PlanarRigidBody::Params simulatedLayout() {
 }
 }  // namespace
 
-// The smoothers. The filters are overconfident here (measured: EKF 374,
-// fixed lag 353 of 480 within 2σ): their bias information comes from
-// linearizations at poses they no longer revisit, as in EKF-SLAM.
-TEST(PlanarRigidBody, SmoothersRecoverTheLinkBiasesWithinTwoSigmaOverSeeds) {
-  const PlanarRigidBody model(simulatedLayout());
-  for (Method method : {Method::Batch, Method::Incremental}) {
+// Every exact method, with the prior of the shipped scenario (the links'
+// own parts σ 0.06 about a part they share, σ 1 m; the biases drawn from
+// it). Measured: EKF 435, fixed lag 470, incremental 471, batch 470 of 480
+// within 2σ. With independent σ = 0.3 priors instead (no common part) the
+// filters were overconfident (EKF 374, fixed lag 353 of 480): at the start
+// (few links seen, the pose unknown) pose and biases trade off, and the
+// information they marginalized there came from linearizations at poses
+// they no longer revisit, as in EKF-SLAM. The paper window's diagonal
+// re-priors drop the biases' correlations: 46 of 480 (not tested here).
+TEST(PlanarRigidBody, EveryMethodRecoversTheLinkBiasesWithinTwoSigmaOverSeeds) {
+  PlanarRigidBody::Params p = simulatedLayout();
+  p.bias_sd = 0.06;
+  p.bias_common_sd = 1.0;
+  const PlanarRigidBody model(p);
+  for (Method method : {Method::Ekf, Method::FixedLag, Method::Incremental, Method::Batch}) {
     int inside = 0, total = 0;
     for (unsigned seed = 1; seed <= 20; ++seed) {
       const SimulatedRun run = layoutRun(model, seed, 1200);
@@ -152,6 +161,7 @@ TEST(PlanarRigidBody, SmoothersRecoverTheLinkBiasesWithinTwoSigmaOverSeeds) {
         inside += std::abs(err) <= 2 * std::sqrt(last.covariance(6 + b, 6 + b)) ? 1 : 0;
       }
     }
+    std::printf("%s: %d of %d biases within 2σ\n", methodName(method), inside, total);
     // 2σ holds ~95% of the time for a consistent estimator.
     EXPECT_GE(inside, 0.9 * total) << methodName(method) << ": " << inside << " of " << total << " biases within 2σ";
   }
