@@ -14,6 +14,9 @@ namespace gssm::internal {
 struct FactorColumns {
   std::vector<Eigen::Index> global;  ///< column of H
   std::vector<double> entries;       ///< the Jacobian, rows × size() column-major
+  /// After gather: the columns with a nonzero entry, ascending (a range's
+  /// Jacobian reaches 4 of its 30 columns: the pose's three and one bias).
+  std::vector<std::size_t> nonzero;
   Eigen::Index rows = 0;
   bool ascending = true;  ///< global columns strictly increase (a factor's keys in Key order)
   std::size_t size() const { return size_; }
@@ -38,6 +41,15 @@ struct FactorColumns {
       for (Eigen::Index i = 0; i < J[a].cols(); ++i) push(offs[a] + i);
       const double* in = J[a].data();
       for (Eigen::Index e = 0, size = J[a].size(); e < size; ++e) *out++ = in[e];  // a few: no memmove call
+    }
+    nonzero.clear();
+    for (std::size_t p = 0; p < size_; ++p) {
+      const double* col = column(p);
+      for (Eigen::Index r = 0; r < rows; ++r)
+        if (col[r] != 0.0) {
+          nonzero.push_back(p);
+          break;
+        }
     }
   }
   /// Column p's entries.
@@ -92,6 +104,21 @@ void forEachUpperJtJ(const FactorColumns& c, Emit&& emit) {
   forEachUpperPair(c, [&](std::size_t p, std::size_t q) {
     emit(c.global[p], c.global[q], c.dot(p, c.column(q)), p, q);
   });
+}
+
+/// forEachUpperJtJ over the gathered nonzero columns only: the entries it
+/// leaves out are exact zeros (the same sums where it emits; for callers
+/// that address entries by position, not by running index).
+template <class Emit>
+void forEachNonzeroUpperJtJ(const FactorColumns& c, Emit&& emit) {
+  const std::size_t* nz = c.nonzero.data();
+  const std::size_t n = c.nonzero.size();
+  for (std::size_t b = 0; b < n; ++b)
+    for (std::size_t a = 0; a < n; ++a) {
+      const std::size_t p = nz[a], q = nz[b];
+      if (c.ascending ? p > q : c.global[p] > c.global[q]) continue;
+      emit(c.global[p], c.global[q], c.dot(p, c.column(q)), p, q);
+    }
 }
 
 }  // namespace gssm::internal

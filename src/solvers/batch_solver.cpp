@@ -160,11 +160,29 @@ struct BatchSolver::Impl {
     std::vector<int> first(static_cast<std::size_t>(n));
     for (Eigen::Index j = 0; j < n; ++j) first[static_cast<std::size_t>(j)] = static_cast<int>(j);
     std::size_t added = 0;
-    forEachFactorEntry(graph.size(), [&](Eigen::Index i, Eigen::Index j) {
-      int& f = first[static_cast<std::size_t>(j)];
-      f = std::min(f, static_cast<int>(i));
-      ++added;
-    });
+    for (std::size_t fi = 0; fi < graph.size(); ++fi) {
+      const std::size_t count = offsetsOf(fi);
+      columns.place(factor_offs.data(), count, [&](std::size_t a) {
+        const std::size_t v = factor_vars[factor_begin[fi] + a];
+        return offset[v + 1] - offset[v];
+      });
+      const std::size_t m = columns.size();
+      if (!columns.ascending) {  // repeated columns: pair by pair
+        internal::forEachUpperPair(columns, [&](std::size_t p, std::size_t q) {
+          int& f = first[static_cast<std::size_t>(columns.global[q])];
+          f = std::min(f, static_cast<int>(columns.global[p]));
+          ++added;
+        });
+        continue;
+      }
+      // Every column's first row from this factor is its smallest column.
+      const int lowest = m ? static_cast<int>(columns.global[0]) : 0;
+      for (std::size_t q = 0; q < m; ++q) {
+        int& f = first[static_cast<std::size_t>(columns.global[q])];
+        f = std::min(f, lowest);
+      }
+      added += m * (m + 1) / 2;
+    }
     std::size_t size = 0;
     for (Eigen::Index j = 0; j < n; ++j) size += static_cast<std::size_t>(j - first[static_cast<std::size_t>(j)] + 1);
     use_envelope = n > 0 && size <= 2 * added + static_cast<std::size_t>(n);
@@ -262,9 +280,9 @@ struct BatchSolver::Impl {
       }
       cost += c;
       columns.gather(factor_offs.data(), J);
-      for (std::size_t p = 0; p < columns.size(); ++p) g[columns.global[p]] += columns.dot(p, r.data());
+      for (std::size_t p : columns.nonzero) g[columns.global[p]] += columns.dot(p, r.data());  // zero columns add 0
       if (use_envelope)
-        internal::forEachUpperJtJ(columns, [&](Eigen::Index i, Eigen::Index j, double v, auto...) {
+        internal::forEachNonzeroUpperJtJ(columns, [&](Eigen::Index i, Eigen::Index j, double v, auto...) {
           H[envelope.position(i, j)] += v;
         });
       else
