@@ -137,6 +137,8 @@ def learn(model_or_folder, data=None, *, out=None, config=None, parameters=None,
     out/scenario.ini (the input with the learnt values) and out/learn.json.
     parameters: names to learn ("range_sd", "Q", "Q[1]"; default every
     learnable one); start: every σ starts here (0: the model's values).
+    A σ of the constants' prior ("bias_sd" of PlanarRigidBody) is learnt by
+    EM on the factor graph (each E-step a batch solve): method "em".
 
     A model written in Python declares no parameters: pass a factory and
     the σs it takes, sigmas={"q": 0.1, "r": 0.5} (the given values); it is

@@ -211,6 +211,7 @@ class LearntParameter:
     standard_error: float
     identifiable: bool
     note: str
+    method: str
 
 class LearnReport:
     parameters: List[LearntParameter]
@@ -222,6 +223,8 @@ class LearnReport:
     iterations: int
     restarts: int
     converged: bool
+    prior_iterations: int
+    prior_converged: bool
     seconds: float
     model: Model
     params: Dict[str, object]

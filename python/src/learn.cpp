@@ -20,6 +20,8 @@ void bindReport(py::module_& m) {
       .def_readonly("standard_error", &LearntParameter::standard_error, "NaN where the log does not determine it")
       .def_readonly("identifiable", &LearntParameter::identifiable)
       .def_readonly("note", &LearntParameter::note, "why it is flagged")
+      .def_readonly("method", &LearntParameter::method,
+                    "'likelihood' (the EKF's prediction errors) or 'em' (a σ of the constants' prior)")
       .def("__repr__", [](const LearntParameter& p) {
         return "<gssm.LearntParameter " + p.name() + " = " + std::to_string(p.value) + ">";
       });
@@ -34,6 +36,9 @@ void bindReport(py::module_& m) {
       .def_readonly("iterations", &NoiseLearningReport::iterations)
       .def_readonly("restarts", &NoiseLearningReport::restarts)
       .def_readonly("converged", &NoiseLearningReport::converged)
+      .def_readonly("prior_iterations", &NoiseLearningReport::prior_iterations,
+                    "EM's E-steps (batch solves) for the constants' prior; 0: none learnt")
+      .def_readonly("prior_converged", &NoiseLearningReport::prior_converged)
       .def_readonly("seconds", &NoiseLearningReport::seconds)
       .def_property_readonly("model", [](const NoiseLearningReport& r) { return std::const_pointer_cast<Model>(r.model); },
                              "the learnt model")

@@ -90,6 +90,15 @@ def test_planar_rigid_body_from_keywords_and_from_the_uwb_log(repo):
     data = gssm.simulate(m, seed=3, steps=120, channels=[c.name for c in m.channels])
     run = gssm.run(m, data, method="batch")
     assert np.all(np.abs(run.mean[-1, 6:] - data.truth_x[-1, 6:]) < 4 * run.sd[-1, 6:])
+    # A part every link shares in the bias prior; a Gauss-Markov error state per link.
+    shared = gssm.models.PlanarRigidBody(anchors=anchors, tags=tags, height=1.0, prior_bias_sd=0.05, prior_bias_common_sd=0.4,
+                                         range_error_tau=0.2)
+    assert shared.nc == 12 and shared.state_names[6] == "err_0_0"
+    P = 0.05 ** 2 * np.eye(6) + 0.4 ** 2
+    np.testing.assert_allclose(shared.prior_constants[1], P, atol=1e-15)
+    spread = gssm.learn(m, data, parameters=["bias_sd"], start=0.3)
+    assert spread.parameters[0].method == "em" and spread.prior_converged and spread.prior_iterations >= 1
+    assert spread.evaluations == 0 and 0 < spread.parameters[0].value < 0.3
     uwb = gssm.io.read_dataset(os.path.join(repo, "datasets", "uwb-fast"))
     assert isinstance(uwb.model, gssm.models.PlanarRigidBody) and len(uwb.model.channels) == 24
     assert len(uwb) == 323514 and uwb.truth_x.shape[1] == 3
