@@ -122,6 +122,7 @@ std::string learnReportJson(const NoiseLearningReport& r, const std::string& dat
      << jsonNumber(r.outlier_probability) << ",\n  \"outlier_stage_from\": " << r.mixture_from
      << ",\n  \"constants_prior\": {\"method\": \"EM on the factor graph (batch posterior of x_b)\", \"e_steps\": "
      << r.prior_iterations << ", \"converged\": " << (r.prior_converged ? "true" : "false")
+     << ", \"expected_log_prior_at_start\": " << jsonNumber(r.prior_start_expected_log_prior)
      << ", \"expected_log_prior\": [" << [&] {
           std::string t;
           for (std::size_t i = 0; i < r.prior_expected_log_prior.size(); ++i)

@@ -93,6 +93,7 @@ void learnConstantsPrior(const std::string& type_name, std::vector<LearntParamet
   r.prior_converged = false;
   for (r.prior_iterations = 1; r.prior_iterations <= o.prior_iterations; ++r.prior_iterations) {
     posteriorOfConstants(*model, measurements, inputs, t0, o.batch, x, q);
+    if (r.prior_iterations == 1) r.prior_start_expected_log_prior = -q.negative(theta);
     const NelderMeadResult m = nelderMead([&q](const Eigen::VectorXd& t) { return q.negative(t); }, theta, 0.5,
                                           200 * static_cast<int>(n + 1), 1e-12, 1e-9);
     const double change = ((m.x - theta).array().abs()).maxCoeff();  // in log σ: relative

@@ -105,6 +105,7 @@ struct NoiseLearningReport {
   /// complete-data log prior E[log p(x_b | σ)] after each M-step (never
   /// decreasing for a fixed posterior), E-steps run, converged.
   std::vector<double> prior_expected_log_prior;
+  double prior_start_expected_log_prior = 0;  ///< Q at the start σ, at the first E-step's posterior
   int prior_iterations = 0;
   bool prior_converged = false;
   double seconds = 0;

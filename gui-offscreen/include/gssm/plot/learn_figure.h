@@ -1,6 +1,7 @@
 #pragma once
 // The figure of a noise learning (docs/DESIGN.md §10): the log-likelihood
-// per iteration, with the hand-given values' likelihood for comparison.
+// per iteration, with the hand-given values' likelihood for comparison; when
+// only the constants' prior was learnt, EM's expected log prior per E-step.
 #include <string>
 
 #include "gssm/learn/noise_learning.h"
