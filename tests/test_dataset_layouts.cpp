@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <iomanip>
 
+#include "gssm/analysis/metrics.h"
 #include "gssm/analysis/offline.h"
 #include "gssm/core/error.h"
 #include "gssm/io/config.h"
@@ -174,4 +175,29 @@ TEST(DatasetLayouts, RowsBeforeTheStartAreDroppedAndListedButARateMayStartAtIt) 
       EXPECT_EQ(d.inputs.size(), 3u);
     }
   }
+}
+
+// A motion-capture truth that stops before the ranges (1 s here, ranges on
+// to 1.5 s): the estimates it covers are compared, the others counted as
+// rows without truth — not an error, as for a truth given at every row.
+TEST(DatasetLayouts, EstimatesOutsideAnInterpolatedTruthAreCountedNotCompared) {
+  const std::string dir = writeLog("uwb_truth_ends",
+                                   "t,tag,anchor,range\n0.25,0,0,4.1\n0.25,1,2,3.9\n0.5,1,1,2.5\n1.25,0,2,4.4\n"
+                                   "1.5,1,0,4.0\n");
+  const io::Dataset d = read(dir);
+  ASSERT_TRUE(d.truth);
+  EXPECT_FALSE(d.truth->covers_every_row);
+  EXPECT_EQ(d.truth->times.size(), 2u);  // 0.25 and 0.5
+  const auto model = io::makeModel(io::readScenario(dir), dir);
+  EstimatorOptions o(Method::Ekf);
+  o.t0 = d.t0;
+  const OfflineRun run = runOffline(*model, o, d.measurements, {}, {}, {}, d.rows);
+  ASSERT_EQ(run.rows.size(), 4u);
+  const RunMetrics m = computeMetrics(*model, run, &*d.truth);
+  EXPECT_TRUE(m.has_truth);
+  EXPECT_EQ(m.rows, 2u);
+  EXPECT_EQ(m.rows_without_truth, 2u);
+  Truth exact = *d.truth;  // a truth meant for every row still names the first it lacks
+  exact.covers_every_row = true;
+  EXPECT_THROW(computeMetrics(*model, run, &exact), InvalidArgument);
 }

@@ -31,6 +31,10 @@ RunErrors runErrors(const OfflineRun& run, const Truth& truth, const std::vector
       wrapped.push_back(static_cast<int>(i));
   for (const auto& row : run.rows) {
     const auto j = match.find(row.t);
+    if (!j && !truth.covers_every_row) {
+      ++out.without_truth;
+      continue;
+    }
     if (!j) {
       std::ostringstream os;
       os << std::setprecision(17) << "run errors: the truth has no row at t = " << row.t << " (" << methodName(run.method)

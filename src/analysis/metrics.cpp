@@ -51,6 +51,11 @@ RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth
   if (!truth || run.rows.empty()) return m;
   m.has_truth = true;
   const RunErrors errors = runErrors(run, *truth, model.angleStates());
+  m.rows_without_truth = errors.without_truth;
+  if (errors.error.empty()) {  // no estimate within the truth's span: nothing to compare
+    m.has_truth = false;
+    return m;
+  }
   const auto all = model.stackedStateNames();
   m.names.clear();
   for (int c : errors.components) m.names.push_back(all[static_cast<std::size_t>(c)]);

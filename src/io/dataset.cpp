@@ -149,7 +149,10 @@ void interpolateTruth(const Model& model, Dataset& out) {
   for (const auto& m : out.measurements) {
     if (!at.times.empty() && sameTime(at.times.back(), m.t)) continue;
     while (k + 1 < tr.times.size() && tr.times[k + 1] < m.t) ++k;
-    if (k + 1 >= tr.times.size() || m.t < tr.times[k]) continue;
+    if (k + 1 >= tr.times.size() || m.t < tr.times[k]) {
+      at.covers_every_row = false;
+      continue;
+    }
     const double w = (m.t - tr.times[k]) / (tr.times[k + 1] - tr.times[k]);
     Eigen::VectorXd z = tr.states[k];
     for (Eigen::Index i = 0; i < z.size(); ++i) {

@@ -31,6 +31,7 @@ std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& 
     const RunMetrics& m = runs[r];
     os << (r ? "," : "") << "\n    " << jsonQuoted(methodName(m.method)) << ": {\n";
     os << "      \"rows\": " << m.rows << ",\n";
+    if (m.rows_without_truth) os << "      \"rows_without_truth\": " << m.rows_without_truth << ",\n";
     if (m.has_truth) {
       os << "      \"rmse\": " << perState(m.names, m.rmse) << ",\n";
       os << "      \"final_error\": " << perState(m.names, m.final_error) << ",\n";

@@ -14,6 +14,7 @@ struct RunMetrics {
   Method method = Method::Ekf;
   std::vector<std::string> names;  ///< the compared components' names (the truth's; all stacked states by default)
   std::size_t rows = 0;            ///< estimates compared with the truth
+  std::size_t rows_without_truth = 0;  ///< estimates outside a partial truth's time span, not compared
   Eigen::VectorXd rmse;            ///< per compared component (empty without truth)
   Eigen::VectorXd max_abs_error;   ///< per compared component
   Eigen::VectorXd final_error;     ///< estimate − truth at the last row

@@ -30,6 +30,11 @@ struct Truth {
   std::vector<double> times;
   std::vector<Eigen::VectorXd> states;
   std::vector<int> components;  ///< the stacked components each row gives, in order; empty: all
+  /// False for a truth interpolated to the estimates' times that does not
+  /// reach all of them (a motion-capture log that starts after, or stops
+  /// before, the sensors): rows without a truth row are then not compared
+  /// (counted) instead of an error.
+  bool covers_every_row = true;
 };
 
 }  // namespace gssm
