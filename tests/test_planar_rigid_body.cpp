@@ -303,3 +303,39 @@ TEST(PlanarRigidBody, FullPassGrowthBoundsThePassesAndResumesExactly) {
   bad.smoother.full_pass_growth = 0.5;
   EXPECT_THROW(makeEstimator(model, bad), gssm::InvalidArgument);
 }
+
+// With a range scale s, a bias-only calibration constant is the range error
+// at the link's mean true distance d̄: b + (s − 1)·d̄ (d̄ computed here from
+// the geometry), its variance σ_b² + d̄²σ_s² + 2d̄·cov(b, s); the scale
+// itself unchanged. Without a scale the constants are compared as they are.
+TEST(PlanarRigidBody, ConstantsComparedWithACalibrationAtTheLinksMeanDistance) {
+  PlanarRigidBody::Params p = uwbLayout();
+  p.range_scale = true;
+  const PlanarRigidBody model(p);
+  Truth truth;
+  truth.components = {0, 1, 2};
+  truth.states = {Eigen::Vector3d(0.5, -0.3, 0.4), Eigen::Vector3d(-1.0, 1.2, -2.0)};
+  Gaussian xb;
+  xb.mean = Eigen::VectorXd::LinSpaced(25, 0.1, 0.3);
+  xb.mean[24] = 1.02;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Random(25, 25) * 0.01;
+  xb.covariance = A * A.transpose() + 1e-6 * Eigen::MatrixXd::Identity(25, 25);
+  const Gaussian c = model.comparableConstants(xb, truth);
+  const int link = model.channelOf(2, 5);
+  double d = 0;
+  for (const auto& x : truth.states) {
+    const double yaw = x[2];
+    const Eigen::Vector3d l = p.tags[2], a = p.anchors[5];
+    const double tx = x[0] + std::cos(yaw) * l.x() - std::sin(yaw) * l.y(), ty = x[1] + std::sin(yaw) * l.x() + std::cos(yaw) * l.y();
+    d += std::sqrt(std::pow(tx - a.x(), 2) + std::pow(ty - a.y(), 2) + std::pow(p.height + l.z() - a.z(), 2)) / 2;
+  }
+  const int b = model.biasIndex(link);
+  EXPECT_NEAR(c.mean[b], xb.mean[b] + 0.02 * d, 1e-12);
+  EXPECT_EQ(c.mean[24], 1.02);
+  const double var = xb.covariance(b, b) + d * d * xb.covariance(24, 24) + 2 * d * xb.covariance(b, 24);
+  EXPECT_NEAR(c.covariance(b, b), var, 1e-12);
+  p.range_scale = false;
+  const PlanarRigidBody plain(p);
+  Gaussian xb24{xb.mean.head(24), xb.covariance.topLeftCorner(24, 24)};
+  EXPECT_EQ(plain.comparableConstants(xb24, truth).mean, xb24.mean);
+}

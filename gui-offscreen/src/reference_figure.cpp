@@ -7,10 +7,12 @@
 namespace gssm::plot {
 
 std::string writeConstantsReferenceFigure(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
-                                          const std::string& dir, const std::string& label) {
+                                          const Truth* truth, const std::string& dir, const std::string& label) {
   const int nb = model.dims().nb;
-  const Eigen::VectorXd mean = run.rows.back().mean.tail(nb);
-  const Eigen::VectorXd sd = run.rows.back().covariance.diagonal().tail(nb).cwiseSqrt();
+  const Gaussian xb{run.rows.back().mean.tail(nb), run.rows.back().covariance.bottomRightCorner(nb, nb)};
+  const Gaussian compared = truth ? model.comparableConstants(xb, *truth) : xb;  // in the reference's terms
+  const Eigen::VectorXd& mean = compared.mean;
+  const Eigen::VectorXd sd = compared.covariance.diagonal().cwiseSqrt();
   Figure fig;
   fig.title = label + ": " + methodName(run.method) + " constants (band: ±2 sd) against the calibration reference";
   fig.xlabel = "constant, in the estimates' column order (" + model.names().constants.front() + " ... " +

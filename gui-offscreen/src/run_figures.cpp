@@ -236,7 +236,8 @@ std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const s
   if (r.dataset.constants_reference && !r.runs.empty() && model.dims().nb > 0) {
     const auto batch = std::find_if(r.runs.begin(), r.runs.end(), [](const OfflineRun& x) { return x.method == Method::Batch; });
     const OfflineRun& run = batch != r.runs.end() ? *batch : r.runs.back();
-    if (!run.rows.empty()) files.push_back(writeConstantsReferenceFigure(model, run, *r.dataset.constants_reference, dir, r.label));
+    if (!run.rows.empty()) files.push_back(writeConstantsReferenceFigure(model, run, *r.dataset.constants_reference,
+                                                                     r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label));
   }
   return files;
 }

@@ -20,15 +20,18 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference) {
-  if (reference.size() != m.constants.size())
+void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference, const Gaussian* compared) {
+  if (reference.size() != m.constants.size() || (compared && compared->mean.size() != m.constants.size()))
     throw InvalidArgument("compareConstants: a reference of " + std::to_string(reference.size()) + " constants for " +
                           std::to_string(m.constants.size()));
   m.constants_reference = reference;
+  m.constants_compared = compared ? compared->mean : m.constants;
+  m.constants_compared_sd = compared ? Eigen::VectorXd(compared->covariance.diagonal().cwiseSqrt()) : m.constants_sd;
   double sum = 0;
   m.constants_referenced = 0;
   for (Eigen::Index i = 0; i < reference.size(); ++i)
-    if (std::isfinite(reference[i])) sum += std::pow(m.constants[i] - reference[i], 2), ++m.constants_referenced;
+    if (std::isfinite(reference[i]))
+      sum += std::pow(m.constants_compared[i] - reference[i], 2), ++m.constants_referenced;
   m.constants_reference_rms = m.constants_referenced ? std::sqrt(sum / static_cast<double>(m.constants_referenced)) : NAN;
 }
 

@@ -47,6 +47,7 @@ std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& 
       os << "      \"constants_sd\": " << perState(m.constant_names, m.constants_sd) << ",\n";
       if (m.constants_referenced > 0)
         os << "      \"constants_reference\": " << perState(m.constant_names, m.constants_reference)
+           << ",\n      \"constants_compared\": " << perState(m.constant_names, m.constants_compared)
            << ",\n      \"constants_reference_rms\": " << num(m.constants_reference_rms)
            << ",\n      \"constants_referenced\": " << m.constants_referenced << ",\n";
     }

@@ -122,10 +122,24 @@ std::vector<Eigen::Vector2d> PlanarRigidBody::bodyPoints(const Eigen::VectorXd& 
   return out;
 }
 
+Eigen::VectorXd PlanarRigidBody::meanTrueDistances(const Truth& truth) const {
+  const Eigen::VectorXd xb0 = priorConstants().mean;  // biases 0, scale 1: h is the geometric range
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(numChannels());
+  for (const auto& row : truth.states) {  // the truth's components into x_c (velocities do not enter h)
+    Eigen::VectorXd xc = Eigen::VectorXd::Zero(dims().nc);
+    for (Eigen::Index i = 0; i < row.size(); ++i) {
+      const int k = truth.components.empty() ? static_cast<int>(i) : truth.components[static_cast<std::size_t>(i)];
+      if (k < 6) xc[k] = row[i];
+    }
+    for (int c = 0; c < numChannels(); ++c) sum[c] += h(c, xc, xb0)[0];
+  }
+  return truth.states.empty() ? sum : Eigen::VectorXd(sum / static_cast<double>(truth.states.size()));
+}
+
 Eigen::VectorXd PlanarRigidBody::referenceConstants(const Eigen::MatrixXd& rows, const Truth& truth) const {
   Eigen::VectorXd out = Eigen::VectorXd::Constant(dims().nb, std::numeric_limits<double>::quiet_NaN());
   if (i_bias_ < 0 || truth.states.empty()) return out;
-  const Eigen::VectorXd xb0 = priorConstants().mean;  // biases 0, scale 1: h is the geometric range
+  const Eigen::VectorXd distance = meanTrueDistances(truth);
   for (Eigen::Index r = 0; r < rows.rows(); ++r) {
     const auto tag = std::find(p_.tag_ids.begin(), p_.tag_ids.end(), static_cast<int>(rows(r, 0)));
     const auto anchor = std::find(p_.anchor_ids.begin(), p_.anchor_ids.end(), static_cast<int>(rows(r, 1)));
@@ -135,18 +149,19 @@ Eigen::VectorXd PlanarRigidBody::referenceConstants(const Eigen::MatrixXd& rows,
                        ") is not in the tags and anchors");
     const int c = channelOf(static_cast<std::size_t>(tag - p_.tag_ids.begin()),
                             static_cast<std::size_t>(anchor - p_.anchor_ids.begin()));
-    double sum = 0;
-    for (const auto& row : truth.states) {  // the truth's components into x_c (velocities do not enter h)
-      Eigen::VectorXd xc = Eigen::VectorXd::Zero(dims().nc);
-      for (Eigen::Index i = 0; i < row.size(); ++i) {
-        const int k = truth.components.empty() ? static_cast<int>(i) : truth.components[static_cast<std::size_t>(i)];
-        if (k < 6) xc[k] = row[i];
-      }
-      sum += h(c, xc, xb0)[0];
-    }
-    out[biasIndex(c)] = rows(r, 2) + rows(r, 3) * sum / static_cast<double>(truth.states.size());
+    out[biasIndex(c)] = rows(r, 2) + rows(r, 3) * distance[c];
   }
   return out;
+}
+
+Gaussian PlanarRigidBody::comparableConstants(const Gaussian& xb, const Truth& truth) const {
+  if (i_scale_ < 0 || i_bias_ < 0 || truth.states.empty()) return xb;
+  const Eigen::VectorXd distance = meanTrueDistances(truth);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Identity(dims().nb, dims().nb);  // linear in x_b
+  for (int c = 0; c < numChannels(); ++c) J(biasIndex(c), i_scale_) = distance[c];
+  Eigen::VectorXd mean = xb.mean;
+  for (int c = 0; c < numChannels(); ++c) mean[biasIndex(c)] += (xb.mean[i_scale_] - 1.0) * distance[c];
+  return {mean, J * xb.covariance * J.transpose()};
 }
 
 std::vector<std::string> PlanarRigidBody::bodyPointNames() const {

@@ -40,7 +40,8 @@ def quat_rotate(q, v):
 
 def reference_biases():
     """bias + slope x mean true distance of each link (the repository's
-    calibration, judged as a bias-only constant)."""
+    calibration, judged as a bias-only constant), and each link's mean true
+    distance."""
     rd = lambda name: list(csv.DictReader(open(os.path.join(data, name))))
     anchors = {int(r["anchor"]): [float(r[k]) for k in "xyz"] for r in rd("anchors.csv")}
     tags = {int(r["tag"]): [float(r[k]) for k in "xyz"] for r in rd("tags.csv")}
@@ -54,9 +55,9 @@ def reference_biases():
             tag = [p[i] + r[i] for i in range(3)]
             for a, pos in anchors.items():
                 total[(t, a)] += math.dist(tag, pos)
-    return {(int(r["tag"]), int(r["anchor"])):
-            float(r["bias"]) + float(r["slope"]) * total[(int(r["tag"]), int(r["anchor"]))] / len(truth)
-            for r in rd("calibration_reference.csv")}
+    mean = {k: v / len(truth) for k, v in total.items()}
+    return {(int(r["tag"]), int(r["anchor"])): float(r["bias"]) + float(r["slope"]) * mean[(int(r["tag"]), int(r["anchor"]))]
+            for r in rd("calibration_reference.csv")}, mean
 
 
 out = os.path.join(work, "uwb")
@@ -68,10 +69,16 @@ check(m["rows"] == 13481, "one estimate row per epoch (%d)" % m["rows"])
 origin, yaw = m["position_error_m"]["rmse"], math.degrees(m["rmse"]["yaw"])
 check(origin <= 0.042, "batch body-origin RMSE %.2f cm <= 4.2 cm" % (100 * origin))
 check(yaw <= 4.7, "batch yaw RMSE %.2f deg <= 4.7 deg" % yaw)
-ref = reference_biases()
-diff = [m["constants"]["bias_%d_%d" % k] - v for k, v in ref.items()]
+ref, distance = reference_biases()
+# With a common range scale s the model's bias is the offset at distance 0:
+# each link's range error at its mean true distance is b + (s - 1) d.
+scale = m["constants"].get("range_scale", 1.0)
+diff = [m["constants"]["bias_%d_%d" % k] + (scale - 1) * distance[k] - v for k, v in ref.items()]
 rms = math.sqrt(sum(d * d for d in diff) / len(diff))
-check(len(diff) == 24 and rms <= 0.020, "24 learnt link biases %.2f cm RMS from the calibration runs (<= 2.0 cm)" % (100 * rms))
+check(len(diff) == 24 and rms <= 0.020,
+      "24 learnt link biases (range scale %.4f) %.2f cm RMS from the calibration runs (<= 2.0 cm)" % (scale, 100 * rms))
+check(abs(rms - m["constants_reference_rms"]) < 0.001,
+      "metrics.json's constants_reference_rms %.2f cm agrees" % (100 * m["constants_reference_rms"]))
 header = open(os.path.join(out, "estimates-batch.csv")).readline().strip().split(",")
 check(header[:4] == ["t", "px", "py", "yaw"] and "bias_2_7" in header and "sd_bias_2_7" in header,
       "estimates columns t, px, py, yaw, bias_<tag>_<anchor> and their sd_")

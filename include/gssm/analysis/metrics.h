@@ -27,6 +27,9 @@ struct RunMetrics {
   /// A calibration reference of the constants (NaN: none for that one) and
   /// the RMS of constants − reference over those it gives (compareConstants).
   Eigen::VectorXd constants_reference;
+  /// The constants in the reference's terms (Model::comparableConstants;
+  /// equal to `constants` unless the model says otherwise) and their sd.
+  Eigen::VectorXd constants_compared, constants_compared_sd;
   double constants_reference_rms = NAN;
   std::size_t constants_referenced = 0;
   std::size_t downweighted = 0;             ///< see OfflineRun
@@ -42,8 +45,10 @@ struct RunMetrics {
 RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth* truth);
 
 /// Fills the reference fields of `m` from `reference` (size n_b, NaN where
-/// it says nothing); InvalidArgument on a size mismatch.
-void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference);
+/// it says nothing), comparing `compared` (the constants in the reference's
+/// terms, Model::comparableConstants; null: m.constants as they are);
+/// InvalidArgument on a size mismatch.
+void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference, const Gaussian* compared = nullptr);
 
 /// Percentile (0..100) of a sample, by linear interpolation; 0 for empty.
 double percentile(std::vector<double> v, double p);

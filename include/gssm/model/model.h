@@ -142,6 +142,9 @@ class Model {
   virtual Eigen::VectorXd referenceConstants(const Eigen::MatrixXd& /*rows*/, const Truth& /*truth*/) const {
     return Eigen::VectorXd::Constant(dims().nb, std::numeric_limits<double>::quiet_NaN());
   }
+  /// Estimated constants (x_b's mean and covariance) in the terms
+  /// referenceConstants gives them along `truth`: by default x_b itself.
+  virtual Gaussian comparableConstants(const Gaussian& xb, const Truth& /*truth*/) const { return xb; }
 
   /// All state names in the stacked order [x_c; x_b].
   std::vector<std::string> stackedStateNames() const;

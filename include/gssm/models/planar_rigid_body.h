@@ -63,6 +63,10 @@ class PlanarRigidBody final : public Model {
   /// along `truth`, the bias-only constant the calibration implies.
   std::vector<std::string> referenceColumns() const override { return {"tag", "anchor", "bias", "slope"}; }
   Eigen::VectorXd referenceConstants(const Eigen::MatrixXd& rows, const Truth& truth) const override;
+  /// With a range scale s, each link's range error at its mean true
+  /// distance d̄ (what a bias-only calibration constant is): b + (s − 1)·d̄,
+  /// the scale itself unchanged; without one, x_b.
+  Gaussian comparableConstants(const Gaussian& xb, const Truth& truth) const override;
   /// The channel of link (tag i, anchor j), by their positions in the lists.
   int channelOf(std::size_t tag, std::size_t anchor) const { return static_cast<int>(tag * p_.anchors.size() + anchor); }
   /// Index in x_b of link c's bias, −1 without link biases.
@@ -79,6 +83,8 @@ class PlanarRigidBody final : public Model {
   Eigen::MatrixXd processNoise(double dt) const override;
 
  private:
+  /// Each link's mean geometric distance along the truth's rows.
+  Eigen::VectorXd meanTrueDistances(const Truth& truth) const;
   Params p_;
   int i_bias_ = -1, i_scale_ = -1;
 };

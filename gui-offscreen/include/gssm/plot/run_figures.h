@@ -34,10 +34,11 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
                                          const std::string& scenario_label,
                                          const std::optional<PlanView>& plan = std::nullopt);
 
-/// fig-constants-vs-reference.png: the run's final constants ±2σ against a
+/// fig-constants-vs-reference.png: the run's final constants ±2σ, in the
+/// reference's terms along `truth` (Model::comparableConstants), against a
 /// calibration reference (NaN entries left out); returns its path.
 std::string writeConstantsReferenceFigure(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
-                                          const std::string& dir, const std::string& label);
+                                          const Truth* truth, const std::string& dir, const std::string& label);
 
 /// The figures of a processed dataset (gssm-process's, gssm.process's):
 /// writeRunFigures with a plan view when the model has px and py (its
