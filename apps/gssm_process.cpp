@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <functional>
 #include <iostream>
+#include <thread>
 #include <sstream>
 #include <unistd.h>
 
@@ -40,6 +41,9 @@ gssm::io::ProcessOptions processOptions(const gssm::apps::CommandLine& cli) {
   o.resume = cli.given("resume") ? cli.get("resume") : "";
   o.skip_bad_rows = cli.given("skip-bad-rows");
   if (cli.given("learn")) o.learn = true;
+  // Every core by default: the methods are independent (the output is the same).
+  o.threads = cli.given("threads") ? static_cast<std::size_t>(cli.getInt("threads", 1, 256))
+                                   : std::max(1u, std::thread::hardware_concurrency());
   return o;
 }
 
@@ -90,6 +94,7 @@ int main(int argc, char** argv) {
                "the same); the output equals an uninterrupted run's");
     cli.flag("learn", "learn the noise from the log first ([learn] of the INI); writes OUTDIR/scenario.ini, learn.json");
     cli.flag("skip-bad-rows", "skip malformed measurement rows (listed in metrics.json) instead of stopping at the first");
+    cli.option("threads", "N", "methods run at the same time (default: one per core; 1: one after another)");
     cli.parse(argc, argv);
     const gssm::io::ProcessOptions options = processOptions(cli);
     const gssm::io::ProcessResult r = gssm::io::processDataset(options, consoleCallbacks());

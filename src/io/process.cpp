@@ -1,8 +1,13 @@
 #include "gssm/io/process.h"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <numeric>
+#include <thread>
 
 #include "gssm/checkpoint/checkpoint.h"
 #include "gssm/core/error.h"
@@ -23,6 +28,7 @@ bool ProcessOptions::validate(std::string* why) const {
   if (out_dir.empty()) return fail("no output folder (out_dir)");
   if (window && (*window < 1 || *window > 1000000)) return fail("window = " + std::to_string(*window) + ": expected 1..10^6");
   if (checkpoint_every > 1000000000) return fail("checkpoint_every is out of range");
+  if (threads < 1 || threads > 256) return fail("threads = " + std::to_string(threads) + ": expected 1..256");
   return true;
 }
 
@@ -109,6 +115,44 @@ void compareToReference(const Model& model, const ProcessResult& r, RunMetrics& 
   compareConstants(m, *r.dataset.constants_reference, &compared);
 }
 
+// Every method's run, `threads` at a time, in the methods' order; the paper
+// window (a window re-solve per step, the slowest by far) starts first. A
+// method that throws lets the others finish; the first error, in the
+// methods' order, is rethrown.
+std::vector<OfflineRun> runConcurrently(const ProcessOptions& o, const Model& model, const ProcessResult& r,
+                                        const EstimatorOptions& options, const std::vector<Method>& methods,
+                                        const ProcessCallbacks& cb) {
+  std::vector<std::size_t> queue(methods.size());
+  std::iota(queue.begin(), queue.end(), std::size_t{0});
+  std::stable_partition(queue.begin(), queue.end(), [&](std::size_t i) { return methods[i] == Method::PaperWindow; });
+  std::mutex mutex;
+  ProcessCallbacks serialized = cb;
+  if (cb.progress)
+    serialized.progress = [&](Method m, std::size_t done, std::size_t total) {
+      const std::lock_guard<std::mutex> lock(mutex);
+      cb.progress(m, done, total);
+    };
+  std::vector<OfflineRun> runs(methods.size());
+  std::vector<std::exception_ptr> errors(methods.size());
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t k = next++; k < queue.size(); k = next++) {
+      const std::size_t i = queue[k];
+      try {
+        runs[i] = runMethod(o, model, r, options, methods[i], serialized);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t t = 0; t < std::min(o.threads, methods.size()); ++t) pool.emplace_back(work);
+  for (auto& t : pool) t.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+  return runs;
+}
+
 // Rows at inputs on a planar model: the filter with no measurements.
 std::optional<OfflineRun> deadReckoning(const Model& model, const ProcessResult& r, EstimatorOptions options) {
   const auto names = model.stackedStateNames();
@@ -141,8 +185,11 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   options.t0 = r.dataset.t0;
   if (o.window) options.fixed_lag.window = options.paper_window.window = *o.window;
   const Truth* truth = r.dataset.truth ? &*r.dataset.truth : nullptr;
-  for (const Method method : methods) {
-    r.runs.push_back(runMethod(o, *model, r, options, method, cb));
+  std::vector<OfflineRun> concurrent;
+  if (o.threads > 1 && methods.size() > 1) concurrent = runConcurrently(o, *model, r, options, methods, cb);
+  for (std::size_t i = 0; i < methods.size(); ++i) {
+    const Method method = methods[i];
+    r.runs.push_back(concurrent.empty() ? runMethod(o, *model, r, options, method, cb) : std::move(concurrent[i]));
     r.metrics.push_back(computeMetrics(*model, r.runs.back(), truth));
     if (r.dataset.constants_reference) compareToReference(*model, r, r.metrics.back());
     r.files.push_back((fs::path(o.out_dir) / RunFiles::estimatesName(method)).string());

@@ -36,6 +36,24 @@ assert set(metrics["methods"]) == {"ekf", "batch", "incremental", "fixed-lag", "
 for fig in ["fig-xdot.png", "fig-h.png", "fig-x-error.png", "fig-latency.png"]:
     assert os.path.getsize(os.path.join(out, fig)) > 10000, fig
 
+# Methods run concurrently (--threads) write the same estimates and metrics
+# as one after another (timings aside).
+def timeless(path):
+    return {k: {kk: vv for kk, vv in v.items() if not kk.endswith("_s")} if isinstance(v, dict) else v
+            for k, v in json.load(open(path))["methods"].items()}
+outs = {}
+for threads in ("1", "3"):
+    outs[threads] = os.path.join(work, "out-threads-" + threads)
+    subprocess.run([f"{bin_dir}/gssm-process", "--data", data, "--method", "all", "--threads", threads,
+                    "--out", outs[threads]], check=True, capture_output=True)
+for method in metrics["methods"]:
+    name = f"estimates-{method}.csv"
+    assert open(os.path.join(outs["1"], name)).read() == open(os.path.join(outs["3"], name)).read(), name
+assert timeless(os.path.join(outs["1"], "metrics.json")) == timeless(os.path.join(outs["3"], "metrics.json"))
+zero = subprocess.run([f"{bin_dir}/gssm-process", "--data", data, "--threads", "0", "--out", out],
+                      capture_output=True, text=True)
+assert zero.returncode != 0 and "--threads" in zero.stderr, zero.stderr
+
 bad = subprocess.run([f"{bin_dir}/gssm-process", "--data", data, "--method", "kalman",
                       "--out", out], capture_output=True, text=True)
 assert bad.returncode != 0

@@ -34,6 +34,12 @@ struct ProcessOptions {
   /// says; unset: as [learn] enabled says. The learnt scenario.ini and
   /// learn.json go to out_dir, and every method runs on the learnt model.
   std::optional<bool> learn;
+  /// Methods run at the same time (each on its own thread; the slowest, the
+  /// paper window, started first). 1: one after another. The estimates and
+  /// metrics are the same either way; per-update latencies share the cores.
+  /// Progress callbacks are then called from the worker threads, one at a
+  /// time; `finished` after all have run, in the methods' order.
+  std::size_t threads = 1;
   /// Empty when usable; otherwise says which field is wrong.
   bool validate(std::string* why = nullptr) const;
 };
