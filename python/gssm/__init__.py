@@ -165,7 +165,7 @@ def learn(model_or_folder, data=None, *, out=None, config=None, parameters=None,
 
 
 def process(data, out, *, method="all", config=None, window=None, checkpoint_every=None, resume=None,
-            skip_bad_rows=False, figures=True, progress=None, learn=None):
+            skip_bad_rows=False, figures=True, progress=None, learn=None, threads=1):
     """gssm-process in this process: runs estimators over a dataset folder and
     writes estimates-<method>.csv, metrics.json and (figures=True) the fig-*.png
     into `out`, the same files gssm-process writes. Returns a gssm.ProcessResult
@@ -177,8 +177,10 @@ def process(data, out, *, method="all", config=None, window=None, checkpoint_eve
     scenario.ini. window: fixed-lag and paper-window states. checkpoint_every,
     resume: as gssm-process's --checkpoint-every, --resume. learn: True to
     learn the noise first (gssm-process --learn), False not to, None as the
-    INI's [learn] enabled says. progress: a
-    callable(method, done, total), called from the loop. Errors are gssm.Error
+    INI's [learn] enabled says. threads: methods run at the same time
+    (gssm-process --threads; the same output). progress: a
+    callable(method, done, total), called from the loop (from the method's
+    thread, one call at a time). Errors are gssm.Error
     subclasses naming file, line and column, as gssm-process prints them.
     """
     if isinstance(method, str) and method == "all":
@@ -189,7 +191,7 @@ def process(data, out, *, method="all", config=None, window=None, checkpoint_eve
         methods = [method_of(method)]
     result = _gssm.process_dataset(str(data), str(out), methods, str(config or ""), window,
                                    int(checkpoint_every or 0), str(resume or ""), bool(skip_bad_rows), progress,
-                                   learn)
+                                   learn, int(threads))
     if figures:
         try:
             from . import _plot

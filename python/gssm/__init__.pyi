@@ -250,7 +250,7 @@ def process(data: str, out: str, *, method: Union[MethodLike, Sequence[MethodLik
             config: Optional[str] = None, window: Optional[int] = None, checkpoint_every: Optional[int] = None,
             resume: Optional[str] = None, skip_bad_rows: bool = False, figures: bool = True,
             progress: Optional[Callable[[Method, int, int], None]] = None,
-            learn: Optional[bool] = None) -> ProcessResult: ...
+            learn: Optional[bool] = None, threads: int = 1) -> ProcessResult: ...
 @overload
 def learn(model_or_folder: Model, data: Dataset, *, parameters: Optional[Sequence[str]] = None,
           start: float = 0.0, search_range: float = 1e4, max_evaluations: int = 4000, tolerance: float = 1e-7,

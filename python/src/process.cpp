@@ -47,17 +47,18 @@ io::ProcessOptions processOptions(const std::string& data, const std::string& ou
 PyProcessResult process(const std::string& data, const std::string& out, const std::vector<Method>& methods,
                         const std::string& config, std::optional<int> window, std::size_t checkpoint_every,
                         const std::string& resume, bool skip_bad_rows, const py::object& progress,
-                        std::optional<bool> learn) {
-  const io::ProcessOptions o =
+                        std::optional<bool> learn, std::size_t threads) {
+  io::ProcessOptions o =
       processOptions(data, out, methods, config, window, checkpoint_every, resume, skip_bad_rows, learn);
+  o.threads = threads;
   io::ProcessCallbacks cb;
+  if (!progress.is_none())  // from whichever thread runs the method (one at a time): take the GIL
+    cb.progress = [&progress](Method m, std::size_t done, std::size_t total) {
+      py::gil_scoped_acquire gil;
+      progress(m, done, total);
+    };
   PyProcessResult r;
-  if (progress.is_none()) {
-    py::gil_scoped_release release;  // the models an INI describes are C++
-    r.result = std::make_shared<io::ProcessResult>(io::processDataset(o, cb));
-    return r;
-  }
-  cb.progress = [&progress](Method m, std::size_t done, std::size_t total) { progress(m, done, total); };
+  py::gil_scoped_release release;  // the models an INI describes are C++
   r.result = std::make_shared<io::ProcessResult>(io::processDataset(o, cb));
   return r;
 }
@@ -104,6 +105,7 @@ void bindProcess(py::module_& m) {
   m.def("process_dataset", &process, py::arg("data"), py::arg("out"), py::arg("methods"), py::arg("config") = "",
         py::arg("window") = py::none(), py::arg("checkpoint_every") = 0, py::arg("resume") = "",
         py::arg("skip_bad_rows") = false, py::arg("progress") = py::none(), py::arg("learn") = py::none(),
+        py::arg("threads") = 1,
         "gssm.process without keyword conveniences");
 }
 

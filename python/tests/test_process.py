@@ -77,3 +77,19 @@ def test_a_bad_row_stops_it_partway_with_what_came_before_written(repo, gssm_pro
     assert filecmp.cmp(tmp_path / "app" / "estimates-ekf.csv", tmp_path / "py" / "estimates-ekf.csv", shallow=False)
     skipped = gssm.process(str(data), str(tmp_path / "skip"), method="ekf", skip_bad_rows=True, figures=False)
     assert not skipped.partial and len(skipped.skipped) == 1 and len(skipped.runs[0]) == 399
+
+
+def test_process_on_threads_writes_the_same_and_reports_progress(repo, tmp_path):
+    data = os.path.join(repo, "datasets", "radar-paper")
+    seen = []
+    r2 = gssm.process(data, str(tmp_path / "t2"), threads=2, figures=False,
+                      progress=lambda m, done, total: seen.append((m.text, done, total)))
+    gssm.process(data, str(tmp_path / "t1"), threads=1, figures=False)
+    for name in os.listdir(tmp_path / "t1"):
+        if name.endswith(".csv"):
+            assert filecmp.cmp(tmp_path / "t1" / name, tmp_path / "t2" / name, shallow=False), name
+    assert without_timings(tmp_path / "t1" / "metrics.json") == without_timings(tmp_path / "t2" / "metrics.json")
+    assert {m for m, _, _ in seen} >= {"ekf", "batch", "incremental", "fixed-lag", "paper-window"} - {"batch"}
+    assert [m.text for m in r2.methods] == gssm.methods()
+    with pytest.raises(gssm.InvalidArgument, match="threads"):
+        gssm.process(data, str(tmp_path / "t0"), threads=0, figures=False)
