@@ -26,7 +26,6 @@ void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference, const Gau
                           std::to_string(m.constants.size()));
   m.constants_reference = reference;
   m.constants_compared = compared ? compared->mean : m.constants;
-  m.constants_compared_sd = compared ? Eigen::VectorXd(compared->covariance.diagonal().cwiseSqrt()) : m.constants_sd;
   double sum = 0;
   m.constants_referenced = 0;
   for (Eigen::Index i = 0; i < reference.size(); ++i)

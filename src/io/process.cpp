@@ -106,10 +106,10 @@ OfflineRun runMethod(const ProcessOptions& o, const Model& model, const ProcessR
   return run;
 }
 
-// The last row's constants, in the reference's terms, against the reference.
-void compareToReference(const Model& model, const ProcessResult& r, RunMetrics& m) {
+// A run's last constants, in the reference's terms, against the reference.
+void compareToReference(const Model& model, const ProcessResult& r, const OfflineRun& run, RunMetrics& m) {
   const int nb = model.dims().nb;
-  const EstimateRow& last = r.runs.back().rows.back();
+  const EstimateRow& last = run.rows.back();
   const Gaussian xb{last.mean.tail(nb), last.covariance.bottomRightCorner(nb, nb)};
   const Gaussian compared = r.dataset.truth ? model.comparableConstants(xb, *r.dataset.truth) : xb;
   compareConstants(m, *r.dataset.constants_reference, &compared);
@@ -191,7 +191,7 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
     const Method method = methods[i];
     r.runs.push_back(concurrent.empty() ? runMethod(o, *model, r, options, method, cb) : std::move(concurrent[i]));
     r.metrics.push_back(computeMetrics(*model, r.runs.back(), truth));
-    if (r.dataset.constants_reference) compareToReference(*model, r, r.metrics.back());
+    if (r.dataset.constants_reference) compareToReference(*model, r, r.runs.back(), r.metrics.back());
     r.files.push_back((fs::path(o.out_dir) / RunFiles::estimatesName(method)).string());
     if (cb.finished) cb.finished(r.runs.back(), r.metrics.back());
   }

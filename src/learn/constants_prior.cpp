@@ -88,31 +88,29 @@ void learnConstantsPrior(const std::string& type_name, std::vector<LearntParamet
     theta[i] = std::log(p.start);
   }
   ExpectedLogPrior q{base, params, type_name, {}, {}};
-  std::shared_ptr<const Model> model = withSigmas(base, params, theta.array().exp().matrix()).build(type_name);
+  ParamValues values = withSigmas(base, params, theta.array().exp().matrix());
+  std::shared_ptr<const Model> model = values.build(type_name);
   Values x = ekfInitialGuess(*model, o.ekf, measurements, inputs, t0);
   r.prior_converged = false;
-  for (r.prior_iterations = 1; r.prior_iterations <= o.prior_iterations; ++r.prior_iterations) {
+  for (int it = 1; it <= o.prior_iterations && !r.prior_converged; ++it) {
+    r.prior_iterations = it;
     posteriorOfConstants(*model, measurements, inputs, t0, o.batch, x, q);
-    if (r.prior_iterations == 1) r.prior_start_expected_log_prior = -q.negative(theta);
+    if (it == 1) r.prior_start_expected_log_prior = -q.negative(theta);
     const NelderMeadResult m = nelderMead([&q](const Eigen::VectorXd& t) { return q.negative(t); }, theta, 0.5,
                                           200 * static_cast<int>(n + 1), 1e-12, 1e-9);
-    const double change = ((m.x - theta).array().abs()).maxCoeff();  // in log σ: relative
+    r.prior_converged = ((m.x - theta).array().abs()).maxCoeff() <= o.prior_tolerance;  // in log σ: relative
     theta = m.x;
     r.prior_expected_log_prior.push_back(-m.value);
-    model = withSigmas(base, params, theta.array().exp().matrix()).build(type_name);
-    if (change <= o.prior_tolerance) {
-      r.prior_converged = true;
-      break;
-    }
+    values = withSigmas(base, params, theta.array().exp().matrix());
+    model = values.build(type_name);
   }
-  r.prior_iterations = std::min(r.prior_iterations, o.prior_iterations);
   for (Eigen::Index i = 0; i < n; ++i) {
     LearntParameter& p = params[static_cast<std::size_t>(i)];
     p.value = std::exp(theta[i]);
     p.method = "em";
   }
   if (o.standard_errors) standardErrorsOfQ(q, theta, params);
-  r.values = withSigmas(base, params, theta.array().exp().matrix());
+  r.values = std::move(values);
   r.model = model;
   r.parameters.insert(r.parameters.end(), params.begin(), params.end());
   r.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

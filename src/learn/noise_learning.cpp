@@ -390,7 +390,6 @@ NoiseLearningReport learnNoise(const Model& model, const std::vector<Measurement
     r.values = internal::withSigmas(base, r.parameters, sigmas);
   }
   if (!prior.empty()) internal::learnConstantsPrior(type_name, prior, measurements, inputs, t0, o, r);
-  if (!r.model) r.model = r.values.build(type_name);
   return r;
 }
 

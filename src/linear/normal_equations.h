@@ -114,9 +114,9 @@ void forEachNonzeroUpperJtJ(const FactorColumns& c, Emit&& emit) {
   const std::size_t* nz = c.nonzero.data();
   const std::size_t n = c.nonzero.size();
   for (std::size_t b = 0; b < n; ++b)
-    for (std::size_t a = 0; a < n; ++a) {
+    for (std::size_t a = 0; a < (c.ascending ? b + 1 : n); ++a) {  // ascending: p ≤ q exactly when a ≤ b
       const std::size_t p = nz[a], q = nz[b];
-      if (c.ascending ? p > q : c.global[p] > c.global[q]) continue;
+      if (!c.ascending && c.global[p] > c.global[q]) continue;
       emit(c.global[p], c.global[q], c.dot(p, c.column(q)), p, q);
     }
 }

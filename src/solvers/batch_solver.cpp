@@ -161,11 +161,7 @@ struct BatchSolver::Impl {
     for (Eigen::Index j = 0; j < n; ++j) first[static_cast<std::size_t>(j)] = static_cast<int>(j);
     std::size_t added = 0;
     for (std::size_t fi = 0; fi < graph.size(); ++fi) {
-      const std::size_t count = offsetsOf(fi);
-      columns.place(factor_offs.data(), count, [&](std::size_t a) {
-        const std::size_t v = factor_vars[factor_begin[fi] + a];
-        return offset[v + 1] - offset[v];
-      });
+      placeColumns(fi);
       const std::size_t m = columns.size();
       if (!columns.ascending) {  // repeated columns: pair by pair
         internal::forEachUpperPair(columns, [&](std::size_t p, std::size_t q) {
@@ -217,11 +213,7 @@ struct BatchSolver::Impl {
   template <class Emit>
   void forEachFactorEntry(std::size_t factors, Emit&& emit) {
     for (std::size_t fi = 0; fi < factors; ++fi) {
-      const std::size_t count = offsetsOf(fi);
-      columns.place(factor_offs.data(), count, [&](std::size_t a) {
-        const std::size_t v = factor_vars[factor_begin[fi] + a];
-        return offset[v + 1] - offset[v];
-      });
+      placeColumns(fi);
       internal::forEachUpperPair(columns,
                                  [&](std::size_t p, std::size_t q) { emit(columns.global[p], columns.global[q]); });
     }
@@ -238,6 +230,15 @@ struct BatchSolver::Impl {
     }
     const auto it = std::lower_bound(layout.begin(), layout.end(), k);
     return it != layout.end() && *it == k ? static_cast<std::size_t>(it - layout.begin()) : npos;
+  }
+
+  // Factor fi's columns of H into `columns` (a pattern: no entries).
+  void placeColumns(std::size_t fi) {
+    const std::size_t count = offsetsOf(fi);
+    columns.place(factor_offs.data(), count, [&](std::size_t a) {
+      const std::size_t v = factor_vars[factor_begin[fi] + a];
+      return offset[v + 1] - offset[v];
+    });
   }
 
   // Factor fi's variables' first columns into factor_offs; returns how many.

@@ -268,13 +268,13 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
       const Eigen::VectorXd xb = engine.estimate(Key::constants());
       if (constants_at_last_check_.size() != xb.size()) {
         constants_at_last_check_ = xb;
-      } else {
+      } else if (static_cast<double>(added_since_pass_) >=
+                 (options.full_pass_growth - 1) * static_cast<double>(held_at_last_pass_)) {
+        // Grown enough for a pass (full_pass_growth); only then the constants' marginal.
         const Eigen::VectorXd sd =
             engine.pathMarginalCovariance({Key::constants()}).diagonal().cwiseSqrt();
         const double moved = ((xb - constants_at_last_check_).cwiseAbs().array() / sd.array()).maxCoeff();
-        const bool grown = static_cast<double>(added_since_pass_) >=
-                           (options.full_pass_growth - 1) * static_cast<double>(held_at_last_pass_);
-        if (moved > options.constants_check_sigmas && grown) {
+        if (moved > options.constants_check_sigmas) {
           counts.variables_backsubstituted += engine.solveAll();
           relinearize(engine.nonlinearSlots(), options.relinearize_threshold, rep, counts);
           rep.relinearization_pass = true;

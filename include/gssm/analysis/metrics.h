@@ -28,8 +28,8 @@ struct RunMetrics {
   /// the RMS of constants − reference over those it gives (compareConstants).
   Eigen::VectorXd constants_reference;
   /// The constants in the reference's terms (Model::comparableConstants;
-  /// equal to `constants` unless the model says otherwise) and their sd.
-  Eigen::VectorXd constants_compared, constants_compared_sd;
+  /// equal to `constants` unless the model says otherwise).
+  Eigen::VectorXd constants_compared;
   double constants_reference_rms = NAN;
   std::size_t constants_referenced = 0;
   std::size_t downweighted = 0;             ///< see OfflineRun
