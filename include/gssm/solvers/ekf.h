@@ -80,7 +80,7 @@ class ExtendedKalmanFilter {
 
  private:
   double outlierLogDensity(int channel) const;
-  void commitUpdate(const Eigen::MatrixXd& H, const Eigen::MatrixXd& S, const Eigen::LLT<Eigen::MatrixXd>& llt,
+  void commitUpdate(const Eigen::MatrixXd& HP, const Eigen::MatrixXd& S, const Eigen::LLT<Eigen::MatrixXd>& llt,
                     const Eigen::VectorXd& innov, double w);
   const Model* model_;
   ExtendedKalmanFilterOptions options_;
