@@ -56,6 +56,8 @@ class EnvelopeCholesky {
   std::vector<std::ptrdiff_t> base_;  // column j's entry for row i at base_[j] + i (i from first_[j] to j)
   std::vector<double> h_, u_;  // H (or H⁻¹ on the envelope after selectedInverse()); U, 1/U(j, j) on its diagonal
   void solveInPlace(double* x) const;  // x: n entries
+  void offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j);  // U(i, j), i < j
+  bool pivot(std::ptrdiff_t j);                          // 1/U(j, j); false if not positive definite there
   // inverse_: h_ holds H⁻¹ on the envelope, not H (values() must refill it).
   bool factored_ = false, inverse_ = false;
 };
