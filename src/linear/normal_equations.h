@@ -29,28 +29,41 @@ struct FactorColumns {
     for (std::size_t a = 0; a < count; ++a)
       for (Eigen::Index i = 0, d = dim(a); i < d; ++i) push(offs[a] + i);
   }
-  /// The columns of J's blocks, block a at offs[a], with their entries.
+  /// The columns of J's blocks, block a at offs[a], with their entries, and
+  /// which of them hold a nonzero (branch-free: which columns of a range's
+  /// 30 are nonzero changes from link to link).
   void gather(const Eigen::Index* offs, const std::vector<Eigen::MatrixXd>& J) {
-    start();
     rows = J.empty() ? 0 : J[0].rows();
-    Eigen::Index total = 0;
-    for (const auto& block : J) total += block.cols();
-    if (entries.size() < static_cast<std::size_t>(rows * total)) entries.resize(static_cast<std::size_t>(rows * total));
+    std::size_t total = 0;
+    for (const auto& block : J) total += static_cast<std::size_t>(block.cols());
+    if (global.size() < total) global.resize(total);
+    if (entries.size() < static_cast<std::size_t>(rows) * total) entries.resize(static_cast<std::size_t>(rows) * total);
+    nonzero.resize(total);
+    size_ = total;
+    ascending = true;
+    Eigen::Index* g = global.data();
     double* out = entries.data();
-    for (std::size_t a = 0; a < J.size(); ++a) {
-      for (Eigen::Index i = 0; i < J[a].cols(); ++i) push(offs[a] + i);
-      const double* in = J[a].data();
-      for (Eigen::Index e = 0, size = J[a].size(); e < size; ++e) *out++ = in[e];  // a few: no memmove call
-    }
-    nonzero.clear();
-    for (std::size_t p = 0; p < size_; ++p) {
-      const double* col = column(p);
-      for (Eigen::Index r = 0; r < rows; ++r)
-        if (col[r] != 0.0) {
-          nonzero.push_back(p);
-          break;
+    std::size_t* nz = nonzero.data();
+    std::size_t p = 0, count = 0;
+    Eigen::Index last = -1;  // the previous block's last column
+    for (const auto& block : J) {
+      const Eigen::Index cols = block.cols(), at = offs[&block - J.data()];
+      if (cols > 0 && at <= last) ascending = false;  // a repeated column takes the general loop
+      if (cols > 0) last = at + cols - 1;
+      const double* in = block.data();
+      for (Eigen::Index i = 0; i < cols; ++i, ++p) {
+        g[p] = at + i;
+        bool any = false;
+        for (Eigen::Index r = 0; r < rows; ++r) {
+          any |= in[r] != 0.0;
+          *out++ = in[r];
         }
+        in += rows;
+        nz[count] = p;
+        count += any;
+      }
     }
+    nonzero.resize(count);
   }
   /// Column p's entries.
   const double* column(std::size_t p) const { return entries.data() + static_cast<Eigen::Index>(p) * rows; }
