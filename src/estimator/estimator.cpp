@@ -660,10 +660,16 @@ class PaperWindowEstimator final : public Estimator {
     last_summary_ = sum;
     markDetail();
   }
+  // Gauss–Newton to a cost change below 1e-9 of the cost: the window is
+  // re-solved twice a step, and on a log with robust ranges its iterations
+  // converge linearly (a step ~1/30 of the one before); the batch default
+  // (1e-12) spent a fourth iteration moving the estimate by < 1e-6 m (UWB:
+  // 20% of the method's time; estimates within 2·10⁻⁵ of it).
   static BatchSolverOptions gaussNewton() {
     BatchSolverOptions o;
     o.method = BatchSolverOptions::Method::GaussNewton;
     o.max_iterations = 20;
+    o.relative_cost_tolerance = 1e-9;
     return o;
   }
   static Gaussian diagonalPrior(const Eigen::VectorXd& mean, const Eigen::MatrixXd& cov) {

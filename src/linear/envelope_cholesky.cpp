@@ -40,6 +40,7 @@ void EnvelopeCholesky::setPattern(std::vector<int> first) {
   h_.assign(static_cast<std::size_t>(size), 0.0);
   u_.clear();
   factored_ = inverse_ = false;
+  inverse_from_ = 0;
 }
 
 Eigen::Index EnvelopeCholesky::factorize() {
@@ -114,46 +115,63 @@ Eigen::MatrixXd EnvelopeCholesky::solve(const Eigen::MatrixXd& B) const {
   return X;
 }
 
-void EnvelopeCholesky::selectedInverse() {
+void EnvelopeCholesky::selectedInverse(Eigen::Index down_to) {
   if (!factored_) throw NumericalError("EnvelopeCholesky: selected inverse before a successful factorize()");
-  const std::size_t n = first_.size();
+  const auto n = static_cast<Eigen::Index>(first_.size());
+  if (!inverse_) {  // a fresh sweep from the last row
+    inverse_ = true;
+    inverse_from_ = n;
+    sweep_columns_.clear();
+  }
   // H⁻¹ takes H's storage (the batch solver refills H before it factors
-  // again): no fresh memory for it.
-  std::vector<double>& z = h_;
-  auto zAt = [&](Eigen::Index a, Eigen::Index b) -> double {  // Z(a, b) = Z(b, a), in the envelope
-    return a <= b ? z[position(a, b)] : z[position(b, a)];
-  };
-  // From the last row up (H⁻¹ = U⁻¹U⁻ᵀ, so U Z = U⁻ᵀ, lower triangular):
+  // again): no fresh memory for it. From the last row up (H⁻¹ = U⁻¹U⁻ᵀ, so
+  // U Z = U⁻ᵀ, lower triangular):
   //   Z(i, j) = −(1/U_ii) Σ_k U(i, k) Z(k, j)   for j in row i's columns,
   //   Z(i, i) = (1/U_ii)(1/U_ii − Σ_k U(i, k) Z(k, i)),
   // k over row i's columns — the columns k > i whose envelope reaches row i,
   // kept in increasing order as the sweep moves up (k = i + 1 joins, a
   // column leaves above its first row); every Z(k, j) needed lies in the
-  // envelope (both reach row i) and below row i: computed already.
-  std::vector<int> row;  // row i's columns
-  for (std::size_t ii = n; ii-- > 0;) {
-    const auto i = static_cast<Eigen::Index>(ii);
+  // envelope (both reach row i) and below row i: computed already. The sweep
+  // stops at `down_to` and resumes there: the last variables' block (a
+  // window's newest state and the constants) costs only its own rows.
+  std::vector<int>& row = sweep_columns_;
+  std::vector<double>& u_row = sweep_u_;
+  for (Eigen::Index i = inverse_from_ - 1; i >= down_to && i >= 0; --i) {
+    const auto ii = static_cast<std::size_t>(i);
     row.erase(std::remove_if(row.begin(), row.end(), [&](int k) { return first_[static_cast<std::size_t>(k)] > i; }),
               row.end());
-    if (ii + 1 < n && first_[ii + 1] <= i) row.insert(row.begin(), static_cast<int>(ii + 1));
-    const double inv = u_[diagonal(i)];  // 1/U(i, i)
-    const std::size_t m = row.size();
-    for (std::size_t b = m; b-- > 0;) {  // Z(i, j) reads Z(k, j), k > i only
-      const Eigen::Index j = row[b];
-      double s = 0;
-      for (std::size_t a = 0; a < m; ++a) s += u_[position(i, row[a])] * zAt(row[a], j);
-      z[position(i, j)] = -s * inv;
-    }
-    double s = 0;
-    for (std::size_t a = 0; a < m; ++a) s += u_[position(i, row[a])] * z[position(i, row[a])];
-    z[diagonal(i)] = (inv - s) * inv;
+    if (i + 1 < n && first_[ii + 1] <= i) row.insert(row.begin(), static_cast<int>(i + 1));
+    inverseRow(i, row, u_row);
+    inverse_from_ = i;
   }
-  inverse_ = true;
+}
+
+// Row i of Z = H⁻¹ on the envelope from the rows below it (row: row i's
+// columns, ascending). Z(k, j) for k ≤ j is held in column j, for k > j in
+// column k: the sum splits there, in the same order.
+void EnvelopeCholesky::inverseRow(Eigen::Index i, const std::vector<int>& row, std::vector<double>& u_row) {
+  double* z = h_.data();
+  const std::ptrdiff_t* base = base_.data();
+  const std::size_t m = row.size();
+  u_row.resize(m);
+  for (std::size_t a = 0; a < m; ++a) u_row[a] = u_[static_cast<std::size_t>(base[row[a]] + i)];  // U(i, k)
+  const double inv = u_[diagonal(i)];  // 1/U(i, i)
+  for (std::size_t b = m; b-- > 0;) {  // Z(i, j) reads Z(k, j), k > i only
+    const int j = row[b];
+    const double* zj = z + base[j];
+    double s = 0;
+    for (std::size_t a = 0; a <= b; ++a) s += u_row[a] * zj[row[a]];
+    for (std::size_t a = b + 1; a < m; ++a) s += u_row[a] * z[base[row[a]] + j];
+    z[base[j] + i] = -s * inv;
+  }
+  double s = 0;
+  for (std::size_t a = 0; a < m; ++a) s += u_row[a] * z[base[row[a]] + i];
+  z[diagonal(i)] = (inv - s) * inv;
 }
 
 bool EnvelopeCholesky::inverseEntry(Eigen::Index i, Eigen::Index j, double& out) const {
   if (i > j) std::swap(i, j);
-  if (!inverse_ || i < 0 || j >= size() || i < first_[static_cast<std::size_t>(j)]) return false;
+  if (!inverse_ || i < inverse_from_ || i < 0 || j >= size() || i < first_[static_cast<std::size_t>(j)]) return false;
   out = h_[position(i, j)];
   return true;
 }

@@ -45,11 +45,16 @@ class EnvelopeCholesky {
   Eigen::MatrixXd solve(const Eigen::MatrixXd& B) const;
 
   /// Computes H⁻¹ on the envelope (Takahashi's recurrences with U's rows:
-  /// every entry the envelope holds, which includes U's pattern), in H's
-  /// storage: values() must be refilled before the next factorize().
-  void selectedInverse();
-  /// H⁻¹(i, j) if (i, j) lies in the envelope (after selectedInverse()).
+  /// every entry the envelope holds, which includes U's pattern) for the
+  /// rows from `down_to` on, in H's storage: values() must be refilled
+  /// before the next factorize(). The sweep runs from the last row up; a
+  /// later call with a smaller `down_to` resumes it.
+  void selectedInverse(Eigen::Index down_to = 0);
+  /// H⁻¹(i, j) if (i, j) lies in the envelope and the sweep reached
+  /// min(i, j) (after selectedInverse()).
   bool inverseEntry(Eigen::Index i, Eigen::Index j, double& out) const;
+  /// The first row the selected inverse holds (size() before any sweep).
+  Eigen::Index inverseFrom() const { return inverse_ ? inverse_from_ : size(); }
 
  private:
   std::vector<int> first_;
@@ -58,8 +63,14 @@ class EnvelopeCholesky {
   void solveInPlace(double* x) const;  // x: n entries
   void offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j);  // U(i, j), i < j
   bool pivot(std::ptrdiff_t j);                          // 1/U(j, j); false if not positive definite there
+  void inverseRow(Eigen::Index i, const std::vector<int>& row, std::vector<double>& u_row);
   // inverse_: h_ holds H⁻¹ on the envelope, not H (values() must refill it).
   bool factored_ = false, inverse_ = false;
+  // The selected inverse's sweep: rows from inverse_from_ on are done; the
+  // columns of the next row up and a buffer for its U entries.
+  Eigen::Index inverse_from_ = 0;
+  std::vector<int> sweep_columns_;
+  std::vector<double> sweep_u_;
 };
 
 }  // namespace gssm::internal

@@ -313,9 +313,10 @@ struct BatchSolver::Impl {
   Eigen::MatrixXd solve(const Eigen::MatrixXd& B) { return use_envelope ? envelope.solve(B) : chol.solve(B); }
   // H⁻¹(i, j) if the selected inverse holds it (computed on the first call).
   bool inverseEntry(Eigen::Index i, Eigen::Index j, double& out) const {
-    if (use_envelope) {
-      if (!envelope_inverse) {
-        const_cast<internal::EnvelopeCholesky&>(envelope).selectedInverse();
+    if (use_envelope) {  // the sweep goes up only as far as the rows asked for
+      const Eigen::Index row = std::min(i, j);
+      if (!envelope_inverse || row < envelope.inverseFrom()) {
+        const_cast<internal::EnvelopeCholesky&>(envelope).selectedInverse(std::max<Eigen::Index>(row, 0));
         envelope_inverse = true;
       }
       return envelope.inverseEntry(i, j, out);
