@@ -147,13 +147,14 @@ void ExtendedKalmanFilter::commitUpdate(const Eigen::MatrixXd& HP, const Eigen::
   Eigen::MatrixXd P;
   if (options_.joseph_form) {
     const Eigen::MatrixXd A = 0.5 * S * K.transpose() - HP;  // m × n
-    P.resize(P_.rows(), P_.cols());
-    for (Eigen::Index j = 0; j < P.cols(); ++j)  // the upper triangle, mirrored: P stays exactly symmetric
-      for (Eigen::Index i = 0; i <= j; ++i) {
-        double v = P_(i, j);
-        for (Eigen::Index c = 0; c < K.cols(); ++c) v += K(i, c) * A(c, j) + K(j, c) * A(c, i);
-        P(i, j) = P(j, i) = v;
-      }
+    P = P_;
+    for (Eigen::Index j = 0; j < P.cols(); ++j) {  // the upper triangle by columns, then mirrored: exactly symmetric
+      auto upper = P.col(j).head(j + 1);
+      for (Eigen::Index c = 0; c < K.cols(); ++c)
+        upper += K.col(c).head(j + 1) * A(c, j) + A.row(c).head(j + 1).transpose() * K(j, c);
+    }
+    for (Eigen::Index j = 0; j < P.cols(); ++j)
+      for (Eigen::Index i = j + 1; i < P.rows(); ++i) P(i, j) = P(j, i);
   } else {
     P = P_ - K * HP;
   }
