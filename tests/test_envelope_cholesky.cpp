@@ -87,7 +87,9 @@ void expectMatchesDense(const Eigen::MatrixXd& H, const std::vector<int>& first,
 
 TEST(EnvelopeCholesky, ChainsWithAConstantsBorderMatchTheDenseFactorization) {
   std::mt19937 rng(2);
-  for (auto [steps, nc, nb] : {std::tuple{1, 1, 0}, {50, 1, 2}, {40, 3, 2}, {30, 2, 0}, {25, 1, 6}, {10, 4, 5}}) {
+  // {60, 6, 25}: the UWB layout, whose constants' panel takes the Gram
+  // matrix of its rows above (and {10, 4, 5}: too few rows for that).
+  for (auto [steps, nc, nb] : {std::tuple{1, 1, 0}, {50, 1, 2}, {40, 3, 2}, {30, 2, 0}, {25, 1, 6}, {10, 4, 5}, {60, 6, 25}}) {
     std::vector<int> first;
     const Eigen::MatrixXd H = chainMatrix(rng, steps, nc, nb, first);
     SCOPED_TRACE(::testing::Message() << steps << " steps, nc " << nc << ", nb " << nb);
@@ -131,4 +133,22 @@ TEST(EnvelopeCholesky, ReportsTheFirstColumnThatIsNotPositiveDefinite) {
   EXPECT_EQ(c.factorize(), bad);
   Eigen::VectorXd b = Eigen::VectorXd::Ones(H.rows());
   EXPECT_THROW(c.solveInPlace(b), gssm::NumericalError);
+}
+
+TEST(EnvelopeCholesky, ReportsTheFirstConstantThatIsNotPositiveDefiniteInAWidePanel) {
+  // 12 constants over 40 states' rows: the panel factored through the Gram
+  // matrix of its rows above; constant 5 made dependent on the columns before.
+  std::mt19937 rng(5);
+  std::vector<int> first;
+  Eigen::MatrixXd H = chainMatrix(rng, 40, 2, 12, first);
+  const Eigen::Index bad = 80 + 5;
+  const Eigen::MatrixXd Hs = H.topLeftCorner(bad, bad);
+  const Eigen::VectorXd h = H.col(bad).head(bad);
+  H(bad, bad) = h.dot(Hs.llt().solve(h)) - 1e-9;
+  EnvelopeCholesky c;
+  fill(c, H, first);
+  EXPECT_EQ(c.factorize(), bad);
+  H(bad, bad) = std::nan("");
+  fill(c, H, first);
+  EXPECT_EQ(c.factorize(), bad);
 }

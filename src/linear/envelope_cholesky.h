@@ -64,6 +64,11 @@ class EnvelopeCholesky {
   void offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j);  // U(i, j), i < j
   bool pivot(std::ptrdiff_t j);                          // 1/U(j, j); false if not positive definite there
   void inverseRow(Eigen::Index i, const std::vector<int>& row, std::vector<double>& u_row);
+  Eigen::Index panelByDots(std::ptrdiff_t j, std::ptrdiff_t end);
+  Eigen::Index panelByGram(std::ptrdiff_t j, std::ptrdiff_t end);
+  // A panel this wide over this many rows above it takes their Gram matrix.
+  static constexpr std::ptrdiff_t kGramColumns = 8, kGramRows = 32;
+  static constexpr std::ptrdiff_t kPanelGroup = 4;  // a panel's columns taken together down the rows above it
   // inverse_: h_ holds H⁻¹ on the envelope, not H (values() must refill it).
   bool factored_ = false, inverse_ = false;
   // The selected inverse's sweep: rows from inverse_from_ on are done; the
