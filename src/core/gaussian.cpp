@@ -56,21 +56,25 @@ GaussianNoise::GaussianNoise(const Eigen::MatrixXd& covariance, const std::strin
   d->L = Eigen::LLT<Eigen::MatrixXd>(covariance).matrixL();
   const Eigen::Index n = d->L.rows();
   d->diagonal = n <= 1 || (d->L - Eigen::MatrixXd(d->L.diagonal().asDiagonal())).cwiseAbs().maxCoeff() == 0.0;
+  d->inverse_diagonal = d->L.diagonal().cwiseInverse();
   data_ = d.release();
 }
 
-// A diagonal L (independent noise, the common case) divides row by row: the
-// same arithmetic as the triangular solve, without its general-size
-// overhead, which was 6% of a million-step batch solve on 1×1 blocks.
+// A diagonal L (independent noise, the common case) scales row by row by
+// 1/L(i, i): without a general-size triangular solve's overhead (6% of a
+// million-step batch solve on 1×1 blocks), and a multiply where a divide
+// was (a range's 30 Jacobian entries: a quarter of its linearization). A
+// full L solves, skipping a block of exact zeros (a motion model's block on
+// constants it does not use), which it would leave zero.
 void GaussianNoise::whitenInPlace(Eigen::VectorXd& v) const {
-  if (data_->diagonal) v.array() /= data_->L.diagonal().array();
+  if (data_->diagonal) v.array() *= data_->inverse_diagonal.array();
   else data_->L.triangularView<Eigen::Lower>().solveInPlace(v);
 }
 
 void GaussianNoise::whitenInPlace(Eigen::MatrixXd& m) const {
   if (data_->diagonal) {
-    for (Eigen::Index i = 0; i < m.rows(); ++i) m.row(i) /= data_->L(i, i);
-  } else {
+    for (Eigen::Index i = 0; i < m.rows(); ++i) m.row(i) *= data_->inverse_diagonal[i];
+  } else if (!(m.array() == 0.0).all()) {
     data_->L.triangularView<Eigen::Lower>().solveInPlace(m);
   }
 }

@@ -50,9 +50,11 @@ double internal::robustify(const RobustLoss& loss, Eigen::VectorXd& r, std::vect
   const double s = r.squaredNorm();
   if (!loss.robust()) return 0.5 * s;
   const double w = std::sqrt(loss.weight(s));
-  r *= w;
-  if (J)
-    for (auto& block : *J) block *= w;
+  if (w != 1.0) {  // an inlier of a Huber loss keeps its weight 1: nothing to scale
+    r *= w;
+    if (J)
+      for (auto& block : *J) block *= w;
+  }
   return 0.5 * loss.rho(s);
 }
 

@@ -49,6 +49,7 @@ class GaussianNoise {
   // a noise model per factor, and a shared_ptr took two words.
   struct Data {
     Eigen::MatrixXd covariance, L;
+    Eigen::VectorXd inverse_diagonal;  // 1 / L(i, i): whitening independent noise multiplies
     bool diagonal = true;
     mutable std::atomic<long> refs{1};
   };
