@@ -664,12 +664,15 @@ class PaperWindowEstimator final : public Estimator {
   // re-solved twice a step, and on a log with robust ranges its iterations
   // converge linearly (a step ~1/30 of the one before); the batch default
   // (1e-12) spent a fourth iteration moving the estimate by < 1e-6 m (UWB:
-  // 20% of the method's time; estimates within 2·10⁻⁵ of it).
+  // 20% of the method's time; estimates within 2·10⁻⁵ of it). The last,
+  // negligible step is taken without relinearizing after it: the window's
+  // covariances come from the factorization that computed it.
   static BatchSolverOptions gaussNewton() {
     BatchSolverOptions o;
     o.method = BatchSolverOptions::Method::GaussNewton;
     o.max_iterations = 20;
     o.relative_cost_tolerance = 1e-9;
+    o.relinearize_at_solution = false;
     return o;
   }
   static Gaussian diagonalPrior(const Eigen::VectorXd& mean, const Eigen::MatrixXd& cov) {
@@ -698,6 +701,7 @@ class PaperWindowEstimator final : public Estimator {
     out.gaussian(prior_state_);
     out.gaussian(prior_constants_);
     out.i64(oldest_);
+    out.values(solver_.factoredAt(values_));  // since version 5
   }
   void loadState(internal::ByteReader& in) override {
     std::deque<std::vector<FactorPtr>> steps(in.count("window steps", 8));
@@ -709,6 +713,7 @@ class PaperWindowEstimator final : public Estimator {
     Values values = in.values("window values");
     Gaussian ps = in.gaussian("prior on the oldest state"), pb = in.gaussian("prior on the constants");
     const std::int64_t oldest = in.i64("oldest step");
+    Values factored = in.version() >= 5 ? in.values("window factorization point") : values;
     const bool nb = model_.dims().nb > 0;
     if (oldest < 0 || oldest > step()) in.fail("oldest window step " + std::to_string(oldest) + " out of range");
     const std::int64_t held = step() - oldest + 1;
@@ -719,16 +724,24 @@ class PaperWindowEstimator final : public Estimator {
     for (std::int64_t k = oldest; ok && k <= step(); ++k)
       ok = values.contains(Key::state(k)) && values.at(Key::state(k)).size() == model_.dims().nc;
     if (ok && nb) ok = values.contains(Key::constants()) && values.at(Key::constants()).size() == model_.dims().nb;
+    ok = ok && sameLayout(factored, values);
     if (!ok) in.fail("the paper window's states, times and priors do not match step " + std::to_string(step()));
-    // The covariances come from a factorization at the window's values; the
-    // uninterrupted run factored the same matrix at the same point.
+    // The covariances come from the factorization the uninterrupted run
+    // kept: at the point before its last step (version 4 and older: at the
+    // window's values).
     steps_ = std::move(steps);
     times_ = std::move(times);
     values_ = std::move(values);
     prior_state_ = std::move(ps);
     prior_constants_ = std::move(pb);
     oldest_ = oldest;
-    solver_.evaluateAt(graph(), values_);
+    solver_.evaluateAt(graph(), factored);
+  }
+  static bool sameLayout(const Values& a, const Values& b) {
+    if (a.size() != b.size()) return false;
+    for (auto i = a.begin(), j = b.begin(); i != a.end(); ++i, ++j)
+      if (!(i->first == j->first) || i->second.size() != j->second.size()) return false;
+    return true;
   }
   std::string formatDetail() const override { return last_summary_.toString(); }
   BatchSolverSummary last_summary_;

@@ -38,6 +38,8 @@ bool BatchSolverOptions::validate(std::string* why) const {
   if (!(initial_lambda > 0)) return fail("initial_lambda must be > 0");
   if (!(max_lambda > initial_lambda)) return fail("max_lambda must exceed initial_lambda");
   if (newton_polish_steps < 0) return fail("newton_polish_steps must be >= 0");
+  if (!relinearize_at_solution && (method != Method::GaussNewton || newton_polish_steps > 0))
+    return fail("relinearize_at_solution = false needs Gauss-Newton without a Newton polish");
   return true;
 }
 
@@ -91,6 +93,7 @@ struct BatchSolver::Impl {
   // measurement factors reuse their storage.
   std::vector<std::vector<Eigen::MatrixXd>> jacobians;
   bool has_solution = false;
+  Eigen::VectorXd factored_point;  // where H was last factored, flat in the layout
   // H⁻¹ on the factor's pattern, computed on the first covariance query.
   mutable std::optional<internal::SparseCholesky::SelectedInverse> selected;
   mutable bool envelope_inverse = false;  // envelope.selectedInverse() done for this solution
@@ -379,6 +382,7 @@ struct BatchSolver::Impl::Iteration {
   // Values was 64 MB of fresh memory and a million small allocations at 10⁶
   // steps.
   Eigen::VectorXd x_before;
+  bool factored_at_solution = false;  // the last step kept its factorization (relinearize_at_solution false)
 
   Iteration(Impl& impl, const BatchSolverOptions& o, const FactorGraph& gr, Values& values, BatchSolverSummary& summary)
       : s(impl), options(o), graph(gr), x(values), sum(summary) {
@@ -426,6 +430,16 @@ struct BatchSolver::Impl::Iteration {
     }
     delta = -g;
     s.solveInPlace(delta);  // −H⁻¹g, exactly the negated solution
+    const double predicted = -0.5 * g.dot(delta);  // the Gauss–Newton model's decrease
+    if (!options.relinearize_at_solution && predicted <= options.relative_cost_tolerance * cost) {
+      internal::flatten(x, s.factored_point);
+      internal::addStep(x, delta, x);  // the last step: H as factored stays the solution's
+      ++sum.iterations;
+      cost -= predicted;
+      factored_at_solution = true;
+      sum.termination = Termination::CostConverged;
+      return false;
+    }
     if (stepConverged(delta, x)) {
       if (policy.undamped()) {  // a tiny undamped step is still the exact correction: take it
         internal::addStep(x, delta, x);
@@ -537,7 +551,10 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   Impl::Iteration it(s, options_, graph, values, sum);
   it.run();
   if (isConverged(sum.termination) && options_.newton_polish_steps > 0) it.polish();
-  it.factorAtSolution();
+  if (!it.factored_at_solution) {
+    it.factorAtSolution();
+    internal::flatten(values, s.factored_point);
+  }
   s.has_solution = true;
   restore.armed = false;
 
@@ -560,6 +577,20 @@ void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
   const Eigen::Index bad = s.factorize();
   if (bad >= 0) s.throwSingular(bad);
   s.has_solution = true;
+  internal::flatten(values, s.factored_point);
+}
+
+Values BatchSolver::factoredAt(const Values& like) const {
+  const Impl& s = *impl_;
+  if (!s.has_solution) throw InvalidArgument("BatchSolver: no solution yet; call solve() before factoredAt()");
+  Eigen::Index n = 0;
+  for (const auto& kv : like) n += kv.second.size();
+  if (n != s.factored_point.size())
+    throw InvalidArgument("BatchSolver::factoredAt: the values have " + std::to_string(n) +
+                          " entries, the last solve " + std::to_string(s.factored_point.size()));
+  Values out = like;
+  internal::unflatten(s.factored_point, out);
+  return out;
 }
 
 Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& keys) const {

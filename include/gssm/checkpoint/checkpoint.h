@@ -33,7 +33,10 @@ namespace gssm {
 /// still restore (those start at 0 and false). Version 4 the smoothers'
 /// full-pass schedule (SmootherOptions::full_pass_growth and its counts;
 /// older files resume with growth 1, a pass whenever the constants moved).
-constexpr std::uint32_t kCheckpointVersion = 4;
+/// Version 5 the point of the paper window's kept factorization (its last
+/// Gauss–Newton step is not relinearized; older files use the window's
+/// values).
+constexpr std::uint32_t kCheckpointVersion = 5;
 
 /// What a checkpoint says about itself (filled by restore).
 struct CheckpointInfo {
