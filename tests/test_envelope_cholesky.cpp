@@ -65,9 +65,16 @@ void expectMatchesDense(const Eigen::MatrixXd& H, const std::vector<int>& first,
   EXPECT_LT((x - x_dense).norm(), 1e-9 * (1 + x_dense.norm()));
   const Eigen::MatrixXd B = Eigen::MatrixXd::Random(H.rows(), 3);
   EXPECT_LT((c.solve(B) - H.llt().solve(B)).norm(), 1e-9 * (1 + B.norm()));
+  // A block by forward substitution, anywhere: the top (a window's oldest
+  // state), the middle, the last column.
+  const Eigen::MatrixXd Hinv = H.inverse();
+  const Eigen::Index n = H.rows();
+  for (auto [first_col, size] : {std::pair<Eigen::Index, Eigen::Index>{0, std::min<Eigen::Index>(3, n)}, {n / 3, 1}, {n - 1, 1}})
+    EXPECT_LT((c.inverseBlock(first_col, size) - Hinv.block(first_col, first_col, size, size)).norm(),
+              1e-9 * (1 + Hinv.block(first_col, first_col, size, size).norm()))
+        << "block " << first_col << " + " << size;
   // The sweep in two parts: the lower half's rows first (what a window's
   // newest state and constants need), then resumed to the top.
-  const Eigen::MatrixXd Hinv = H.inverse();
   for (const Eigen::Index from : {H.rows() / 2, Eigen::Index{0}}) {
     c.selectedInverse(from);
     EXPECT_EQ(c.inverseFrom(), from);

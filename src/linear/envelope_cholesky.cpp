@@ -212,6 +212,34 @@ void EnvelopeCholesky::inverseRow(Eigen::Index i, const std::vector<int>& row, s
   z[diagonal(i)] = (inv - s) * inv;
 }
 
+Eigen::MatrixXd EnvelopeCholesky::inverseBlock(Eigen::Index first, Eigen::Index size) const {
+  if (!factored_) throw NumericalError("EnvelopeCholesky: inverse block before a successful factorize()");
+  const auto n = static_cast<std::ptrdiff_t>(first_.size());
+  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(n - first, size);  // rows first … n − 1 of U⁻ᵀE
+  for (Eigen::Index c = 0; c < size; ++c) {
+    double* w = W.col(c).data() - first;  // w[j]: row j
+    w[first + c] = 1.0;
+    for (std::ptrdiff_t j = first + c; j < n; ++j) {  // Uᵀw = e: rows above first + c are 0
+      const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(first_[static_cast<std::size_t>(j)], first + c);
+      const double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
+      w[j] = (w[j] - dot(uj + lo, w + lo, j - lo)) * uj[j];
+    }
+  }
+  const Eigen::MatrixXd block = W.transpose() * W;
+  return 0.5 * (block + block.transpose());
+}
+
+double EnvelopeCholesky::inverseBlockWork(Eigen::Index first, Eigen::Index size) const {
+  const auto f = static_cast<std::size_t>(first);
+  const double below = static_cast<double>(h_.size()) - static_cast<double>(base_[f] + first_[f]);
+  return static_cast<double>(size) * below;
+}
+
+double EnvelopeCholesky::sweepWork(Eigen::Index first) const {
+  const double width = static_cast<double>(h_.size()) / static_cast<double>(std::max<Eigen::Index>(size(), 1));
+  return static_cast<double>(std::max<Eigen::Index>(inverseFrom() - first, 0)) * width * width;
+}
+
 bool EnvelopeCholesky::inverseEntry(Eigen::Index i, Eigen::Index j, double& out) const {
   if (i > j) std::swap(i, j);
   if (!inverse_ || i < inverse_from_ || i < 0 || j >= size() || i < first_[static_cast<std::size_t>(j)]) return false;

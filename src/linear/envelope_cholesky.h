@@ -53,6 +53,15 @@ class EnvelopeCholesky {
   /// H⁻¹(i, j) if (i, j) lies in the envelope and the sweep reached
   /// min(i, j) (after selectedInverse()).
   bool inverseEntry(Eigen::Index i, Eigen::Index j, double& out) const;
+  /// The block of H⁻¹ on columns [first, first + size) as WᵀW with
+  /// W = U⁻ᵀE (E: those unit columns; H⁻¹ = U⁻¹U⁻ᵀ): one forward
+  /// substitution per column from row `first` down, no sweep — for a small
+  /// block near the top, which the sweep reaches only at its end.
+  Eigen::MatrixXd inverseBlock(Eigen::Index first, Eigen::Index size) const;
+  /// Work of inverseBlock(first, size) and of the sweep from where it stands
+  /// up to row `first`, in multiply-adds (estimates, to choose between them).
+  double inverseBlockWork(Eigen::Index first, Eigen::Index size) const;
+  double sweepWork(Eigen::Index first) const;
   /// The first row the selected inverse holds (size() before any sweep).
   Eigen::Index inverseFrom() const { return inverse_ ? inverse_from_ : size(); }
 

@@ -97,6 +97,7 @@ struct BatchSolver::Impl {
   // H⁻¹ on the factor's pattern, computed on the first covariance query.
   mutable std::optional<internal::SparseCholesky::SelectedInverse> selected;
   mutable bool envelope_inverse = false;  // envelope.selectedInverse() done for this solution
+  mutable bool envelope_block_used = false;  // envelope.inverseBlock() answered once for this solution
 
   // The variables' layout, each factor's variables and shape, then the
   // linear solver for the graph's pattern.
@@ -306,7 +307,7 @@ struct BatchSolver::Impl {
   }
   Eigen::Index factorize() {
     selected.reset();
-    envelope_inverse = false;
+    envelope_inverse = envelope_block_used = false;
     return use_envelope ? envelope.factorize() : chol.factorize();
   }
   void solveInPlace(Eigen::VectorXd& b) {
@@ -610,6 +611,15 @@ Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& key
     offs[a] = s.offset[i];
     dims[a] = s.offset[i + 1] - s.offset[i];
     m += dims[a];
+  }
+  // One small variable the envelope's selected inverse has not reached (a
+  // window's oldest states): a forward substitution per column beats the
+  // sweep up to it — once per factorization, so that asking for every
+  // state in turn still takes one sweep, not one substitution each.
+  if (s.use_envelope && keys.size() == 1 && !s.envelope_block_used && offs[0] < s.envelope.inverseFrom() &&
+      s.envelope.inverseBlockWork(offs[0], dims[0]) < s.envelope.sweepWork(offs[0])) {
+    s.envelope_block_used = true;
+    return s.envelope.inverseBlock(offs[0], dims[0]);
   }
   Eigen::MatrixXd out(m, m);
   // Fast path: every requested entry lies on the factor's pattern (true for
