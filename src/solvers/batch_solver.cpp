@@ -161,30 +161,42 @@ struct BatchSolver::Impl {
   // SparseCholesky for any other graph (dense up to 64 unknowns, CHOLMOD
   // beyond). True when the envelope is used.
   bool chooseEnvelope(const FactorGraph& graph) {
-    std::vector<int> first(static_cast<std::size_t>(n));
-    for (Eigen::Index j = 0; j < n; ++j) first[static_cast<std::size_t>(j)] = static_cast<int>(j);
+    // Every column of a factor's variables gets the factor's lowest column
+    // as a first row (it is ≤ each of them): one minimum per variable, not
+    // per column (a range reaches 30 columns through two variables).
+    std::vector<Eigen::Index> low(layout.size(), n);  // lowest column of any factor on the variable
     std::size_t added = 0;
     for (std::size_t fi = 0; fi < graph.size(); ++fi) {
-      placeColumns(fi);
-      const std::size_t m = columns.size();
-      if (!columns.ascending) {  // repeated columns: pair by pair
-        internal::forEachUpperPair(columns, [&](std::size_t p, std::size_t q) {
-          int& f = first[static_cast<std::size_t>(columns.global[q])];
-          f = std::min(f, static_cast<int>(columns.global[p]));
-          ++added;
-        });
-        continue;
+      const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
+      Eigen::Index lowest = n, prev = -1, m = 0;
+      bool ascending = true;
+      for (std::size_t a = 0; a < count; ++a) {
+        const std::uint32_t v = factor_vars[b + a];
+        const Eigen::Index o = offset[v], d = offset[v + 1] - o;
+        if (d == 0) continue;
+        if (o <= prev) ascending = false;  // a repeated column: its pairs counted one by one
+        prev = o + d - 1;
+        lowest = std::min(lowest, o);
+        m += d;
       }
-      // Every column's first row from this factor is its smallest column.
-      const int lowest = m ? static_cast<int>(columns.global[0]) : 0;
-      for (std::size_t q = 0; q < m; ++q) {
-        int& f = first[static_cast<std::size_t>(columns.global[q])];
-        f = std::min(f, lowest);
+      for (std::size_t a = 0; a < count; ++a) {
+        Eigen::Index& l = low[factor_vars[b + a]];
+        l = std::min(l, lowest);
       }
-      added += m * (m + 1) / 2;
+      if (ascending) {
+        added += static_cast<std::size_t>(m * (m + 1) / 2);
+      } else {
+        placeColumns(fi);
+        internal::forEachUpperPair(columns, [&](std::size_t, std::size_t) { ++added; });
+      }
     }
+    std::vector<int> first(static_cast<std::size_t>(n));
     std::size_t size = 0;
-    for (Eigen::Index j = 0; j < n; ++j) size += static_cast<std::size_t>(j - first[static_cast<std::size_t>(j)] + 1);
+    for (std::size_t v = 0; v < layout.size(); ++v)
+      for (Eigen::Index j = offset[v]; j < offset[v + 1]; ++j) {
+        first[static_cast<std::size_t>(j)] = static_cast<int>(std::min(j, low[v]));
+        size += static_cast<std::size_t>(j - first[static_cast<std::size_t>(j)] + 1);
+      }
     use_envelope = n > 0 && size <= 2 * added + static_cast<std::size_t>(n);
     if (use_envelope) {
       chol.reset(0, 0);  // a previous graph's pattern and factor go
