@@ -22,7 +22,11 @@ void requireVector(const Eigen::VectorXd& v, Eigen::Index n, const std::string& 
     }
 }
 
-void requireCovariance(const Eigen::MatrixXd& m, Eigen::Index n, const std::string& what) {
+namespace {
+// requireCovariance's checks; returns the Cholesky factor L they computed
+// (a diagonal covariance, a window's re-prior, needs no factorization: L is
+// the square roots, what the factorization would give bit for bit).
+Eigen::MatrixXd checkedCholeskyFactor(const Eigen::MatrixXd& m, Eigen::Index n, const std::string& what) {
   if (m.rows() != n || m.cols() != n) {
     std::ostringstream os;
     os << what << ": expected a " << n << "x" << n << " covariance, got " << m.rows() << "x"
@@ -33,14 +37,30 @@ void requireCovariance(const Eigen::MatrixXd& m, Eigen::Index n, const std::stri
   const double scale = std::max(1.0, m.cwiseAbs().maxCoeff());
   if ((m - m.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale)
     throw InvalidArgument(what + ": covariance is not symmetric");
-  Eigen::LLT<Eigen::MatrixXd> llt(m);
-  if (llt.info() != Eigen::Success) {
+  const Eigen::MatrixXd off_diagonal = m - Eigen::MatrixXd(m.diagonal().asDiagonal());
+  bool ok = true;
+  Eigen::MatrixXd L;
+  if ((off_diagonal.array() == 0.0).all()) {
+    ok = (m.diagonal().array() > 0).all();
+    L = m.diagonal().cwiseSqrt().asDiagonal();
+  } else {
+    Eigen::LLT<Eigen::MatrixXd> llt(m);
+    ok = llt.info() == Eigen::Success;
+    L = llt.matrixL();
+  }
+  if (!ok) {
     std::ostringstream os;
     os << what << ": covariance is not positive definite (diagonal: "
        << m.diagonal().transpose()
        << "); every variance must be > 0 and the matrix full rank";
     throw NumericalError(os.str());
   }
+  return L;
+}
+}  // namespace
+
+void requireCovariance(const Eigen::MatrixXd& m, Eigen::Index n, const std::string& what) {
+  checkedCholeskyFactor(m, n, what);
 }
 
 GaussianNoise::GaussianNoise() {
@@ -50,10 +70,9 @@ GaussianNoise::GaussianNoise() {
 }
 
 GaussianNoise::GaussianNoise(const Eigen::MatrixXd& covariance, const std::string& what) {
-  requireCovariance(covariance, covariance.rows(), what);
   auto d = std::make_unique<Data>();
+  d->L = checkedCholeskyFactor(covariance, covariance.rows(), what);  // one factorization for the checks and L
   d->covariance = covariance;
-  d->L = Eigen::LLT<Eigen::MatrixXd>(covariance).matrixL();
   const Eigen::Index n = d->L.rows();
   d->diagonal = n <= 1 || (d->L - Eigen::MatrixXd(d->L.diagonal().asDiagonal())).cwiseAbs().maxCoeff() == 0.0;
   d->inverse_diagonal = d->L.diagonal().cwiseInverse();
