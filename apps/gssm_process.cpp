@@ -101,7 +101,8 @@ int main(int argc, char** argv) {
     if (r.status.late_rows > 0)
       std::cout << "gssm-process: " << r.status.late_rows << " measurement rows came after later ones (up to "
                 << r.status.max_lateness << " s late): processed in time order\n";
-    for (const auto& p : gssm::plot::writeProcessFigures(r, options.out_dir)) std::cout << "figure: " << p << "\n";
+    for (const auto& p : gssm::plot::writeProcessFigures(r, options.out_dir, static_cast<int>(options.threads)))
+      std::cout << "figure: " << p << "\n";
     std::cout << "gssm-process: wrote " << options.out_dir << "/metrics.json and estimates-*.csv\n";
     if (r.status.partial) {
       // Everything before the bad row was processed and written; say where it stopped.

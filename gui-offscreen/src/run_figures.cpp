@@ -175,14 +175,11 @@ std::optional<Figure> latencyFigure(const std::vector<OfflineRun>& runs, const s
 
 std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
                                          const Truth* truth, const std::string& dir,
-                                         const std::string& scenario_label, const std::optional<PlanView>& plan) {
+                                         const std::string& scenario_label, const std::optional<PlanView>& plan,
+                                         int threads) {
   namespace fs = std::filesystem;
-  std::vector<std::string> written;
-  const auto save = [&](const Figure& f, const std::string& name) {
-    const std::string path = (fs::path(dir) / name).string();
-    savePng(f, path);
-    written.push_back(path);
-  };
+  std::vector<std::pair<Figure, std::string>> figures;  // built first, then drawn `threads` at a time
+  const auto save = [&](Figure f, const std::string& name) { figures.emplace_back(std::move(f), (fs::path(dir) / name).string()); };
   const auto names = model.stackedStateNames();
   for (std::size_t i = 0; i < names.size(); ++i) {
     const bool constant = static_cast<int>(i) >= model.dims().nc;
@@ -196,6 +193,9 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
       save(positionErrorFigure(runs, *truth, plan->x, plan->y, tx, ty, scenario_label), "fig-position-error.png");
   }
   if (const auto latency = latencyFigure(runs, scenario_label)) save(*latency, "fig-latency.png");
+  savePngs(figures, threads);
+  std::vector<std::string> written;
+  for (const auto& f : figures) written.push_back(f.second);
   return written;
 }
 
@@ -216,7 +216,7 @@ void addBodyPointTracks(const Model& model, const io::ProcessResult& r, PlanView
 }
 }  // namespace
 
-std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const std::string& dir) {
+std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const std::string& dir, int threads) {
   const Model& model = *r.model;
   std::optional<PlanView> plan;
   const auto names = model.stackedStateNames();
@@ -231,7 +231,7 @@ std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const s
     addBodyPointTracks(model, r, *plan);
   }
   std::vector<std::string> files =
-      writeRunFigures(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan);
+      writeRunFigures(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan, threads);
   if (r.learnt) files.push_back(writeLearningFigure(*r.learnt, dir, r.label));
   if (r.dataset.constants_reference && !r.runs.empty() && model.dims().nb > 0) {
     const auto batch = std::find_if(r.runs.begin(), r.runs.end(), [](const OfflineRun& x) { return x.method == Method::Batch; });

@@ -177,8 +177,8 @@ def process(data, out, *, method="all", config=None, window=None, checkpoint_eve
     scenario.ini. window: fixed-lag and paper-window states. checkpoint_every,
     resume: as gssm-process's --checkpoint-every, --resume. learn: True to
     learn the noise first (gssm-process --learn), False not to, None as the
-    INI's [learn] enabled says. threads: methods run at the same time
-    (gssm-process --threads; the same output). progress: a
+    INI's [learn] enabled says. threads: methods run at the same time, and
+    figures drawn (gssm-process --threads; the same output). progress: a
     callable(method, done, total), called from the loop (from the method's
     thread, one call at a time). Errors are gssm.Error
     subclasses naming file, line and column, as gssm-process prints them.
@@ -198,7 +198,7 @@ def process(data, out, *, method="all", config=None, window=None, checkpoint_eve
         except ImportError as e:
             raise Error("gssm.process: figures need the gssm._plot extension (built with the apps, "
                         "GSSM_BUILD_APPS=ON); pass figures=False (%s)" % e) from e
-        result._add_files(_plot.write_process_figures(result, str(out)))
+        result._add_files(_plot.write_process_figures(result, str(out), int(threads)))
     return result
 
 

@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "gssm/plot/figure.h"
 #include "gssm/plot/ticks.h"
@@ -75,4 +77,42 @@ TEST(Figure, WritesAPngOfTheRequestedSizeThatIsNotBlank) {
   // the sine spans most of the plot height: its curve has many pixels, which
   // it would not if the 1e6 outlier had set the range
   EXPECT_GT(curve, 800u);
+}
+
+TEST(Figure, FiguresDrawnInParallelAreTheFilesDrawnOneAfterAnother) {
+  // Eight figures of different curves (and one path that cannot be
+  // written), drawn by one thread and by three: the same bytes, and the
+  // error still reported once every other figure was written.
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() / "gssm_plot_parallel";
+  fs::remove_all(root);
+  std::vector<std::pair<Figure, std::string>> one, three;
+  for (int k = 0; k < 8; ++k) {
+    Figure f;
+    f.title = "curve " + std::to_string(k);
+    Series s{"s", {}, {}, paletteColor(k), 2, false};
+    for (int i = 0; i <= 200; ++i) {
+      s.x.push_back(i * 0.05);
+      s.y.push_back(std::sin((k + 1) * i * 0.05));
+    }
+    f.series.push_back(s);
+    for (auto* jobs : {&one, &three}) {
+      const fs::path dir = root / (jobs == &one ? "one" : "three");
+      fs::create_directories(dir);
+      jobs->emplace_back(f, (dir / ("fig-" + std::to_string(k) + ".png")).string());
+    }
+  }
+  savePngs(one, 1);
+  three.emplace(three.begin() + 3, one[0].first, (root / "missing-dir" / "x.png").string());
+  EXPECT_THROW(savePngs(three, 3), std::runtime_error);
+  for (int k = 0; k < 8; ++k) {
+    auto bytes = [](const std::string& p) {
+      std::ifstream in(p, std::ios::binary);
+      return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    };
+    const std::string a = bytes(one[static_cast<std::size_t>(k)].second);
+    EXPECT_FALSE(a.empty()) << k;
+    EXPECT_EQ(a, bytes((root / "three" / ("fig-" + std::to_string(k) + ".png")).string())) << k;
+  }
+  fs::remove_all(root);
 }

@@ -55,6 +55,10 @@ struct Figure {
 /// Draws the figure into a PNG of the given size; throws std::runtime_error
 /// if the file cannot be written.
 void savePng(const Figure& fig, const std::string& path, int width = 960, int height = 600);
+/// savePng of each (figure, path), up to `threads` at a time (drawing and
+/// PNG encoding are most of a figure's cost): the same files as one after
+/// another. An error is rethrown once every figure was tried.
+void savePngs(const std::vector<std::pair<Figure, std::string>>& figures, int threads);
 
 /// A histogram figure of `values` (e.g. latencies) with `bins` bins per group;
 /// each group is one labelled colour.

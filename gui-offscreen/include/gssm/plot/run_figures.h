@@ -27,12 +27,12 @@ struct PlanView {
 };
 
 /// Writes fig-<constant>.png, fig-<state>-error.png (with truth),
-/// fig-trajectory.png (with a plan view) and fig-latency.png into `dir`;
-/// returns the paths written.
+/// fig-trajectory.png (with a plan view) and fig-latency.png into `dir`,
+/// drawing up to `threads` at a time (savePngs); returns the paths written.
 std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
                                          const Truth* truth, const std::string& dir,
                                          const std::string& scenario_label,
-                                         const std::optional<PlanView>& plan = std::nullopt);
+                                         const std::optional<PlanView>& plan = std::nullopt, int threads = 1);
 
 /// fig-constants-vs-reference.png: the run's final constants ±2σ, in the
 /// reference's terms along `truth` (Model::comparableConstants), against a
@@ -45,7 +45,8 @@ std::string writeConstantsReferenceFigure(const Model& model, const OfflineRun& 
 /// landmarks, and the dead reckoning when the rows are at inputs), and the
 /// learning's log-likelihood figure when the noise was learnt, and the
 /// constants against their calibration reference when the dataset has one
-/// (the batch run's, else the last run's).
-std::vector<std::string> writeProcessFigures(const io::ProcessResult& result, const std::string& dir);
+/// (the batch run's, else the last run's). The run figures are drawn up to
+/// `threads` at a time.
+std::vector<std::string> writeProcessFigures(const io::ProcessResult& result, const std::string& dir, int threads = 1);
 
 }  // namespace gssm::plot
