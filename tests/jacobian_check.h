@@ -3,6 +3,7 @@
 // central differences at several random points (manif's common_tester idea).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 #include <random>
 
@@ -17,6 +18,29 @@ struct JacobianPoint {
 };
 using PointSampler = std::function<JacobianPoint(std::mt19937&)>;
 
+/// A channel that names its constants (MeasurementChannel::constants): h
+/// neither moves with any other constant (each perturbed by 1e-3 and by 1)
+/// nor has a nonzero Jacobian entry outside them.
+inline void expectChannelsReachOnlyTheirConstants(const Model& model, const JacobianPoint& p, int point) {
+  for (int c = 0; c < model.numChannels(); ++c) {
+    const std::vector<int>& used = model.channel(c).constants;
+    if (used.empty()) continue;
+    Eigen::MatrixXd J_xc, J_xb;
+    const Eigen::VectorXd y = model.h(c, p.xc, p.xb, &J_xc, &J_xb);
+    for (int j = 0; j < model.dims().nb; ++j) {
+      if (std::find(used.begin(), used.end(), j) != used.end()) continue;
+      EXPECT_TRUE((J_xb.col(j).array() == 0.0).all())
+          << model.name() << " channel '" << model.channel(c).name << "' at point " << point << ": ∂h/∂x_b[" << j << "]";
+      for (double step : {1e-3, 1.0}) {
+        Eigen::VectorXd xb = p.xb;
+        xb[j] += step;
+        EXPECT_EQ(model.h(c, p.xc, xb), y)
+            << model.name() << " channel '" << model.channel(c).name << "' at point " << point << " moves with x_b[" << j << "]";
+      }
+    }
+  }
+}
+
 inline void expectJacobiansMatchDifferences(const Model& model, const PointSampler& sample,
                                             int points = 20, double tol = 1e-6) {
   std::mt19937 rng(12345);
@@ -25,6 +49,7 @@ inline void expectJacobiansMatchDifferences(const Model& model, const PointSampl
     const JacobianCheck c = checkJacobians(model, p.xc, p.xb, p.u, p.dt);
     EXPECT_TRUE(c.ok(tol)) << model.name() << " at point " << i << ": worst entry " << c.worst
                            << " (relative error " << c.max_rel_error << ")";
+    expectChannelsReachOnlyTheirConstants(model, p, i);
   }
 }
 

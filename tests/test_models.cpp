@@ -1,8 +1,10 @@
+#include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
 
 #include "gssm/core/error.h"
+#include "gssm/factors/factors.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
 #include "jacobian_check.h"
@@ -111,4 +113,60 @@ TEST(Nav2D, ProcessNoiseIsTheWhiteAccelerationModel) {
   const Eigen::VectorXd x = nav.f(Eigen::Vector4d(0, 0, 0, 0), Eigen::Vector3d(0.5, 0, 0), Eigen::Vector2d(1.5, 0), 1.0);
   EXPECT_DOUBLE_EQ(x[0], 0.5);
   EXPECT_DOUBLE_EQ(x[2], 1.0);
+}
+
+namespace {
+// The radar with its channel naming the constants h reaches.
+class RadarNamingConstants final : public Model {
+ public:
+  explicit RadarNamingConstants(std::vector<int> used) : Model(radar_.dims(), radar_.names(), radar_.noise()) {
+    MeasurementChannel ch = radar_.channel(0);
+    ch.constants = std::move(used);
+    setChannels({ch});
+  }
+  std::string name() const override { return "radar naming its constants"; }
+  Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u, double dt,
+                    Eigen::MatrixXd* J_f_xc = nullptr, Eigen::MatrixXd* J_f_xb = nullptr) const override {
+    return radar_.f(xc, xb, u, dt, J_f_xc, J_f_xb);
+  }
+  using Model::h;
+  Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc = nullptr,
+                    Eigen::MatrixXd* J_h_xb = nullptr) const override {
+    return radar_.h(xc, xb, J_h_xc, J_h_xb);
+  }
+
+ private:
+  static inline const models::Radar2D radar_{};
+};
+}  // namespace
+
+TEST(MeasurementChannel, NamedConstantsAreCheckedWhereDeclaredAndAgainstTheJacobian) {
+  // The range reaches the altitude (x_b[1]), not the speed (x_b[0]).
+  const RadarNamingConstants right({1});
+  gssm::testing::JacobianPoint p{Eigen::VectorXd::Constant(1, 40.0), Eigen::Vector2d(100, 1000), Eigen::VectorXd(), 0.05};
+  gssm::testing::expectChannelsReachOnlyTheirConstants(right, p, 0);
+  const RadarNamingConstants wrong({0});
+  ::testing::TestPartResultArray caught;  // the check fails on the false claim: the Jacobian and both steps
+  {
+    ::testing::ScopedFakeTestPartResultReporter intercept(
+        ::testing::ScopedFakeTestPartResultReporter::INTERCEPT_ONLY_CURRENT_THREAD, &caught);
+    gssm::testing::expectChannelsReachOnlyTheirConstants(wrong, p, 0);
+  }
+  ASSERT_EQ(caught.size(), 3);
+  EXPECT_NE(std::string(caught.GetTestPartResult(0).message()).find("x_b[1]"), std::string::npos);
+  EXPECT_NE(std::string(caught.GetTestPartResult(2).message()).find("moves with x_b[1]"), std::string::npos);
+  for (const std::vector<int>& bad : {std::vector<int>{1, 0}, std::vector<int>{2}, std::vector<int>{-1}}) {
+    try {
+      RadarNamingConstants m(bad);
+      ADD_FAILURE() << "constants accepted";
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("ascending indices into x_b"), std::string::npos) << e.what();
+    }
+  }
+  // A factor on that channel gives the batch solver only those columns.
+  const MeasurementFactor f(right, 3, Eigen::VectorXd::Constant(1, 1000.0));
+  ASSERT_NE(f.columnsOf(1), nullptr);
+  EXPECT_EQ(*f.columnsOf(1), std::vector<int>{1});
+  EXPECT_EQ(f.columnsOf(0), nullptr);
+  EXPECT_EQ(MeasurementFactor(models::Radar2D(), 3, Eigen::VectorXd::Constant(1, 1000.0)).columnsOf(1), nullptr);
 }

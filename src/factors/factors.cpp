@@ -241,6 +241,12 @@ void MeasurementFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::Vect
   internal::measurementResidual(*model_, channel_, y_, noise_, x, r, J);
 }
 
+const std::vector<int>* MeasurementFactor::columnsOf(std::size_t a) const {
+  if (a != 1) return nullptr;  // keys: x_c(k), then x_b
+  const std::vector<int>& used = model_->channel(channel_).constants;
+  return used.empty() ? nullptr : &used;
+}
+
 std::string MeasurementFactor::describe() const {
   if (channel_ == 0 && model_->numChannels() == 1) return "measurement at " + keys()[0].toString();
   return "measurement on channel '" + model_->channel(channel_).name + "' at " + keys()[0].toString();

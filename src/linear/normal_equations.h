@@ -31,39 +31,31 @@ struct FactorColumns {
   }
   /// The columns of J's blocks, block a at offs[a], with their entries, and
   /// which of them hold a nonzero (branch-free: which columns of a range's
-  /// 30 are nonzero changes from link to link).
-  void gather(const Eigen::Index* offs, const std::vector<Eigen::MatrixXd>& J) {
+  /// 30 are nonzero changes from link to link). With `used` (one entry per
+  /// block, nullptr: all its columns), only the listed columns of a block
+  /// are taken: the factor says the others are zero everywhere (a range's
+  /// own bias and the scale of 25 constants).
+  void gather(const Eigen::Index* offs, const std::vector<Eigen::MatrixXd>& J,
+              const std::vector<int>* const* used = nullptr) {
     rows = J.empty() ? 0 : J[0].rows();
     std::size_t total = 0;
-    for (const auto& block : J) total += static_cast<std::size_t>(block.cols());
+    for (std::size_t a = 0; a < J.size(); ++a)
+      total += used && used[a] ? used[a]->size() : static_cast<std::size_t>(J[a].cols());
     if (global.size() < total) global.resize(total);
     if (entries.size() < static_cast<std::size_t>(rows) * total) entries.resize(static_cast<std::size_t>(rows) * total);
     nonzero.resize(total);
     size_ = total;
     ascending = true;
-    Eigen::Index* g = global.data();
-    double* out = entries.data();
-    std::size_t* nz = nonzero.data();
-    std::size_t p = 0, count = 0;
-    Eigen::Index last = -1;  // the previous block's last column
-    for (const auto& block : J) {
-      const Eigen::Index cols = block.cols(), at = offs[&block - J.data()];
-      if (cols > 0 && at <= last) ascending = false;  // a repeated column takes the general loop
-      if (cols > 0) last = at + cols - 1;
-      const double* in = block.data();
-      for (Eigen::Index i = 0; i < cols; ++i, ++p) {
-        g[p] = at + i;
-        bool any = false;
-        for (Eigen::Index r = 0; r < rows; ++r) {
-          any |= in[r] != 0.0;
-          *out++ = in[r];
-        }
-        in += rows;
-        nz[count] = p;
-        count += any;
-      }
+    out_ = entries.data();
+    count_ = 0;
+    p_ = 0;
+    last_ = -1;
+    for (std::size_t a = 0; a < J.size(); ++a) {
+      const std::vector<int>* list = used ? used[a] : nullptr;
+      const Eigen::Index cols = list ? static_cast<Eigen::Index>(list->size()) : J[a].cols();
+      for (Eigen::Index i = 0; i < cols; ++i) take(offs[a], J[a], list ? (*list)[static_cast<std::size_t>(i)] : i);
     }
-    nonzero.resize(count);
+    nonzero.resize(count_);
   }
   /// Column p's entries.
   const double* column(std::size_t p) const { return entries.data() + static_cast<Eigen::Index>(p) * rows; }
@@ -81,6 +73,25 @@ struct FactorColumns {
     size_ = 0;
     ascending = true;
   }
+  // Column c of `block` (at column `at` of H) as the next gathered column.
+  void take(Eigen::Index at, const Eigen::MatrixXd& block, Eigen::Index c) {
+    const Eigen::Index column = at + c;
+    if (column <= last_) ascending = false;  // a repeated column takes the general loop
+    last_ = column;
+    global[p_] = column;
+    const double* in = block.data() + c * rows;
+    bool any = false;
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      any |= in[r] != 0.0;
+      *out_++ = in[r];
+    }
+    nonzero[count_] = p_;
+    count_ += any;
+    ++p_;
+  }
+  double* out_ = nullptr;
+  std::size_t count_ = 0, p_ = 0;
+  Eigen::Index last_ = -1;
   void push(Eigen::Index column) {
     if (size_ > 0 && column <= global[size_ - 1]) ascending = false;  // a repeated column takes the general loop
     if (size_ == global.size()) global.push_back(column);

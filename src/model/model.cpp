@@ -110,6 +110,10 @@ void Model::setChannels(std::vector<MeasurementChannel> channels) {
     requireCovariance(ch.R, ch.dim(), "model: noise R of channel '" + ch.name + "'");
     for (int a : ch.angles)
       if (a < 0 || a >= ch.dim()) throw InvalidArgument("model: channel '" + ch.name + "': angle component out of range");
+    for (std::size_t i = 0; i < ch.constants.size(); ++i)
+      if (ch.constants[i] < 0 || ch.constants[i] >= dims_.nb || (i > 0 && ch.constants[i] <= ch.constants[i - 1]))
+        throw InvalidArgument("model: channel '" + ch.name + "': its constants must be ascending indices into x_b (0 to " +
+                              std::to_string(dims_.nb - 1) + ")");
     std::string why;
     if (!ch.loss.validate(&why)) throw InvalidArgument("model: channel '" + ch.name + "': " + why);
     noise.emplace_back(ch.R, "model: noise R of channel '" + ch.name + "'");

@@ -103,6 +103,8 @@ PlanarRigidBody::PlanarRigidBody(const Params& p)
       ch.R = Eigen::MatrixXd::Constant(1, 1, p.range_sd * p.range_sd);
       ch.loss = p.range_loss;
       ch.ekf_gate = p.ekf_gate;
+      if (i_bias_ >= 0) ch.constants.push_back(i_bias_ + static_cast<int>(t * p.anchors.size() + a));
+      if (i_scale_ >= 0) ch.constants.push_back(i_scale_);
       channels.push_back(std::move(ch));
     }
   setChannels(std::move(channels));

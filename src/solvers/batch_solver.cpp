@@ -152,6 +152,7 @@ struct BatchSolver::Impl {
     jacobians.resize(shapes.size());
     factor_offs.resize(max_keys);
     factor_x.resize(max_keys);
+    factor_used.resize(max_keys);
   }
 
   // The envelope: each column's first row reached by a factor. Compact (at
@@ -265,6 +266,7 @@ struct BatchSolver::Impl {
   }
   std::vector<Eigen::Index> factor_offs;
   std::vector<const Eigen::VectorXd*> factor_x;  // factor fi's variables' values, in its key order
+  std::vector<const std::vector<int>*> factor_used;  // the columns factor fi's blocks can reach (Factor::columnsOf)
   internal::FactorColumns columns;
 
   // Linearizes every factor at x: writes H = JᵀJ into the factorization's
@@ -296,7 +298,15 @@ struct BatchSolver::Impl {
                              "' has a non-finite residual at the current estimate");
       }
       cost += c;
-      columns.gather(factor_offs.data(), J);
+      // The envelope places entries by position, so a block's columns the
+      // factor rules out need not be read; CHOLMOD's slots follow every
+      // column in order.
+      if (use_envelope) {
+        for (std::size_t a = 0; a < count; ++a) factor_used[a] = f->columnsOf(a);
+        columns.gather(factor_offs.data(), J, factor_used.data());
+      } else {
+        columns.gather(factor_offs.data(), J);
+      }
       for (std::size_t p : columns.nonzero) g[columns.global[p]] += columns.dot(p, r.data());  // zero columns add 0
       if (use_envelope)
         internal::forEachNonzeroUpperJtJ(columns, [&](Eigen::Index i, Eigen::Index j, double v, auto...) {

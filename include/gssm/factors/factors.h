@@ -44,6 +44,10 @@ class Factor {
   const RobustLoss& loss() const { return loss_; }
   /// Human-readable description naming the variables ("range at x_c(12)").
   virtual std::string describe() const = 0;
+  /// The columns of keys()[a]'s Jacobian block that can be nonzero,
+  /// ascending; nullptr: any. A solver may skip the others (they are zero at
+  /// every point).
+  virtual const std::vector<int>* columnsOf(std::size_t /*a*/) const { return nullptr; }
 
  protected:
   Factor(std::vector<Key> keys, int dim, RobustLoss loss = {})
@@ -116,6 +120,9 @@ class MeasurementFactor final : public Factor {
   void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                    std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
+  /// On x_b: the channel's constants (MeasurementChannel::constants), if it
+  /// names them.
+  const std::vector<int>* columnsOf(std::size_t a) const override;
   const Eigen::VectorXd& measurement() const { return y_; }
   int channel() const { return channel_; }
   const GaussianNoise& noise() const { return noise_; }

@@ -31,6 +31,11 @@ struct MeasurementChannel {
   /// EKF: a measurement whose NIS exceeds this is rejected (0: no gate),
   /// e.g. the χ² 0.999 quantile of the channel's dimension.
   double ekf_gate = 0;
+  /// The constants h on this channel can depend on, ascending (empty: all
+  /// of x_b). Its Jacobian on x_b is zero in every other column at every
+  /// point, so the batch solver reads only these (a link's range: its own
+  /// bias and the scale, 2 of 25); the Jacobian tests check the claim.
+  std::vector<int> constants;
   int dim() const { return static_cast<int>(components.size()); }
 };
 
