@@ -3,14 +3,12 @@
 #include <mrpt/img/CImage.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <exception>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
 
+#include "gssm/core/parallel.h"
 #include "gssm/plot/ticks.h"
 
 namespace gssm::plot {
@@ -358,25 +356,9 @@ void savePngs(const std::vector<std::pair<Figure, std::string>>& figures, int th
   // selection, unguarded: done here, before any worker draws.
   mrpt::img::CImage fonts(1, 1, mrpt::img::CH_RGB);
   fonts.selectTextFont("6x13");
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    for (std::size_t i; (i = next++) < figures.size();) {
-      try {
-        savePng(figures[i].first, figures[i].second);
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    }
-  };
-  const auto n = static_cast<std::size_t>(std::max(1, threads));
-  std::vector<std::thread> workers;
-  for (std::size_t t = 1; t < std::min(n, figures.size()); ++t) workers.emplace_back(work);
-  work();
-  for (auto& w : workers) w.join();
-  if (error) std::rethrow_exception(error);
+  for (const auto& e : runJobs(figures.size(), static_cast<std::size_t>(std::max(1, threads)),
+                               [&](std::size_t k) { savePng(figures[k].first, figures[k].second); }))
+    if (e) std::rethrow_exception(e);
 }
 
 Figure histogram(const std::vector<std::pair<std::string, std::vector<double>>>& groups, int bins,

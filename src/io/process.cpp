@@ -1,16 +1,15 @@
 #include "gssm/io/process.h"
 
 #include <algorithm>
-#include <atomic>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <numeric>
-#include <thread>
 
 #include "gssm/checkpoint/checkpoint.h"
 #include "gssm/core/error.h"
+#include "gssm/core/parallel.h"
 #include "gssm/io/config.h"
 #include "gssm/io/learn_config.h"
 #include "gssm/io/run_files.h"
@@ -134,20 +133,10 @@ std::vector<OfflineRun> runConcurrently(const ProcessOptions& o, const Model& mo
     };
   std::vector<OfflineRun> runs(methods.size());
   std::vector<std::exception_ptr> errors(methods.size());
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t k = next++; k < queue.size(); k = next++) {
-      const std::size_t i = queue[k];
-      try {
-        runs[i] = runMethod(o, model, r, options, methods[i], serialized);
-      } catch (...) {
-        errors[i] = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (std::size_t t = 0; t < std::min(o.threads, methods.size()); ++t) pool.emplace_back(work);
-  for (auto& t : pool) t.join();
+  const auto failed = runJobs(queue.size(), o.threads, [&](std::size_t k) {
+    runs[queue[k]] = runMethod(o, model, r, options, methods[queue[k]], serialized);
+  });
+  for (std::size_t k = 0; k < queue.size(); ++k) errors[queue[k]] = failed[k];  // back in the methods' order
   for (const auto& e : errors)
     if (e) std::rethrow_exception(e);
   return runs;

@@ -40,7 +40,6 @@ void EnvelopeCholesky::setPattern(std::vector<int> first) {
   h_.assign(static_cast<std::size_t>(size), 0.0);
   u_.clear();
   factored_ = inverse_ = false;
-  inverse_from_ = 0;
 }
 
 Eigen::Index EnvelopeCholesky::factorize() {
@@ -66,7 +65,7 @@ Eigen::Index EnvelopeCholesky::factorize() {
     for (std::ptrdiff_t c0 = j; c0 < end; c0 += kPanelGroup)
       for (std::ptrdiff_t i = f; i < j; ++i)
         for (std::ptrdiff_t c = c0; c < std::min(c0 + kPanelGroup, end); ++c) offDiagonal(i, c);
-    const Eigen::Index bad = j - f >= kGramRows && end - j >= kGramColumns ? panelByGram(j, end) : panelByDots(j, end);
+    const Eigen::Index bad = panel(j, end);
     if (bad >= 0) return bad;
     j = end;
   }
@@ -75,61 +74,47 @@ Eigen::Index EnvelopeCholesky::factorize() {
 }
 
 // The panel [j, end)'s own rows, column by column; the first column whose
-// pivot fails, or -1.
-Eigen::Index EnvelopeCholesky::panelByDots(std::ptrdiff_t j, std::ptrdiff_t end) {
-  for (std::ptrdiff_t c = j; c < end; ++c) {
-    for (std::ptrdiff_t i = j; i < c; ++i) offDiagonal(i, c);
-    if (!pivot(c)) return c;
-  }
-  return -1;
-}
-
-// As panelByDots, with the part of every dot that runs over the rows above
-// the panel taken from their Gram matrix G = Aᵀ A (A: U's rows f … j − 1 of
-// the panel's columns), one blocked product: a GSSM's constants are ~25
-// columns over every state's rows, and their ~300 dots, each a pass over
-// columns of 10⁵ entries, were a factorization's main cost (memory bound).
-Eigen::Index EnvelopeCholesky::panelByGram(std::ptrdiff_t j, std::ptrdiff_t end) {
+// pivot fails, or -1. A wide panel over many rows takes the part of every
+// dot that runs over the rows above it (U's rows f … j − 1 of its columns,
+// A) from their Gram matrix AᵀA, one blocked product: a GSSM's constants
+// are ~25 columns over every state's rows, and their ~300 dots, each a pass
+// over columns of 10⁵ entries, were a factorization's main cost (memory
+// bound). A narrow one dots from its first row.
+Eigen::Index EnvelopeCholesky::panel(std::ptrdiff_t j, std::ptrdiff_t end) {
   const std::ptrdiff_t f = first_[static_cast<std::size_t>(j)], w = end - j;
-  double* u = u_.data();
-  const double* h = h_.data();
-  const std::ptrdiff_t* base = base_.data();
-  Eigen::MatrixXd above(j - f, w);
-  for (std::ptrdiff_t a = 0; a < w; ++a) above.col(a) = Eigen::Map<const Eigen::VectorXd>(u + base[j + a] + f, j - f);
-  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(w, w);
-  gram.selfadjointView<Eigen::Lower>().rankUpdate(above.transpose());
+  const bool by_gram = j - f >= kGramRows && w >= kGramColumns;
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(by_gram ? w : 0, by_gram ? w : 0);
+  if (by_gram) {
+    Eigen::MatrixXd above(j - f, w);
+    for (std::ptrdiff_t a = 0; a < w; ++a)
+      above.col(a) = Eigen::Map<const Eigen::VectorXd>(u_.data() + base_[static_cast<std::size_t>(j + a)] + f, j - f);
+    gram.selfadjointView<Eigen::Lower>().rankUpdate(above.transpose());
+  }
+  const std::ptrdiff_t from = by_gram ? j : f;  // where each dot starts
   for (std::ptrdiff_t a = 0; a < w; ++a) {
-    const std::ptrdiff_t c = j + a;
-    double* uc = u + base[c];
-    const double* hc = h + base[c];
-    for (std::ptrdiff_t b = 0; b < a; ++b) {
-      const std::ptrdiff_t i = j + b;
-      const double* ui = u + base[i];
-      uc[i] = (hc[i] - gram(a, b) - dot(ui + j, uc + j, i - j)) * ui[i];
-    }
-    const double d = hc[c] - gram(a, a) - dot(uc + j, uc + j, c - j);
-    if (!(d > 0) || !std::isfinite(d)) return c;
-    uc[c] = 1.0 / std::sqrt(d);
+    for (std::ptrdiff_t b = 0; b < a; ++b) offDiagonal(j + b, j + a, from, by_gram ? gram(a, b) : 0.0);
+    if (!pivot(j + a, from, by_gram ? gram(a, a) : 0.0)) return j + a;
   }
   return -1;
 }
 
-// U(i, j), i < j: (H(i, j) − Σ_k U(k, i) U(k, j)) / U(i, i) over the rows
-// both columns hold.
-inline void EnvelopeCholesky::offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j) {
+// U(i, j), i < j: (H(i, j) − known − Σ_k U(k, i) U(k, j)) / U(i, i), the
+// sum over the rows both columns hold from `from` on (known: the part
+// before it, already summed).
+inline void EnvelopeCholesky::offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j, std::ptrdiff_t from, double known) {
   const std::ptrdiff_t fi = first_[static_cast<std::size_t>(i)], fj = first_[static_cast<std::size_t>(j)];
   const double* ui = u_.data() + base_[static_cast<std::size_t>(i)];
   double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
-  const std::ptrdiff_t lo = fi > fj ? fi : fj;
-  uj[i] = (h_[static_cast<std::size_t>(base_[static_cast<std::size_t>(j)] + i)] - dot(ui + lo, uj + lo, i - lo)) * ui[i];
+  const std::ptrdiff_t lo = std::max({fi, fj, from});
+  uj[i] = (h_[static_cast<std::size_t>(base_[static_cast<std::size_t>(j)] + i)] - known - dot(ui + lo, uj + lo, i - lo)) * ui[i];
 }
 
-// 1/U(j, j) from column j's entries above it; false if H(j, j) − Σ U(k, j)²
-// is not positive and finite.
-inline bool EnvelopeCholesky::pivot(std::ptrdiff_t j) {
-  const std::ptrdiff_t fj = first_[static_cast<std::size_t>(j)];
+// 1/U(j, j) from column j's entries above it (from `from` on, `known` the
+// part before); false if H(j, j) − Σ U(k, j)² is not positive and finite.
+inline bool EnvelopeCholesky::pivot(std::ptrdiff_t j, std::ptrdiff_t from, double known) {
+  const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(first_[static_cast<std::size_t>(j)], from);
   double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
-  const double d = h_[static_cast<std::size_t>(base_[static_cast<std::size_t>(j)] + j)] - dot(uj + fj, uj + fj, j - fj);
+  const double d = h_[static_cast<std::size_t>(base_[static_cast<std::size_t>(j)] + j)] - known - dot(uj + lo, uj + lo, j - lo);
   if (!(d > 0) || !std::isfinite(d)) return false;
   uj[j] = 1.0 / std::sqrt(d);
   return true;

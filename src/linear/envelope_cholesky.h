@@ -70,11 +70,12 @@ class EnvelopeCholesky {
   std::vector<std::ptrdiff_t> base_;  // column j's entry for row i at base_[j] + i (i from first_[j] to j)
   std::vector<double> h_, u_;  // H (or H⁻¹ on the envelope after selectedInverse()); U, 1/U(j, j) on its diagonal
   void solveInPlace(double* x) const;  // x: n entries
-  void offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j);  // U(i, j), i < j
-  bool pivot(std::ptrdiff_t j);                          // 1/U(j, j); false if not positive definite there
+  // U(i, j), i < j; 1/U(j, j) (false if not positive definite there): the
+  // dots from row `from` on, `known` the part of the sum before it.
+  void offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j, std::ptrdiff_t from = 0, double known = 0.0);
+  bool pivot(std::ptrdiff_t j, std::ptrdiff_t from = 0, double known = 0.0);
   void inverseRow(Eigen::Index i, const std::vector<int>& row, std::vector<double>& u_row);
-  Eigen::Index panelByDots(std::ptrdiff_t j, std::ptrdiff_t end);
-  Eigen::Index panelByGram(std::ptrdiff_t j, std::ptrdiff_t end);
+  Eigen::Index panel(std::ptrdiff_t j, std::ptrdiff_t end);
   // A panel this wide over this many rows above it takes their Gram matrix.
   static constexpr std::ptrdiff_t kGramColumns = 8, kGramRows = 32;
   static constexpr std::ptrdiff_t kPanelGroup = 4;  // a panel's columns taken together down the rows above it

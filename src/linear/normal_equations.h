@@ -46,16 +46,30 @@ struct FactorColumns {
     nonzero.resize(total);
     size_ = total;
     ascending = true;
-    out_ = entries.data();
-    count_ = 0;
-    p_ = 0;
-    last_ = -1;
+    double* out = entries.data();
+    std::size_t p = 0, count = 0;
+    Eigen::Index last = -1;
+    auto take = [&](Eigen::Index column, const double* in) {  // the next gathered column
+      if (column <= last) ascending = false;  // a repeated column takes the general loop
+      last = column;
+      global[p] = column;
+      bool any = false;
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        any |= in[r] != 0.0;
+        *out++ = in[r];
+      }
+      nonzero[count] = p++;
+      count += any;
+    };
     for (std::size_t a = 0; a < J.size(); ++a) {
       const std::vector<int>* list = used ? used[a] : nullptr;
       const Eigen::Index cols = list ? static_cast<Eigen::Index>(list->size()) : J[a].cols();
-      for (Eigen::Index i = 0; i < cols; ++i) take(offs[a], J[a], list ? (*list)[static_cast<std::size_t>(i)] : i);
+      for (Eigen::Index i = 0; i < cols; ++i) {
+        const Eigen::Index c = list ? (*list)[static_cast<std::size_t>(i)] : i;
+        take(offs[a] + c, J[a].data() + c * rows);
+      }
     }
-    nonzero.resize(count_);
+    nonzero.resize(count);
   }
   /// Column p's entries.
   const double* column(std::size_t p) const { return entries.data() + static_cast<Eigen::Index>(p) * rows; }
@@ -73,25 +87,6 @@ struct FactorColumns {
     size_ = 0;
     ascending = true;
   }
-  // Column c of `block` (at column `at` of H) as the next gathered column.
-  void take(Eigen::Index at, const Eigen::MatrixXd& block, Eigen::Index c) {
-    const Eigen::Index column = at + c;
-    if (column <= last_) ascending = false;  // a repeated column takes the general loop
-    last_ = column;
-    global[p_] = column;
-    const double* in = block.data() + c * rows;
-    bool any = false;
-    for (Eigen::Index r = 0; r < rows; ++r) {
-      any |= in[r] != 0.0;
-      *out_++ = in[r];
-    }
-    nonzero[count_] = p_;
-    count_ += any;
-    ++p_;
-  }
-  double* out_ = nullptr;
-  std::size_t count_ = 0, p_ = 0;
-  Eigen::Index last_ = -1;
   void push(Eigen::Index column) {
     if (size_ > 0 && column <= global[size_ - 1]) ascending = false;  // a repeated column takes the general loop
     if (size_ == global.size()) global.push_back(column);

@@ -160,9 +160,11 @@ Gaussian PlanarRigidBody::comparableConstants(const Gaussian& xb, const Truth& t
   if (i_scale_ < 0 || i_bias_ < 0 || truth.states.empty()) return xb;
   const Eigen::VectorXd distance = meanTrueDistances(truth);
   Eigen::MatrixXd J = Eigen::MatrixXd::Identity(dims().nb, dims().nb);  // linear in x_b
-  for (int c = 0; c < numChannels(); ++c) J(biasIndex(c), i_scale_) = distance[c];
   Eigen::VectorXd mean = xb.mean;
-  for (int c = 0; c < numChannels(); ++c) mean[biasIndex(c)] += (xb.mean[i_scale_] - 1.0) * distance[c];
+  for (int c = 0; c < numChannels(); ++c) {
+    J(biasIndex(c), i_scale_) = distance[c];
+    mean[biasIndex(c)] += (xb.mean[i_scale_] - 1.0) * distance[c];
+  }
   return {mean, J * xb.covariance * J.transpose()};
 }
 

@@ -606,10 +606,8 @@ void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
 Values BatchSolver::factoredAt(const Values& like) const {
   const Impl& s = *impl_;
   if (!s.has_solution) throw InvalidArgument("BatchSolver: no solution yet; call solve() before factoredAt()");
-  Eigen::Index n = 0;
-  for (const auto& kv : like) n += kv.second.size();
-  if (n != s.factored_point.size())
-    throw InvalidArgument("BatchSolver::factoredAt: the values have " + std::to_string(n) +
+  if (like.dim() != s.factored_point.size())
+    throw InvalidArgument("BatchSolver::factoredAt: the values have " + std::to_string(like.dim()) +
                           " entries, the last solve " + std::to_string(s.factored_point.size()));
   Values out = like;
   internal::unflatten(s.factored_point, out);

@@ -175,8 +175,8 @@ void ExtendedKalmanFilter::commitUpdate(const Eigen::MatrixXd& HP, const Eigen::
   // diagonal and only the non-Joseph form, which can lose definiteness to
   // cancellation, pays a Cholesky of P (it was 40% of a 31-state filter's
   // time).
-  const bool variances_ok = P.diagonal().allFinite() && (P.diagonal().array() > 0).all();
-  if (!variances_ok || !allFinite(P) || (!options_.joseph_form && Eigen::LLT<Eigen::MatrixXd>(P).info() != Eigen::Success))
+  if (!allFinite(P) || !(P.diagonal().array() > 0).all() ||
+      (!options_.joseph_form && Eigen::LLT<Eigen::MatrixXd>(P).info() != Eigen::Success))
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
                          ": the updated covariance is not positive definite (filter unchanged)");
   z_ += w * dz;
