@@ -192,8 +192,8 @@ TEST(Estimator, OptionsValidateNamesTheField) {
   expectThrowsNaming([&] { makeEstimator(radar, o); }, "fixed_lag.window must be >= 1");
   o.method = Method::PaperWindow;  // reads only its own window
   EXPECT_NO_THROW(makeEstimator(radar, o));
-  o.paper_window.window = 0;
-  expectThrowsNaming([&] { makeEstimator(radar, o); }, "paper_window.window must be >= 1");
+  o.paper_window.window = 1;  // its priors go on the second-oldest state
+  expectThrowsNaming([&] { makeEstimator(radar, o); }, "paper_window.window must be >= 2, got 1");
 }
 
 TEST(Method, OneTableNamesEveryMethodOnce) {
@@ -224,6 +224,127 @@ TEST(Estimator, ReportSaysWhatWasUsed) {
   EXPECT_EQ(inc->report().ordering, EliminationOrdering::ConstrainedColamd);
   o.method = Method::Ekf;
   EXPECT_FALSE(makeEstimator(radar, o)->report().ordering.has_value());
+}
+
+namespace {
+// The paper's window recursion written out in dense algebra on a linear
+// model, independently of the factor graph: the window's information matrix
+// and vector summed from its priors, process and measurement rows, solved by
+// a dense inverse; once w states are held, the oldest leaves before a new
+// one joins, and the priors become the diagonal marginals (at the estimate)
+// of the window last solved: on the constants and on the new oldest state,
+// whose prior then stands for its measurements too.
+class DenseWindowReference {
+ public:
+  DenseWindowReference(const models::LinearModel& m, int window) : m_(m), w_(window) {
+    m.discreteMatrices(m.system().noise.T, F_, Fb_, Bk_);
+    ps_ = m.priorState();
+    pb_ = m.priorConstants();
+    steps_.push_back({});
+  }
+  // Adds y at step j (a new step after the last one, or the last one again).
+  void add(std::int64_t j, const Eigen::VectorXd& y) {
+    if (j > oldest_ + static_cast<std::int64_t>(steps_.size()) - 1) {
+      if (static_cast<int>(steps_.size()) >= w_) {  // full: the oldest leaves
+        const Eigen::Index nc = F_.rows(), nb = Fb_.cols();
+        ps_ = {x_.segment(nc, nc), Eigen::MatrixXd(cov_.block(nc, nc, nc, nc).diagonal().asDiagonal())};
+        pb_ = {x_.tail(nb), Eigen::MatrixXd(cov_.bottomRightCorner(nb, nb).diagonal().asDiagonal())};
+        steps_.erase(steps_.begin());
+        steps_.front().clear();  // the new oldest state's measurements are in its prior
+        ++oldest_;
+      }
+      steps_.push_back({});
+    }
+    steps_.back().push_back(y);
+    solve();
+  }
+  // [x_c(newest); x_b] and its covariance.
+  Eigen::VectorXd mean() const { return stacked(x_); }
+  Eigen::MatrixXd covariance() const {
+    const Eigen::Index nc = F_.rows(), nb = Fb_.cols(), last = x_.size() - nb - nc;
+    Eigen::MatrixXd P(nc + nb, nc + nb);
+    P << cov_.block(last, last, nc, nc), cov_.block(last, x_.size() - nb, nc, nb),
+        cov_.block(x_.size() - nb, last, nb, nc), cov_.bottomRightCorner(nb, nb);
+    return P;
+  }
+
+ private:
+  Eigen::VectorXd stacked(const Eigen::VectorXd& x) const {
+    const Eigen::Index nc = F_.rows(), nb = Fb_.cols();
+    Eigen::VectorXd z(nc + nb);
+    z << x.segment(x.size() - nb - nc, nc), x.tail(nb);
+    return z;
+  }
+  void solve() {
+    const Eigen::Index nc = F_.rows(), nb = Fb_.cols(), ns = static_cast<Eigen::Index>(steps_.size());
+    const Eigen::Index n = ns * nc + nb, b = ns * nc;
+    Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
+    Eigen::VectorXd eta = Eigen::VectorXd::Zero(n);
+    // Rows A over the window's variables with A z = target + noise of covariance S.
+    auto rows = [&](const Eigen::MatrixXd& A, const Eigen::VectorXd& target, const Eigen::MatrixXd& S) {
+      const Eigen::MatrixXd AtSi = A.transpose() * S.inverse();
+      L += AtSi * A;
+      eta += AtSi * target;
+    };
+    auto place = [&](Eigen::Index rows_count) { return Eigen::MatrixXd(Eigen::MatrixXd::Zero(rows_count, n)); };
+    Eigen::MatrixXd A = place(nc);
+    A.block(0, 0, nc, nc).setIdentity();
+    rows(A, ps_.mean, ps_.covariance);
+    A = place(nb);
+    A.block(0, b, nb, nb).setIdentity();
+    rows(A, pb_.mean, pb_.covariance);
+    Eigen::MatrixXd C, Cb;
+    m_.outputMatrices(0, C, Cb);
+    for (Eigen::Index s = 0; s < ns; ++s) {
+      if (s > 0) {  // x(s) − F x(s−1) − F_b x_b = q
+        A = place(nc);
+        A.block(0, (s - 1) * nc, nc, nc) = -F_;
+        A.block(0, s * nc, nc, nc).setIdentity();
+        A.block(0, b, nc, nb) = -Fb_;
+        rows(A, Eigen::VectorXd::Zero(nc), m_.processNoise(m_.system().noise.T));
+      }
+      for (const auto& y : steps_[static_cast<std::size_t>(s)]) {
+        A = place(y.size());
+        A.block(0, s * nc, y.size(), nc) = C;
+        A.block(0, b, y.size(), nb) = Cb;
+        rows(A, y, m_.system().noise.R);
+      }
+    }
+    cov_ = L.inverse();
+    x_ = cov_ * eta;
+  }
+  const models::LinearModel& m_;
+  int w_;
+  Eigen::MatrixXd F_, Fb_, Bk_;
+  Gaussian ps_, pb_;
+  std::int64_t oldest_ = 0;
+  std::vector<std::vector<Eigen::VectorXd>> steps_;  // each held step's measurements
+  Eigen::VectorXd x_;
+  Eigen::MatrixXd cov_;
+};
+}  // namespace
+
+TEST(PaperWindow, EqualsTheDenseWindowRecursionOnALinearModel) {
+  std::mt19937 rng(11);
+  const models::LinearModel model(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1));
+  SimulationSpec spec;
+  spec.steps = 40;
+  const SimulatedRun run = simulate(model, spec, normalSampler(4));
+  for (int window : {2, 5}) {
+    EstimatorOptions o;
+    o.method = Method::PaperWindow;
+    o.paper_window.window = window;
+    auto pw = makeEstimator(model, o);
+    DenseWindowReference ref(model, window);
+    for (const auto& m : run.measurements) {
+      pw->addMeasurement(m.t, m.y);
+      ref.add(std::llround(m.t / model.system().noise.T), m.y);
+      const StateEstimate e = pw->current();
+      EXPECT_LT(relativeError(e.mean, ref.mean()), 1e-7) << "window " << window << ", step " << pw->step();
+      EXPECT_LT(relativeError(e.covariance, ref.covariance()), 1e-7) << "window " << window << ", step " << pw->step();
+    }
+    EXPECT_EQ(pw->step(), spec.steps);
+  }
 }
 
 TEST(PaperWindow, IsOverConfidentComparedWithTheExactFixedLagSmoother) {

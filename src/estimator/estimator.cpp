@@ -7,6 +7,8 @@
 #include <map>
 #include <type_traits>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "core/byte_stream.h"
 #include "factors/factor_io.h"
@@ -28,8 +30,8 @@ bool EstimatorOptions::validate(const Model& model, std::string* why) const {
   if (!std::isfinite(t0)) return fail("t0 must be finite");
   if ((reads & kFixedLagOptions) && fixed_lag.window < 1)
     return fail("fixed_lag.window must be >= 1, got " + std::to_string(fixed_lag.window));
-  if ((reads & kPaperWindowOptions) && paper_window.window < 1)
-    return fail("paper_window.window must be >= 1, got " + std::to_string(paper_window.window));
+  if ((reads & kPaperWindowOptions) && paper_window.window < 2)  // the priors go on the second-oldest state
+    return fail("paper_window.window must be >= 2, got " + std::to_string(paper_window.window));
   if ((reads & kEkfOptions) && !ekf.validate(model.dims().nb, why)) return false;
   if ((reads & kBatchOptions) && !batch.validate(why)) return false;
   return !(reads & kSmootherOptions) || smoother.validate(why);
@@ -569,13 +571,15 @@ class SmootherEstimator final : public Estimator {
 };
 
 // ---- The paper's window re-solve (reproduction mode) -----------------------------
-// What the paper's reference implementation does: re-solve the whole window by
-// Gauss–Newton at every step; once the window is full, drop the oldest state
-// and replace all priors by independent 1-D priors (mean = current estimate,
-// variance = marginal variance from the current window) on the oldest
-// remaining x_c and on each constant. This counts the window's measurements
-// again at every step, so it is over-confident; it exists to reproduce the
-// paper's figures, not as an estimator to deploy.
+// What the paper's reference implementation does: solve the whole window of
+// the newest w states by Gauss–Newton at every step; once it is full, the
+// oldest state leaves before the new one joins, and all priors are replaced
+// by independent 1-D priors (mean = current estimate, variance = marginal
+// variance from the window last solved) on the oldest remaining x_c, which
+// then stands for that state's measurements too, and on each constant: one
+// solve of w states a step. This counts the window's
+// measurements again at every step, so it is over-confident; it exists to
+// reproduce the paper's figures, not as an estimator to deploy.
 class PaperWindowEstimator final : public Estimator {
  public:
   PaperWindowEstimator(const Model& m, const EstimatorOptions& o)
@@ -615,35 +619,28 @@ class PaperWindowEstimator final : public Estimator {
     Values values = values_;
     Gaussian prior_state = prior_state_, prior_constants = prior_constants_;
     std::int64_t oldest = oldest_;
+    if (full()) {  // the oldest state leaves; the priors prepared after the last solve take its place
+      prior_state = next_prior_state_;
+      prior_constants = next_prior_constants_;
+      values.erase(Key::state(oldest));
+      steps.pop_front();
+      times.pop_front();
+      ++oldest;
+    }
     steps.push_back(stepFactors(model_, k, dt, u, ms, count));
     const Eigen::VectorXd xb = model_.dims().nb ? values.at(Key::constants()) : Eigen::VectorXd();
     values.insert(Key::state(k), predictState(model_, values.at(Key::state(k - 1)), xb, u, dt, k));
     times.push_back(times.back() + dt);
     BatchSolver solver(gaussNewton());
     const BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state, prior_constants, oldest), values);
-    if (static_cast<int>(steps.size()) + 1 > window_) {
-      // Window full: drop the oldest state, new 1-D priors from this solve.
-      const Key next = Key::state(oldest + 1);
-      prior_state = diagonalPrior(values.at(next), solver.marginalCovariance(next));
-      if (model_.dims().nb > 0)
-        prior_constants = diagonalPrior(values.at(Key::constants()), solver.marginalCovariance(Key::constants()));
-      values.erase(Key::state(oldest));
-      steps.pop_front();
-      times.pop_front();
-      ++oldest;
-      // Re-solve so the reported covariances belong to the new window.
-      solver.solve(windowGraph(steps, prior_state, prior_constants, oldest), values);
-    }
+    auto next = nextPriors(solver, values, oldest, times.size());
     steps_ = std::move(steps);
     times_ = std::move(times);
     values_ = std::move(values);
     prior_state_ = std::move(prior_state);
     prior_constants_ = std::move(prior_constants);
     oldest_ = oldest;
-    solver_ = std::move(solver);
-    report_.iterations = sum.iterations;
-    last_summary_ = sum;
-    markDetail();
+    commitSolve(std::move(solver), sum, std::move(next));
   }
 
  private:
@@ -653,15 +650,35 @@ class PaperWindowEstimator final : public Estimator {
     for (std::size_t i = 0; i < count; ++i) steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, ms[i]));
     BatchSolver solver(gaussNewton());
     const BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state_, prior_constants_, oldest_), values);
+    auto next = nextPriors(solver, values, oldest_, times_.size());
     steps_ = std::move(steps);
     values_ = std::move(values);
+    commitSolve(std::move(solver), sum, std::move(next));
+  }
+  bool full() const { return static_cast<int>(times_.size()) >= window_; }
+  // Once the window is full, the 1-D priors the next step puts on what
+  // stays (the second-oldest state, the constants): the marginals of this
+  // solve at its estimate. Taken right after the solve, so that a user's
+  // reads in between (which move the factorization's selected inverse)
+  // cannot change their rounding, and a restored window takes them alike.
+  std::pair<Gaussian, Gaussian> nextPriors(BatchSolver& solver, const Values& values, std::int64_t oldest,
+                                           std::size_t held) const {
+    if (static_cast<int>(held) < window_) return {};
+    const Key next = Key::state(oldest + 1);
+    Gaussian ps = diagonalPrior(values.at(next), solver.marginalCovariance(next)), pb;
+    if (model_.dims().nb > 0) pb = diagonalPrior(values.at(Key::constants()), solver.marginalCovariance(Key::constants()));
+    return {std::move(ps), std::move(pb)};
+  }
+  void commitSolve(BatchSolver&& solver, const BatchSolverSummary& sum, std::pair<Gaussian, Gaussian>&& next) {
     solver_ = std::move(solver);
+    next_prior_state_ = std::move(next.first);
+    next_prior_constants_ = std::move(next.second);
     report_.iterations = sum.iterations;
     last_summary_ = sum;
     markDetail();
   }
   // Gauss–Newton to a cost change below 1e-9 of the cost: the window is
-  // re-solved twice a step, and on a log with robust ranges its iterations
+  // re-solved every step, and on a log with robust ranges its iterations
   // converge linearly (a step ~1/30 of the one before); the batch default
   // (1e-12) spent a fourth iteration moving the estimate by < 1e-6 m (UWB:
   // 20% of the method's time; estimates within 2·10⁻⁵ of it). The last,
@@ -736,6 +753,7 @@ class PaperWindowEstimator final : public Estimator {
     prior_constants_ = std::move(pb);
     oldest_ = oldest;
     solver_.evaluateAt(graph(), factored);
+    std::tie(next_prior_state_, next_prior_constants_) = nextPriors(solver_, values_, oldest_, times_.size());
   }
   static bool sameLayout(const Values& a, const Values& b) {
     if (a.size() != b.size()) return false;
@@ -750,6 +768,7 @@ class PaperWindowEstimator final : public Estimator {
   std::deque<double> times_;
   Values values_;
   Gaussian prior_state_, prior_constants_;
+  Gaussian next_prior_state_, next_prior_constants_;  // full window: the priors after its oldest state leaves
   std::int64_t oldest_ = 0;
   BatchSolver solver_{gaussNewton()};
 };
