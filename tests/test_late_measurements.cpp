@@ -101,8 +101,9 @@ TEST(LateMeasurements, WhatCannotBeTakenIsRefusedUnchangedOrDroppedAndCounted) {
       FAIL() << method << ": a measurement 12 states late must be refused";
     } catch (const InvalidArgument& e) {
       EXPECT_NE(std::string(e.what()).find("is before the newest state"), std::string::npos) << e.what();
-      if (method == Method::FixedLag)
+      if (method == Method::FixedLag) {
         EXPECT_NE(std::string(e.what()).find("older than the window"), std::string::npos) << e.what();
+      }
     }
     EXPECT_EQ(est->current().mean, mean) << method;
     EXPECT_EQ(est->report().measurements, taken) << method;

@@ -245,6 +245,29 @@ TEST(PlanarRigidBody, LinkBiasSpreadLearntByEmIsAStationaryPointOfTheExpectedLog
   const double s = r.parameters[0].value;
   given.bias_sd = s;
   const OfflineRun batch = runOffline(PlanarRigidBody(given), EstimatorOptions(Method::Batch), run.measurements);
+  // Learning's last E-step starts the learnt model's batch nearly converged:
+  // the MAP the EKF's start reaches, in fewer iterations.
+  ASSERT_FALSE(r.posterior.empty());
+  const OfflineRun warm = runBatch(PlanarRigidBody(given), EstimatorOptions(Method::Batch), run.measurements, {},
+                                   RowTimes::Measurements, &r.posterior);
+  ASSERT_EQ(warm.rows.size(), batch.rows.size());
+  for (std::size_t i = 0; i < warm.rows.size(); ++i) {
+    ASSERT_LT((warm.rows[i].mean - batch.rows[i].mean).cwiseAbs().maxCoeff(), 1e-6) << "row " << i;
+    ASSERT_LT((warm.rows[i].covariance - batch.rows[i].covariance).cwiseAbs().maxCoeff(), 1e-8) << "row " << i;
+  }
+  EXPECT_LT(warm.iterations, batch.iterations);
+  Values other = r.posterior;
+  other.erase(Key::state(3));
+  EXPECT_THROW(
+      {
+        try {
+          runBatch(PlanarRigidBody(given), EstimatorOptions(Method::Batch), run.measurements, {}, RowTimes::Measurements, &other);
+        } catch (const InvalidArgument& e) {
+          EXPECT_NE(std::string(e.what()).find("is not of this run"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      InvalidArgument);
   const Eigen::VectorXd m = batch.rows.back().mean.tail(24);
   const Eigen::MatrixXd P = batch.rows.back().covariance.bottomRightCorner(24, 24);
   const Eigen::MatrixXd Sigma = PlanarRigidBody(given).priorConstants().covariance;

@@ -16,6 +16,16 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
+
+// A batch start must hold the problem's variables with their sizes.
+void requireSameVariables(const Values& start, const Values& problem) {
+  bool same = start.size() == problem.size();
+  for (auto a = start.begin(), b = problem.begin(); same && a != start.end(); ++a, ++b)
+    same = a->first == b->first && a->second.size() == b->second.size() && a->second.allFinite();
+  if (!same)
+    throw InvalidArgument("runBatch: the start (" + std::to_string(start.size()) + " variables) is not of this run (" +
+                          std::to_string(problem.size()) + "): it needs the same variables, sizes and finite values");
+}
 }  // namespace
 
 namespace {
@@ -305,12 +315,13 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
 
 OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
                     const std::vector<Measurement>& measurements,
-                    const std::vector<Input>& inputs, RowTimes rows) {
+                    const std::vector<Input>& inputs, RowTimes rows, const Values* from) {
   OfflineRun out;
   out.method = Method::Batch;
   const auto start = Clock::now();
   Problem p = buildProblem(model, measurements, inputs, options.t0);
-  Values x = ekfInitialGuess(model, ExtendedKalmanFilterOptions{}, measurements, inputs, options.t0);
+  if (from) requireSameVariables(*from, p.initial);
+  Values x = from ? *from : ekfInitialGuess(model, ExtendedKalmanFilterOptions{}, measurements, inputs, options.t0);
   BatchSolver solver(options.batch);
   const BatchSolverSummary sum = solver.solve(p.graph, x);
   out.iterations = sum.iterations;

@@ -118,6 +118,7 @@ void learnConstantsPrior(const std::string& type_name, std::vector<LearntParamet
   if (o.standard_errors) standardErrorsOfQ(q, theta, params);
   r.values = std::move(values);
   r.model = model;
+  r.posterior = std::move(x);
   r.parameters.insert(r.parameters.end(), params.begin(), params.end());
   r.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 }

@@ -92,12 +92,15 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
                         const std::function<void(std::size_t, std::size_t)>& progress = {},
                         const StreamingCheckpoints& checkpoints = {}, RowTimes rows = RowTimes::Measurements);
 
-/// The batch MAP of the whole run (from an EKF pass with default options);
-/// rows hold the smoothed estimate at each measurement time with its
-/// marginal covariance.
+/// The batch MAP of the whole run, from `start` (every state of the run
+/// and the constants: a solution of a nearby model, such as learning's
+/// last E-step) or else from an EKF pass with default options; rows hold
+/// the smoothed estimate at each measurement time with its marginal
+/// covariance. InvalidArgument if `start` holds other variables.
 OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
                     const std::vector<Measurement>& measurements,
-                    const std::vector<Input>& inputs = {}, RowTimes rows = RowTimes::Measurements);
+                    const std::vector<Input>& inputs = {}, RowTimes rows = RowTimes::Measurements,
+                    const Values* start = nullptr);
 
 /// options.method over the whole recording: runBatch for the batch,
 /// runStreaming for the others (progress and checkpoints apply to those).

@@ -112,6 +112,10 @@ struct NoiseLearningReport {
   std::size_t measurements = 0;
   ParamValues values;                  ///< every parameter of the learnt model
   std::shared_ptr<const Model> model;  ///< the learnt model
+  /// EM's last E-step: the batch MAP of the run under the σ before the last
+  /// M-step, which moved it by less than the tolerance (empty without EM):
+  /// where a batch solve of the learnt model starts nearly converged.
+  Values posterior;
   /// A few lines: each parameter's start, learnt value ± standard error.
   std::string toString() const;
 };
