@@ -7,12 +7,12 @@ namespace gssm {
 
 const std::vector<MethodInfo>& methods() {
   static const std::vector<MethodInfo> table{
-      {Method::Ekf, "ekf", "EKF", true, kEkfOptions, "ekf"},
-      {Method::Batch, "batch", "batch MAP (smoother)", false, kBatchOptions, "batch"},
+      {Method::Ekf, "ekf", "EKF", true, kEkfOptions, "ekf", 0},
+      {Method::Batch, "batch", "batch MAP (smoother)", false, kBatchOptions, "batch", 1},
       {Method::Incremental, "incremental", "GSSM incremental", true, kSmootherOptions | kIncrementalOptions,
-       "smoother"},
-      {Method::FixedLag, "fixed-lag", "GSSM fixed-lag", true, kSmootherOptions | kFixedLagOptions, "fixed_lag"},
-      {Method::PaperWindow, "paper-window", "paper window", true, kPaperWindowOptions, "paper_window"},
+       "smoother", 3},
+      {Method::FixedLag, "fixed-lag", "GSSM fixed-lag", true, kSmootherOptions | kFixedLagOptions, "fixed_lag", 2},
+      {Method::PaperWindow, "paper-window", "paper window", true, kPaperWindowOptions, "paper_window", 4},
   };
   return table;
 }

@@ -118,16 +118,17 @@ void compareToReference(const Model& model, const ProcessResult& r, const Offlin
   compareConstants(m, *r.dataset.constants_reference, &compared);
 }
 
-// Every method's run, `threads` at a time, in the methods' order; the paper
-// window (a window re-solve per step, the slowest by far) starts first. A
-// method that throws lets the others finish; the first error, in the
-// methods' order, is rethrown.
+// Every method's run, `threads` at a time, the costliest first (MethodInfo::
+// cost_rank: the cheap ones fill in at the end). A method that throws lets
+// the others finish; the first error, in the methods' order, is rethrown.
 std::vector<OfflineRun> runConcurrently(const ProcessOptions& o, const Model& model, const ProcessResult& r,
                                         const EstimatorOptions& options, const std::vector<Method>& methods,
                                         const ProcessCallbacks& cb) {
   std::vector<std::size_t> queue(methods.size());
   std::iota(queue.begin(), queue.end(), std::size_t{0});
-  std::stable_partition(queue.begin(), queue.end(), [&](std::size_t i) { return methods[i] == Method::PaperWindow; });
+  std::stable_sort(queue.begin(), queue.end(), [&](std::size_t a, std::size_t b) {
+    return methodInfo(methods[a]).cost_rank > methodInfo(methods[b]).cost_rank;
+  });
   std::mutex mutex;
   ProcessCallbacks serialized = cb;
   if (cb.progress)

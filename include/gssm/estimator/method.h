@@ -37,6 +37,11 @@ struct MethodInfo {
   bool streaming;           ///< makeEstimator builds it; false: needs the whole run
   unsigned reads;           ///< MethodOptions bits it reads
   const char* ini_section;  ///< its own INI section ("" if none)
+  /// Work over a run relative to the others (higher: more): methods run
+  /// side by side start the costliest first, so that the cheap ones fill
+  /// in at the end (a window re-solve per step > a smoother's update >
+  /// one batch solve > a filter's update).
+  int cost_rank;
 };
 
 /// Every method, in the order "all" runs them.
