@@ -943,25 +943,33 @@ Eigen::MatrixXd BayesTreeEngine::bayesNetCovariance(const std::vector<Key>& keys
     off[f] = n;
     n += vars_.at(f).dim();
   }
-  const Eigen::SparseMatrix<double> R = pathConditionals(path, off, n);
   Eigen::Index m = 0;
   for (const auto& k : keys) m += vars_.at(k).dim();
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, m);
   Eigen::Index c = 0;
   for (const auto& k : keys)
     for (Eigen::Index j = 0; j < vars_.at(k).dim(); ++j) E(off.at(k) + j, c++) = 1.0;
-  // Σ = R⁻¹ R⁻ᵀ, so Σ_req = Yᵀ Y with Y = R⁻ᵀ E.
-  const Eigen::MatrixXd Y = Eigen::SparseMatrix<double>(R.transpose()).triangularView<Eigen::Lower>().solve(E);
+  // Σ = R⁻¹ R⁻ᵀ, so Σ_req = Yᵀ Y with Y = R⁻ᵀ E. A short path (a newest
+  // state and the constants: 31 columns, asked for after every update)
+  // densely: assembling a sparse R took 3× the solves' time.
+  Eigen::MatrixXd Y;
+  if (n <= kDensePathColumns) {
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n);
+    forEachPathEntry(path, off, [&](Eigen::Index i, Eigen::Index j, double v) { R(i, j) = v; });
+    Y = R.transpose().triangularView<Eigen::Lower>().solve(E);
+  } else {
+    std::vector<Eigen::Triplet<double>> trip;
+    forEachPathEntry(path, off, [&](Eigen::Index i, Eigen::Index j, double v) { trip.emplace_back(i, j, v); });
+    Eigen::SparseMatrix<double> R(n, n);
+    R.setFromTriplets(trip.begin(), trip.end());
+    Y = Eigen::SparseMatrix<double>(R.transpose()).triangularView<Eigen::Lower>().solve(E);
+  }
   const Eigen::MatrixXd S = Y.transpose() * Y;
   return 0.5 * (S + S.transpose());
 }
 
-// The path's conditionals [R S] as one sparse upper-triangular R (n × n),
-// each clique's rows at its frontal variable's offset.
-template <class Offsets>
-Eigen::SparseMatrix<double> BayesTreeEngine::pathConditionals(const std::vector<int>& path, const Offsets& off,
-                                                              Eigen::Index n) const {
-  std::vector<Eigen::Triplet<double>> trip;
+template <class Offsets, class Emit>
+void BayesTreeEngine::forEachPathEntry(const std::vector<int>& path, const Offsets& off, Emit&& emit) const {
   for (int c : path) {
     const Clique& cl = cliques_[static_cast<std::size_t>(c)];
     const Eigen::Index r0 = off.at(cl.frontal);
@@ -969,19 +977,16 @@ Eigen::SparseMatrix<double> BayesTreeEngine::pathConditionals(const std::vector<
     const auto R = C.leftCols(cl.dv);
     const auto S = C.middleCols(cl.dv, cl.width);
     for (Eigen::Index i = 0; i < R.rows(); ++i)
-      for (Eigen::Index j = i; j < R.cols(); ++j) trip.emplace_back(r0 + i, r0 + j, R(i, j));
+      for (Eigen::Index j = i; j < R.cols(); ++j) emit(r0 + i, r0 + j, R(i, j));
     Eigen::Index col = 0;
     for (const auto& k : separator(cl)) {
       const Eigen::Index dk = vars_.at(k).dim();
       const Eigen::Index c0 = off.at(k);
       for (Eigen::Index i = 0; i < S.rows(); ++i)
-        for (Eigen::Index j = 0; j < dk; ++j) trip.emplace_back(r0 + i, c0 + j, S(i, col + j));
+        for (Eigen::Index j = 0; j < dk; ++j) emit(r0 + i, c0 + j, S(i, col + j));
       col += dk;
     }
   }
-  Eigen::SparseMatrix<double> R(n, n);
-  R.setFromTriplets(trip.begin(), trip.end());
-  return R;
 }
 
 double BayesTreeEngine::linearizationError(int slot) const {

@@ -421,8 +421,13 @@ class BayesTreeEngine {
   // pathMarginalCovariance's two cases (bayes_tree.cpp).
   Eigen::MatrixXd rootCovariance(const Clique& root) const;
   Eigen::MatrixXd bayesNetCovariance(const std::vector<Key>& keys) const;
-  template <class Offsets>
-  Eigen::SparseMatrix<double> pathConditionals(const std::vector<int>& path, const Offsets& off, Eigen::Index n) const;
+  // Paths up to this many columns are solved densely (UWB: 6 + 25).
+  static constexpr Eigen::Index kDensePathColumns = 64;
+  // Calls emit(i, j, v) for every entry of the path's conditionals [R S]
+  // as one upper-triangular n × n matrix (each clique's rows at its frontal
+  // variable's offset).
+  template <class Offsets, class Emit>
+  void forEachPathEntry(const std::vector<int>& path, const Offsets& off, Emit&& emit) const;
   void commitFactors(UpdatePlan& plan, EngineCounts& counts);
   /// Frees a slot: off its variables' lists, its record released.
   void killSlot(int s);
