@@ -101,8 +101,8 @@ void PriorFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& 
   noise_.whitenInPlace(r);
   if (J) {
     J->resize(1);
-    (*J)[0] = noise_.sqrtCovariance().triangularView<Eigen::Lower>().solve(
-        Eigen::MatrixXd::Identity(dim(), dim()));
+    (*J)[0].setIdentity(dim(), dim());  // whitened in place: L⁻¹ (1/σ for independent components), no temporaries
+    noise_.whitenInPlace((*J)[0]);
   }
 }
 

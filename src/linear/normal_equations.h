@@ -3,6 +3,8 @@
 // into the upper triangle of a sparse symmetric matrix (the batch solver's
 // information matrix, the Newton system's Hessian).
 #include <Eigen/Core>
+#include <algorithm>
+#include <utility>
 #include <vector>
 
 namespace gssm::internal {
@@ -17,6 +19,9 @@ struct FactorColumns {
   /// After gather: the columns with a nonzero entry, ascending (a range's
   /// Jacobian reaches 4 of its 30 columns: the pose's three and one bias).
   std::vector<std::size_t> nonzero;
+  /// After gather, with more than one row: the rows [first, last) outside
+  /// which column p is zero (a prior's identity Jacobian: one row each).
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> span;
   Eigen::Index rows = 0;
   bool ascending = true;  ///< global columns strictly increase (a factor's keys in Key order)
   std::size_t size() const { return size_; }
@@ -44,6 +49,7 @@ struct FactorColumns {
     if (global.size() < total) global.resize(total);
     if (entries.size() < static_cast<std::size_t>(rows) * total) entries.resize(static_cast<std::size_t>(rows) * total);
     nonzero.resize(total);
+    if (rows > 1) span.resize(total);
     size_ = total;
     ascending = true;
     double* out = entries.data();
@@ -57,6 +63,12 @@ struct FactorColumns {
       for (Eigen::Index r = 0; r < rows; ++r) {
         any |= in[r] != 0.0;
         *out++ = in[r];
+      }
+      if (rows > 1) {
+        Eigen::Index lo = 0, hi = rows;
+        while (lo < hi && in[lo] == 0.0) ++lo;
+        while (hi > lo && in[hi - 1] == 0.0) --hi;
+        span[p] = {lo, hi};
       }
       nonzero[count] = p++;
       count += any;
@@ -126,17 +138,38 @@ void forEachUpperJtJ(const FactorColumns& c, Emit&& emit) {
 }
 
 /// forEachUpperJtJ over the gathered nonzero columns only: the entries it
-/// leaves out are exact zeros (the same sums where it emits; for callers
-/// that address entries by position, not by running index).
+/// leaves out are exact zeros, and so are those of two columns whose
+/// nonzero rows do not meet (the same sums where it emits: only zero terms
+/// are left out; for callers that address entries by position, not by
+/// running index).
 template <class Emit>
 void forEachNonzeroUpperJtJ(const FactorColumns& c, Emit&& emit) {
   const std::size_t* nz = c.nonzero.data();
   const std::size_t n = c.nonzero.size();
+  constexpr std::size_t kLocal = 16;
+  if (c.rows == 1 && c.ascending && n <= kLocal) {
+    // A scalar residual (most factors): its values in locals, which the
+    // caller's stores into H cannot alias, so none is read twice.
+    double v[kLocal];
+    Eigen::Index g[kLocal];
+    for (std::size_t a = 0; a < n; ++a) v[a] = c.entries[nz[a]], g[a] = c.global[nz[a]];
+    for (std::size_t b = 0; b < n; ++b)
+      for (std::size_t a = 0; a <= b; ++a) emit(g[a], g[b], v[a] * v[b], nz[a], nz[b]);
+    return;
+  }
   for (std::size_t b = 0; b < n; ++b)
     for (std::size_t a = 0; a < (c.ascending ? b + 1 : n); ++a) {  // ascending: p ≤ q exactly when a ≤ b
       const std::size_t p = nz[a], q = nz[b];
       if (!c.ascending && c.global[p] > c.global[q]) continue;
-      emit(c.global[p], c.global[q], c.dot(p, c.column(q)), p, q);
+      if (c.rows == 1) {
+        emit(c.global[p], c.global[q], c.entries[p] * c.entries[q], p, q);
+        continue;
+      }
+      const Eigen::Index lo = std::max(c.span[p].first, c.span[q].first), hi = std::min(c.span[p].second, c.span[q].second);
+      if (lo >= hi) continue;  // no row holds both
+      double v = 0;
+      for (Eigen::Index r = lo; r < hi; ++r) v += c.column(p)[r] * c.column(q)[r];
+      emit(c.global[p], c.global[q], v, p, q);
     }
 }
 
