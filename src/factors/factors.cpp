@@ -229,7 +229,8 @@ void internal::measurementResidual(const Model& model, int channel, const Eigen:
   if (J) J->resize(has_constants ? 2 : 1);
   Eigen::MatrixXd* J_h_xc = J ? &(*J)[0] : nullptr;
   Eigen::MatrixXd* J_h_xb = J ? (has_constants ? &(*J)[1] : &no_constants) : nullptr;
-  r = model.h(channel, xc, xb, J_h_xc, J_h_xb) - y;
+  model.hInto(channel, xc, xb, r, J_h_xc, J_h_xb);
+  r -= y;
   wrapAngles(r, model.channel(channel).angles);
   noise.whitenInPlace(r);
   if (J)

@@ -60,6 +60,11 @@ Model::Model(ModelDims dims, ModelNames names, ModelNoise noise)
 Eigen::MatrixXd Model::processNoise(double dt) const { return noise_.Q * (dt / noise_.T); }
 Eigen::MatrixXd Model::processNoiseOf(double dt, const Eigen::VectorXd&) const { return processNoise(dt); }
 
+void Model::hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
+                  Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  out = h(channel, xc, xb, J_h_xc, J_h_xb);
+}
+
 Eigen::VectorXd Model::h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                          Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
   if (channel != 0)

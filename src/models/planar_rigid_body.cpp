@@ -201,6 +201,13 @@ Eigen::VectorXd PlanarRigidBody::h(const Eigen::VectorXd& xc, const Eigen::Vecto
 // ∂ρ/∂yaw = d_xy·(R'(yaw) l)/ρ with R' l = (−sin·lx − cos·ly, cos·lx − sin·ly).
 Eigen::VectorXd PlanarRigidBody::h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                                    Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  Eigen::VectorXd out;
+  hInto(channel, xc, xb, out, J_h_xc, J_h_xb);
+  return out;
+}
+
+void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
+                            Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
   this->channel(channel);  // range check
   const std::size_t t = static_cast<std::size_t>(channel) / p_.anchors.size();
   const std::size_t a = static_cast<std::size_t>(channel) % p_.anchors.size();
@@ -227,7 +234,8 @@ Eigen::VectorXd PlanarRigidBody::h(int channel, const Eigen::VectorXd& xc, const
     if (i_scale_ >= 0) (*J_h_xb)(0, i_scale_) = rho;
   }
   const double error = dims().nc > 6 ? xc[6 + channel] : 0.0;
-  return Eigen::VectorXd::Constant(1, scale * rho + (ib >= 0 ? xb[ib] : 0.0) + error);
+  out.resize(1);
+  out[0] = scale * rho + (ib >= 0 ? xb[ib] : 0.0) + error;
 }
 
 Eigen::MatrixXd PlanarRigidBody::processNoise(double dt) const {

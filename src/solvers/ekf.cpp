@@ -104,32 +104,35 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   if (!validVector(y, ch.dim()))
     requireVector(y, ch.dim(), "ExtendedKalmanFilter::update: measurement on channel '" + ch.name + "'");
   if (m.R.size()) requireCovariance(m.R, ch.dim(), "ExtendedKalmanFilter::update: the measurement's own R");
-  Eigen::MatrixXd J_h_xc, J_h_xb;
-  const Eigen::VectorXd yhat = model_->h(m.channel, z_.head(d.nc), z_.tail(d.nb), &J_h_xc, &J_h_xb);
+  UpdateBuffers& b = u_;
+  b.xc = z_.head(d.nc);
+  b.xb = z_.tail(d.nb);
+  model_->hInto(m.channel, b.xc, b.xb, b.yhat, &b.J_h_xc, &b.J_h_xb);
   const int n = d.nc + d.nb;
-  Eigen::MatrixXd H(ch.dim(), n);
-  H << J_h_xc, J_h_xb;
+  b.H.resize(ch.dim(), n);
+  b.H << b.J_h_xc, b.J_h_xb;
   const Eigen::MatrixXd& R = m.R.size() ? m.R : ch.R;
-  const Eigen::MatrixXd HP = H * P_;  // m × n, shared by S, the gain and the covariance update
-  const Eigen::MatrixXd S = HP * H.transpose() + R;
-  Eigen::LLT<Eigen::MatrixXd> llt(S);
-  if (llt.info() != Eigen::Success || !S.allFinite())
+  b.HP.noalias() = b.H * P_;  // m × n, shared by S, the gain and the covariance update
+  b.S = b.HP * b.H.transpose() + R;
+  b.llt.compute(b.S);
+  if (b.llt.info() != Eigen::Success || !b.S.allFinite())
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
                          ": innovation covariance S = HPHᵀ + R is not positive definite; "
                          "check R and the covariance P (filter unchanged)");
-  Eigen::VectorXd innov = y - yhat;
-  wrapAngles(innov, ch.angles);
-  const double nis = innov.dot(llt.solve(innov));
+  b.innov = y - b.yhat;
+  wrapAngles(b.innov, ch.angles);
+  b.whitened = b.llt.solve(b.innov);
+  const double nis = b.innov.dot(b.whitened);
   if (options_.use_gates && ch.ekf_gate > 0 && nis > ch.ekf_gate) {  // an outlier: leave the estimate as it is
     nis_ = nis;
     ++rejected_;
     return false;
   }
   // log N(e; 0, S) = −½ (eᵀS⁻¹e + log det S + m log 2π), log det S from S's Cholesky factor.
-  const double log_det_S = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
+  const double log_det_S = 2.0 * b.llt.matrixLLT().diagonal().array().log().sum();
   const double log_normal = -0.5 * (nis + log_det_S + static_cast<double>(ch.dim()) * std::log(2.0 * M_PI));
   const auto [log_p, w] = mixture(log_normal, options_.outlier_probability, outlierLogDensity(m.channel));
-  commitUpdate(HP, S, llt, innov, w);
+  commitUpdate(w);
   nis_ = nis;
   log_likelihood_ += log_p;
   return true;
@@ -145,28 +148,32 @@ double ExtendedKalmanFilter::outlierLogDensity(int channel) const {
 
 // The update with inlier weight w (1: the Kalman update): the moments of the
 // mixture w·N(inlier update) + (1 − w)·N(no update).
-void ExtendedKalmanFilter::commitUpdate(const Eigen::MatrixXd& HP, const Eigen::MatrixXd& S,
-                                        const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& innov, double w) {
-  const Eigen::MatrixXd K = llt.solve(HP).transpose();  // P Hᵀ S⁻¹ (P, S symmetric)
+void ExtendedKalmanFilter::commitUpdate(double w) {
+  UpdateBuffers& b = u_;
+  b.KT = b.llt.solve(b.HP);  // Kᵀ = S⁻¹ H P (P, S symmetric)
+  b.K = b.KT.transpose();      // contiguous columns: the loops below vectorize
+  const Eigen::MatrixXd& K = b.K;
   // Joseph form (I − KH) P (I − KH)ᵀ + K R Kᵀ, expanded as
   // P − K(HP) − (K(HP))ᵀ + K S Kᵀ = P + M + Mᵀ with M = K (½ S Kᵀ − HP):
   // one n × m × n product for an m-row update (a scalar range: one outer
   // product) instead of two n×n×n products.
-  Eigen::MatrixXd P;
+  Eigen::MatrixXd& P = b.P;
   if (options_.joseph_form) {
-    const Eigen::MatrixXd A = 0.5 * S * K.transpose() - HP;  // m × n
+    b.A.noalias() = 0.5 * b.S * K.transpose();  // m × n
+    b.A -= b.HP;
     P = P_;
     for (Eigen::Index j = 0; j < P.cols(); ++j) {  // the upper triangle by columns, then mirrored: exactly symmetric
       auto upper = P.col(j).head(j + 1);
       for (Eigen::Index c = 0; c < K.cols(); ++c)
-        upper += K.col(c).head(j + 1) * A(c, j) + A.row(c).head(j + 1).transpose() * K(j, c);
+        upper += K.col(c).head(j + 1) * b.A(c, j) + b.A.row(c).head(j + 1).transpose() * K(j, c);
     }
     for (Eigen::Index j = 0; j < P.cols(); ++j)
       for (Eigen::Index i = j + 1; i < P.rows(); ++i) P(i, j) = P(j, i);
   } else {
-    P = P_ - K * HP;
+    P = P_ - K * b.HP;
   }
-  const Eigen::VectorXd dz = K * innov;
+  b.dz.noalias() = K * b.innov;
+  const Eigen::VectorXd& dz = b.dz;
   if (w < 1.0) P = w * P + (1.0 - w) * P_ + (w * (1.0 - w)) * dz * dz.transpose();
   if (!options_.joseph_form || w < 1.0) P = 0.5 * (P + P.transpose());
   // With R > 0 the update keeps P positive definite in exact arithmetic
@@ -181,7 +188,7 @@ void ExtendedKalmanFilter::commitUpdate(const Eigen::MatrixXd& HP, const Eigen::
                          ": the updated covariance is not positive definite (filter unchanged)");
   z_ += w * dz;
   wrapAngles(z_, model_->angleStates());
-  P_ = std::move(P);
+  P_.swap(P);  // the old covariance's storage is the next candidate's
 }
 
 void filterAlong(ExtendedKalmanFilter& filter, const std::vector<ScheduledStep>& schedule,

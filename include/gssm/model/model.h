@@ -87,6 +87,13 @@ class Model {
   /// Default: channel 0 is h() above; models with several channels override.
   virtual Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                             Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const;
+  /// h(channel, ...) written into `out` (resized to the channel's
+  /// dimension): the same numbers without a fresh vector per call, which
+  /// the solvers' inner loops use. Default: out = h(channel, ...). A model
+  /// evaluated millions of times per run (one range per call) overrides
+  /// this and lets h() call it.
+  virtual void hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
+                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const;
 
   /// The measurement channels (at least one; channel 0 has n_y components).
   int numChannels() const { return static_cast<int>(channels_.size()); }

@@ -78,6 +78,8 @@ class PlanarRigidBody final : public Model {
                     Eigen::MatrixXd* J_h_xb = nullptr) const override;
   Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  void hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
+             Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
   /// White acceleration over dt on (px, vx), (py, vy), (yaw, omega):
   /// q²·[[dt³/3, dt²/2], [dt²/2, dt]] each.
   Eigen::MatrixXd processNoise(double dt) const override;
