@@ -4,27 +4,14 @@
 #include <cmath>
 
 #include "gssm/core/error.h"
+#include "linear/dot.h"
 
 namespace gssm::internal {
 
-namespace {
-// Σ a[k] b[k] over [0, n) in four interleaved partial sums: a constants'
+// Dots in four interleaved partial sums (linear/dot.h): a constants'
 // column is dotted with every column before it (~70 entries in a paper
 // window), and one running sum is a chain of dependent additions, 4× slower.
 // Below four entries (a band) the sum is in order, as before.
-inline double dot(const double* a, const double* b, std::ptrdiff_t n) {
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  std::ptrdiff_t k = 0;
-  for (; k + 4 <= n; k += 4) {
-    s0 += a[k] * b[k];
-    s1 += a[k + 1] * b[k + 1];
-    s2 += a[k + 2] * b[k + 2];
-    s3 += a[k + 3] * b[k + 3];
-  }
-  for (; k < n; ++k) s0 += a[k] * b[k];
-  return (s0 + s1) + (s2 + s3);
-}
-}  // namespace
 
 void EnvelopeCholesky::setPattern(std::vector<int> first) {
   first_ = std::move(first);
@@ -106,7 +93,7 @@ inline void EnvelopeCholesky::offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j, st
   const double* ui = u_.data() + base_[static_cast<std::size_t>(i)];
   double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
   const std::ptrdiff_t lo = std::max({fi, fj, from});
-  uj[i] = (h_[static_cast<std::size_t>(base_[static_cast<std::size_t>(j)] + i)] - known - dot(ui + lo, uj + lo, i - lo)) * ui[i];
+  uj[i] = (h_[static_cast<std::size_t>(base_[static_cast<std::size_t>(j)] + i)] - known - dot4(ui + lo, uj + lo, i - lo)) * ui[i];
 }
 
 // 1/U(j, j) from column j's entries above it (from `from` on, `known` the
@@ -114,7 +101,7 @@ inline void EnvelopeCholesky::offDiagonal(std::ptrdiff_t i, std::ptrdiff_t j, st
 inline bool EnvelopeCholesky::pivot(std::ptrdiff_t j, std::ptrdiff_t from, double known) {
   const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(first_[static_cast<std::size_t>(j)], from);
   double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
-  const double d = h_[static_cast<std::size_t>(base_[static_cast<std::size_t>(j)] + j)] - known - dot(uj + lo, uj + lo, j - lo);
+  const double d = h_[static_cast<std::size_t>(base_[static_cast<std::size_t>(j)] + j)] - known - dot4(uj + lo, uj + lo, j - lo);
   if (!(d > 0) || !std::isfinite(d)) return false;
   uj[j] = 1.0 / std::sqrt(d);
   return true;
@@ -126,7 +113,7 @@ void EnvelopeCholesky::solveInPlace(double* x) const {
   for (std::ptrdiff_t j = 0; j < n; ++j) {  // Uᵀ y = b
     const std::ptrdiff_t fj = first_[static_cast<std::size_t>(j)];
     const double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
-    x[j] = (x[j] - dot(uj + fj, x + fj, j - fj)) * uj[j];  // uj[j] = 1/U(j, j)
+    x[j] = (x[j] - dot4(uj + fj, x + fj, j - fj)) * uj[j];  // uj[j] = 1/U(j, j)
   }
   for (std::ptrdiff_t j = n - 1; j >= 0; --j) {  // U x = y
     const std::ptrdiff_t fj = first_[static_cast<std::size_t>(j)];
@@ -207,7 +194,7 @@ Eigen::MatrixXd EnvelopeCholesky::inverseBlock(Eigen::Index first, Eigen::Index 
     for (std::ptrdiff_t j = first + c; j < n; ++j) {  // Uᵀw = e: rows above first + c are 0
       const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(first_[static_cast<std::size_t>(j)], first + c);
       const double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
-      w[j] = (w[j] - dot(uj + lo, w + lo, j - lo)) * uj[j];
+      w[j] = (w[j] - dot4(uj + lo, w + lo, j - lo)) * uj[j];
     }
   }
   const Eigen::MatrixXd block = W.transpose() * W;

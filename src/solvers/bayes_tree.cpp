@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "gssm/core/error.h"
+#include "linear/dot.h"
 #include "solvers/newton.h"
 
 namespace gssm::internal {
@@ -95,8 +96,7 @@ void triangularize(Eigen::MatrixXd& M, std::vector<Eigen::Index>& last) {
   for (Eigen::Index k = 0; k < n; ++k) {
     double* x = &M(k, k);
     const Eigen::Index m = std::max<Eigen::Index>(last[static_cast<std::size_t>(k)] + 1 - k, 1);
-    double tail = 0;
-    for (Eigen::Index i = 1; i < m; ++i) tail += x[i] * x[i];
+    const double tail = dot4(x + 1, x + 1, m - 1);  // four partial sums: the chain of one sum was the clique's bottleneck
     if (tail <= std::numeric_limits<double>::min()) continue;  // already triangular here: τ = 0
     const double c0 = x[0];
     double beta = std::sqrt(c0 * c0 + tail);
@@ -107,9 +107,7 @@ void triangularize(Eigen::MatrixXd& M, std::vector<Eigen::Index>& last) {
     x[0] = beta;
     for (Eigen::Index j = k + 1; j < cols; ++j) {  // (I − τ v vᵀ) applied to each later column
       double* y = &M(k, j);
-      double w = 0;
-      for (Eigen::Index i = 1; i < m; ++i) w += x[i] * y[i];
-      w += y[0];
+      const double w = dot4(x + 1, y + 1, m - 1) + y[0];
       y[0] -= tau * w;
       for (Eigen::Index i = 1; i < m; ++i) y[i] -= (tau * x[i]) * w;
     }
