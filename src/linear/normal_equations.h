@@ -137,26 +137,33 @@ void forEachUpperJtJ(const FactorColumns& c, Emit&& emit) {
   });
 }
 
-/// forEachUpperJtJ over the gathered nonzero columns only: the entries it
-/// leaves out are exact zeros, and so are those of two columns whose
+/// A factor's whole contribution to Jᵀr and JᵀJ over its gathered nonzero
+/// columns, in one pass: with the residual r (rows entries; nullptr: none)
+/// first grad(column of H, column p · r) for every nonzero column, then
+/// emit(row, col, v, p, q) for forEachUpperJtJ's entries among them. The
+/// entries left out are exact zeros, and so are those of two columns whose
 /// nonzero rows do not meet (the same sums where it emits: only zero terms
 /// are left out; for callers that address entries by position, not by
 /// running index).
-template <class Emit>
-void forEachNonzeroUpperJtJ(const FactorColumns& c, Emit&& emit) {
+template <class Grad, class Emit>
+void forEachNonzeroGradientAndUpperJtJ(const FactorColumns& c, const double* r, Grad&& grad, Emit&& emit) {
   const std::size_t* nz = c.nonzero.data();
   const std::size_t n = c.nonzero.size();
   constexpr std::size_t kLocal = 16;
   if (c.rows == 1 && c.ascending && n <= kLocal) {
     // A scalar residual (most factors): its values in locals, which the
-    // caller's stores into H cannot alias, so none is read twice.
+    // caller's stores into g and H cannot alias, so none is read twice.
     double v[kLocal];
     Eigen::Index g[kLocal];
     for (std::size_t a = 0; a < n; ++a) v[a] = c.entries[nz[a]], g[a] = c.global[nz[a]];
+    if (r)
+      for (std::size_t a = 0; a < n; ++a) grad(g[a], v[a] * r[0]);
     for (std::size_t b = 0; b < n; ++b)
       for (std::size_t a = 0; a <= b; ++a) emit(g[a], g[b], v[a] * v[b], nz[a], nz[b]);
     return;
   }
+  if (r)
+    for (std::size_t a = 0; a < n; ++a) grad(c.global[nz[a]], c.dot(nz[a], r));
   for (std::size_t b = 0; b < n; ++b)
     for (std::size_t a = 0; a < (c.ascending ? b + 1 : n); ++a) {  // ascending: p ≤ q exactly when a ≤ b
       const std::size_t p = nz[a], q = nz[b];
@@ -171,6 +178,12 @@ void forEachNonzeroUpperJtJ(const FactorColumns& c, Emit&& emit) {
       for (Eigen::Index r = lo; r < hi; ++r) v += c.column(p)[r] * c.column(q)[r];
       emit(c.global[p], c.global[q], v, p, q);
     }
+}
+
+/// forEachNonzeroGradientAndUpperJtJ's JᵀJ entries alone.
+template <class Emit>
+void forEachNonzeroUpperJtJ(const FactorColumns& c, Emit&& emit) {
+  forEachNonzeroGradientAndUpperJtJ(c, nullptr, [](Eigen::Index, double) {}, emit);
 }
 
 }  // namespace gssm::internal

@@ -307,13 +307,15 @@ struct BatchSolver::Impl {
       } else {
         columns.gather(factor_offs.data(), J);
       }
-      for (std::size_t p : columns.nonzero) g[columns.global[p]] += columns.dot(p, r.data());  // zero columns add 0
-      if (use_envelope)
-        internal::forEachNonzeroUpperJtJ(columns, [&](Eigen::Index i, Eigen::Index j, double v, auto...) {
-          H[envelope.position(i, j)] += v;
-        });
-      else
+      double* gd = g.data();
+      if (use_envelope) {
+        internal::forEachNonzeroGradientAndUpperJtJ(
+            columns, r.data(), [gd](Eigen::Index i, double v) { gd[i] += v; },
+            [&](Eigen::Index i, Eigen::Index j, double v, auto...) { H[envelope.position(i, j)] += v; });
+      } else {
+        for (std::size_t p : columns.nonzero) gd[columns.global[p]] += columns.dot(p, r.data());  // zero columns add 0
         internal::forEachUpperJtJ(columns, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
+      }
       ++fi;
     }
     diag.resize(n);
