@@ -124,6 +124,52 @@ TEST(BatchSolver, LinearModelEqualsRtsSmootherAtEveryStep) {
                           ref.Pf.back()), 1e-8);
 }
 
+// A chain of 16384 factors or more is linearized in two halves (on two
+// threads where allowed): the same bits with one thread or two, the RTS
+// smoother's answer, and a non-finite residual in the second half named
+// as in one pass, the values left as they were.
+TEST(BatchSolver, ALongChainInTwoHalvesEqualsTheRtsSmootherWithAnyThreadCount) {
+  std::mt19937 rng(17);
+  models::LinearSystem sys = gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1);
+  sys.A_c = -0.5 * Eigen::MatrixXd::Identity(3, 3);  // stable: 830 s of a random A_c may grow by 10^100
+  const models::LinearModel model(sys);
+  SimulationSpec spec;
+  spec.steps = 8300;  // 2 priors + 8300 process + 8300 measurement factors
+  const SimulatedRun run = simulate(model, spec, normalSampler(8));
+  const Problem p = buildProblem(model, run.measurements);
+  ASSERT_GE(p.graph.size(), 16384u);
+  Values one = p.initial, two = p.initial;
+  BatchSolverOptions o;
+  BatchSolver a(o);
+  o.threads = 2;
+  BatchSolver b(o);
+  ASSERT_TRUE(a.solve(p.graph, one).converged);
+  ASSERT_TRUE(b.solve(p.graph, two).converged);
+  const auto ref = gssm::testing::kalmanAndRts(gssm::testing::stack(model, 0.1), run.measurements);
+  for (int k : {0, 1, 4000, 4150, 4151, 4152, 8299, 8300}) {
+    const std::vector<Key> keys{Key::state(k), Key::constants()};
+    EXPECT_EQ(one.at(Key::state(k)), two.at(Key::state(k))) << "step " << k;
+    EXPECT_EQ(a.jointMarginalCovariance(keys), b.jointMarginalCovariance(keys)) << "step " << k;
+    Eigen::VectorXd z(5);
+    z << one.at(Key::state(k)), one.at(Key::constants());
+    EXPECT_LT(relativeError(z, ref.zs[static_cast<std::size_t>(k)]), 1e-8) << "mean at step " << k;
+    EXPECT_LT(relativeError(a.jointMarginalCovariance(keys), ref.Ps[static_cast<std::size_t>(k)]), 1e-8)
+        << "covariance at step " << k;
+  }
+  Values bad = p.initial;
+  bad.at(Key::state(6000))[1] = std::numeric_limits<double>::quiet_NaN();
+  const Values before = bad;
+  try {
+    b.solve(p.graph, bad);
+    FAIL() << "a NaN state must be refused";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("x_c(6000)"), std::string::npos) << e.what();
+  }
+  for (int k : {0, 5999, 6000, 8300})
+    EXPECT_TRUE(bad.at(Key::state(k)).isApprox(before.at(Key::state(k))) || k == 6000) << "step " << k;
+  EXPECT_TRUE(std::isnan(bad.at(Key::state(6000))[1]));
+}
+
 TEST(BatchSolver, GaussNewtonAndLevenbergMarquardtAgreeOnLinearModel) {
   std::mt19937 rng(5);
   const models::LinearModel model(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1));

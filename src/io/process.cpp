@@ -118,12 +118,26 @@ void compareToReference(const Model& model, const ProcessResult& r, const Offlin
   compareConstants(m, *r.dataset.constants_reference, &compared);
 }
 
-// Every method's run, `threads` at a time, the costliest first (MethodInfo::
-// cost_rank: the cheap ones fill in at the end). A method that throws lets
-// the others finish; the first error, in the methods' order, is rethrown.
-std::vector<OfflineRun> runConcurrently(const ProcessOptions& o, const Model& model, const ProcessResult& r,
-                                        const EstimatorOptions& options, const std::vector<Method>& methods,
-                                        const ProcessCallbacks& cb) {
+// A method's run and its metrics (against the reference too, if any).
+struct MeasuredRun {
+  OfflineRun run;
+  RunMetrics metrics;
+};
+MeasuredRun runAndMeasure(const ProcessOptions& o, const Model& model, const ProcessResult& r,
+                          const EstimatorOptions& options, Method method, const ProcessCallbacks& cb) {
+  MeasuredRun m{runMethod(o, model, r, options, method, cb), {}};
+  m.metrics = computeMetrics(model, m.run, r.dataset.truth ? &*r.dataset.truth : nullptr);
+  if (r.dataset.constants_reference) compareToReference(model, r, m.run, m.metrics);
+  return m;
+}
+
+// Every method's run and metrics, `threads` at a time, the costliest first
+// (MethodInfo::cost_rank: the cheap ones fill in at the end). A method that
+// throws lets the others finish; the first error, in the methods' order, is
+// rethrown.
+std::vector<MeasuredRun> runConcurrently(const ProcessOptions& o, const Model& model, const ProcessResult& r,
+                                         const EstimatorOptions& options, const std::vector<Method>& methods,
+                                         const ProcessCallbacks& cb) {
   std::vector<std::size_t> queue(methods.size());
   std::iota(queue.begin(), queue.end(), std::size_t{0});
   std::stable_sort(queue.begin(), queue.end(), [&](std::size_t a, std::size_t b) {
@@ -136,10 +150,10 @@ std::vector<OfflineRun> runConcurrently(const ProcessOptions& o, const Model& mo
       const std::lock_guard<std::mutex> lock(mutex);
       cb.progress(m, done, total);
     };
-  std::vector<OfflineRun> runs(methods.size());
+  std::vector<MeasuredRun> runs(methods.size());
   std::vector<std::exception_ptr> errors(methods.size());
   const auto failed = runJobs(queue.size(), o.threads, [&](std::size_t k) {
-    runs[queue[k]] = runMethod(o, model, r, options, methods[queue[k]], serialized);
+    runs[queue[k]] = runAndMeasure(o, model, r, options, methods[queue[k]], serialized);
   });
   for (std::size_t k = 0; k < queue.size(); ++k) errors[queue[k]] = failed[k];  // back in the methods' order
   for (const auto& e : errors)
@@ -166,7 +180,8 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   r.model = model;
   const std::vector<Method> methods = methodsToRun(o, *model);
   readData(o, *model, r, cb);
-  if (const LearnSettings learn = learnSettings(r.config); o.learn.value_or(learn.enabled)) {
+  if (LearnSettings learn = learnSettings(r.config); o.learn.value_or(learn.enabled)) {
+    learn.options.batch.threads = static_cast<int>(o.threads);  // learning runs alone: its batch solves may use them all
     LearnResult learnt = learnAndWrite(*model, r.config, r.dataset, o.out_dir, learn.options);
     r.config = std::move(learnt.config);
     model = r.model = learnt.report.model;
@@ -178,14 +193,14 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   EstimatorOptions options = estimatorOptions(r.config, *model);
   options.t0 = r.dataset.t0;
   if (o.window) options.fixed_lag.window = options.paper_window.window = *o.window;
-  const Truth* truth = r.dataset.truth ? &*r.dataset.truth : nullptr;
-  std::vector<OfflineRun> concurrent;
+  if (methods.size() == 1) options.batch.threads = static_cast<int>(o.threads);  // alone, the batch may use them all
+  std::vector<MeasuredRun> concurrent;
   if (o.threads > 1 && methods.size() > 1) concurrent = runConcurrently(o, *model, r, options, methods, cb);
   for (std::size_t i = 0; i < methods.size(); ++i) {
     const Method method = methods[i];
-    r.runs.push_back(concurrent.empty() ? runMethod(o, *model, r, options, method, cb) : std::move(concurrent[i]));
-    r.metrics.push_back(computeMetrics(*model, r.runs.back(), truth));
-    if (r.dataset.constants_reference) compareToReference(*model, r, r.runs.back(), r.metrics.back());
+    MeasuredRun m = concurrent.empty() ? runAndMeasure(o, *model, r, options, method, cb) : std::move(concurrent[i]);
+    r.runs.push_back(std::move(m.run));
+    r.metrics.push_back(std::move(m.metrics));
     r.files.push_back((fs::path(o.out_dir) / RunFiles::estimatesName(method)).string());
     if (cb.finished) cb.finished(r.runs.back(), r.metrics.back());
   }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "gssm/core/error.h"
+#include "gssm/core/parallel.h"
 #include "linear/envelope_cholesky.h"
 #include "linear/normal_equations.h"
 #include "linear/sparse_cholesky.h"
@@ -38,6 +39,7 @@ bool BatchSolverOptions::validate(std::string* why) const {
   if (!(initial_lambda > 0)) return fail("initial_lambda must be > 0");
   if (!(max_lambda > initial_lambda)) return fail("max_lambda must exceed initial_lambda");
   if (newton_polish_steps < 0) return fail("newton_polish_steps must be >= 0");
+  if (threads < 1) return fail("threads must be >= 1, got " + std::to_string(threads));
   if (!relinearize_at_solution && (method != Method::GaussNewton || newton_polish_steps > 0))
     return fail("relinearize_at_solution = false needs Gauss-Newton without a Newton polish");
   return true;
@@ -88,10 +90,42 @@ struct BatchSolver::Impl {
   std::vector<std::uint32_t> factor_begin;
   const int* entry_slot = nullptr;        // H's value index of every JᵀJ entry, factor by factor (chol's)
   const int* diagonal_slot = nullptr;     // H(i, i)'s value index
-  std::vector<std::uint32_t> factor_shape;  // index into jacobians (same keys count and residual size)
-  // Jacobian buffers per factor shape, so alternating process and
-  // measurement factors reuse their storage.
-  std::vector<std::vector<Eigen::MatrixXd>> jacobians;
+  std::vector<std::uint32_t> factor_shape;  // index into a Scratch's jacobians (same keys count and residual size)
+  // One thread's buffers for linearizing a run of factors: Jacobians per
+  // factor shape (alternating process and measurement factors reuse their
+  // storage), a factor's variables' values, first columns and reachable
+  // columns (Factor::columnsOf), its gathered columns and residual.
+  struct Scratch {
+    std::vector<std::vector<Eigen::MatrixXd>> jacobians;
+    std::vector<const Eigen::VectorXd*> x;
+    std::vector<Eigen::Index> offs;
+    std::vector<const std::vector<int>*> used;
+    internal::FactorColumns columns;
+    Eigen::VectorXd r;
+    void size(std::size_t shapes, std::size_t max_keys) {
+      jacobians.clear();
+      jacobians.resize(shapes);
+      x.resize(max_keys);
+      offs.resize(max_keys);
+      used.resize(max_keys);
+    }
+  };
+  Scratch scratch[2];  // [1]: the second part of a split linearization
+  // A long chain (kSplitFactors factors or more, on the envelope) is
+  // linearized in two halves of its factors, on two threads where the
+  // options allow. The halves write disjoint entries of H and g except
+  // those among the columns both reach (a chain's middle state and the
+  // constants): the second half sums these apart, added after both — the
+  // same order, so the same bits, with one thread or two.
+  struct Split {
+    std::size_t at = 0;                 // the second half's first factor; 0: not split
+    std::vector<int> shared;            // by column: its index among the shared columns, or −1
+    std::vector<Eigen::Index> columns;  // the shared columns, ascending
+    Eigen::MatrixXd side_h;             // the second half's JᵀJ among them (upper triangle)
+    Eigen::VectorXd side_g;             // and its gradient there
+  } split;
+  static constexpr std::size_t kSplitFactors = 16384, kMaxSharedColumns = 256;
+  int threads = 1;
   bool has_solution = false;
   Eigen::VectorXd factored_point;  // where H was last factored, flat in the layout
   // H⁻¹ on the factor's pattern, computed on the first covariance query.
@@ -105,6 +139,7 @@ struct BatchSolver::Impl {
     layoutVariables(values);
     indexFactors(graph, values);
     if (!chooseEnvelope(graph)) assembleSparsePattern(graph);
+    chooseSplit(graph);
   }
 
   void layoutVariables(const Values& values) {
@@ -124,7 +159,6 @@ struct BatchSolver::Impl {
     factor_vars.clear();
     factor_begin.assign(1, 0);
     factor_shape.clear();
-    jacobians.clear();
     // Few distinct shapes (process, measurement, prior): a short list, not a map.
     std::vector<std::pair<std::pair<std::size_t, int>, std::uint32_t>> shapes;
     factor_vars.reserve(3 * graph.size());
@@ -149,10 +183,32 @@ struct BatchSolver::Impl {
       if (shape == shapes.end()) shape = shapes.insert(shapes.end(), {key, static_cast<std::uint32_t>(shapes.size())});
       factor_shape.push_back(shape->second);
     }
-    jacobians.resize(shapes.size());
-    factor_offs.resize(max_keys);
-    factor_x.resize(max_keys);
-    factor_used.resize(max_keys);
+    for (Scratch& s : scratch) s.size(shapes.size(), max_keys);
+  }
+
+  // The halves of a long chain and the columns both reach (Split); a graph
+  // whose halves share many columns (no chain) stays whole.
+  void chooseSplit(const FactorGraph& graph) {
+    split.at = 0;
+    split.shared.clear();
+    split.columns.clear();
+    if (!use_envelope || graph.size() < kSplitFactors) return;
+    const std::size_t at = graph.size() / 2;
+    std::vector<std::uint8_t> half(layout.size(), 0);  // bit 1: the first half reaches it, bit 2: the second
+    for (std::size_t fi = 0; fi < graph.size(); ++fi)
+      for (std::size_t k = factor_begin[fi]; k < factor_begin[fi + 1]; ++k) half[factor_vars[k]] |= fi < at ? 1 : 2;
+    std::vector<Eigen::Index> columns;
+    for (std::size_t v = 0; v < layout.size(); ++v)
+      if (half[v] == 3)
+        for (Eigen::Index j = offset[v]; j < offset[v + 1]; ++j) columns.push_back(j);
+    if (columns.size() > kMaxSharedColumns) return;
+    split.shared.assign(static_cast<std::size_t>(n), -1);
+    for (std::size_t a = 0; a < columns.size(); ++a) split.shared[static_cast<std::size_t>(columns[a])] = static_cast<int>(a);
+    split.columns = std::move(columns);
+    const auto k = static_cast<Eigen::Index>(split.columns.size());
+    split.side_h.resize(k, k);
+    split.side_g.resize(k);
+    split.at = at;
   }
 
   // The envelope: each column's first row reached by a factor. Compact (at
@@ -188,7 +244,7 @@ struct BatchSolver::Impl {
         added += static_cast<std::size_t>(m * (m + 1) / 2);
       } else {
         placeColumns(fi);
-        internal::forEachUpperPair(columns, [&](std::size_t, std::size_t) { ++added; });
+        internal::forEachUpperPair(scratch[0].columns, [&](std::size_t, std::size_t) { ++added; });
       }
     }
     std::vector<int> first(static_cast<std::size_t>(n));
@@ -231,6 +287,7 @@ struct BatchSolver::Impl {
   void forEachFactorEntry(std::size_t factors, Emit&& emit) {
     for (std::size_t fi = 0; fi < factors; ++fi) {
       placeColumns(fi);
+      const internal::FactorColumns& columns = scratch[0].columns;
       internal::forEachUpperPair(columns,
                                  [&](std::size_t p, std::size_t q) { emit(columns.global[p], columns.global[q]); });
     }
@@ -249,25 +306,16 @@ struct BatchSolver::Impl {
     return it != layout.end() && *it == k ? static_cast<std::size_t>(it - layout.begin()) : npos;
   }
 
-  // Factor fi's columns of H into `columns` (a pattern: no entries).
+  // Factor fi's columns of H into scratch[0].columns (a pattern: no entries).
   void placeColumns(std::size_t fi) {
-    const std::size_t count = offsetsOf(fi);
-    columns.place(factor_offs.data(), count, [&](std::size_t a) {
-      const std::size_t v = factor_vars[factor_begin[fi] + a];
+    Scratch& s = scratch[0];
+    const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
+    for (std::size_t a = 0; a < count; ++a) s.offs[a] = offset[factor_vars[b + a]];
+    s.columns.place(s.offs.data(), count, [&](std::size_t a) {
+      const std::size_t v = factor_vars[b + a];
       return offset[v + 1] - offset[v];
     });
   }
-
-  // Factor fi's variables' first columns into factor_offs; returns how many.
-  std::size_t offsetsOf(std::size_t fi) {
-    const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
-    for (std::size_t a = 0; a < count; ++a) factor_offs[a] = offset[factor_vars[b + a]];
-    return count;
-  }
-  std::vector<Eigen::Index> factor_offs;
-  std::vector<const Eigen::VectorXd*> factor_x;  // factor fi's variables' values, in its key order
-  std::vector<const std::vector<int>*> factor_used;  // the columns factor fi's blocks can reach (Factor::columnsOf)
-  internal::FactorColumns columns;
 
   // Linearizes every factor at x: writes H = JᵀJ into the factorization's
   // values (undamped; `diag` gets its diagonal), the gradient g = Jᵀr, and
@@ -278,49 +326,99 @@ struct BatchSolver::Impl {
     g.setZero(n);
     double* H = use_envelope ? envelope.values() : chol.values();
     std::fill(H, H + (use_envelope ? envelope.entries() : chol.nonzeros()), 0.0);
+    RangeResult half[2];
+    std::vector<std::exception_ptr> errors(2);
+    if (split.at == 0) {
+      half[0] = linearizeRange<false>(graph, x, 0, graph.size(), scratch[0], H, g.data());
+    } else {
+      split.side_h.setZero();
+      split.side_g.setZero();
+      errors = runJobs(2, static_cast<std::size_t>(threads), [&](std::size_t k) {
+        half[k] = k == 0 ? linearizeRange<false>(graph, x, 0, split.at, scratch[0], H, g.data())
+                         : linearizeRange<true>(graph, x, split.at, graph.size(), scratch[1], H, g.data());
+      });
+    }
+    for (std::size_t k = 0; k < 2; ++k) {  // in factor order: what one pass would have met first
+      if (errors[k]) std::rethrow_exception(errors[k]);
+      if (half[k].bad == npos) continue;
+      if (trial) return std::numeric_limits<double>::infinity();
+      throw NumericalError("BatchSolver: factor '" + graph[half[k].bad]->describe() +
+                           "' has a non-finite residual at the current estimate");
+    }
+    if (split.at != 0) addSharedEntries(H, g.data());
+    diag.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) diag[i] = H[diagonalOf(i)];
+    return half[0].cost + half[1].cost;
+  }
+
+  struct RangeResult {
     double cost = 0;
-    const int* slot = entry_slot;
-    Eigen::VectorXd r;
-    std::size_t fi = 0;
+    std::size_t bad = npos;  // the first factor with a non-finite residual (it stopped there)
+  };
+  // Factors [begin, end) into H and g (kSecond: the second half of a split,
+  // its entries among the shared columns into split.side_h/side_g).
+  template <bool kSecond>
+  RangeResult linearizeRange(const FactorGraph& graph, const Values& x, std::size_t begin, std::size_t end,
+                             Scratch& s, double* H, double* g) {
+    RangeResult out;
+    const int* slot = entry_slot;  // CHOLMOD's order: the whole graph, one part
     const auto first = x.begin();  // positions are the layout's (x has values' keys)
-    for (const auto& f : graph) {
-      std::vector<Eigen::MatrixXd>& J = jacobians[factor_shape[fi]];
+    for (std::size_t fi = begin; fi < end; ++fi) {
+      const Factor& f = *graph[fi];
+      std::vector<Eigen::MatrixXd>& J = s.jacobians[factor_shape[fi]];
       const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
       for (std::size_t a = 0; a < count; ++a) {  // its variables' values and first columns
         const std::uint32_t v = factor_vars[b + a];
-        factor_x[a] = &(first + v)->second;
-        factor_offs[a] = offset[v];
+        s.x[a] = &(first + v)->second;
+        s.offs[a] = offset[v];
       }
-      const double c = f->linearizeRobustAt(factor_x.data(), r, &J);  // reweighted at every linearization
-      if (!r.allFinite()) {
-        if (trial) return std::numeric_limits<double>::infinity();
-        throw NumericalError("BatchSolver: factor '" + f->describe() +
-                             "' has a non-finite residual at the current estimate");
+      const double c = f.linearizeRobustAt(s.x.data(), s.r, &J);  // reweighted at every linearization
+      if (!s.r.allFinite()) {
+        out.bad = fi;
+        return out;
       }
-      cost += c;
+      out.cost += c;
       // The envelope places entries by position, so a block's columns the
       // factor rules out need not be read; CHOLMOD's slots follow every
       // column in order.
       if (use_envelope) {
-        for (std::size_t a = 0; a < count; ++a) factor_used[a] = f->columnsOf(a);
-        columns.gather(factor_offs.data(), J, factor_used.data());
-      } else {
-        columns.gather(factor_offs.data(), J);
-      }
-      double* gd = g.data();
-      if (use_envelope) {
+        for (std::size_t a = 0; a < count; ++a) s.used[a] = f.columnsOf(a);
+        s.columns.gather(s.offs.data(), J, s.used.data());
         internal::forEachNonzeroGradientAndUpperJtJ(
-            columns, r.data(), [gd](Eigen::Index i, double v) { gd[i] += v; },
-            [&](Eigen::Index i, Eigen::Index j, double v, auto...) { H[envelope.position(i, j)] += v; });
+            s.columns, s.r.data(),
+            [&](Eigen::Index i, double v) {
+              if (kSecond && split.shared[static_cast<std::size_t>(i)] >= 0) split.side_g[split.shared[static_cast<std::size_t>(i)]] += v;
+              else g[i] += v;
+            },
+            [&](Eigen::Index i, Eigen::Index j, double v, auto...) {
+              if (kSecond) {
+                const int p = split.shared[static_cast<std::size_t>(i)], q = split.shared[static_cast<std::size_t>(j)];
+                if (p >= 0 && q >= 0) {
+                  split.side_h(p, q) += v;
+                  return;
+                }
+              }
+              H[envelope.position(i, j)] += v;
+            });
       } else {
-        for (std::size_t p : columns.nonzero) gd[columns.global[p]] += columns.dot(p, r.data());  // zero columns add 0
-        internal::forEachUpperJtJ(columns, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
+        s.columns.gather(s.offs.data(), J);
+        for (std::size_t p : s.columns.nonzero) g[s.columns.global[p]] += s.columns.dot(p, s.r.data());  // zero columns add 0
+        internal::forEachUpperJtJ(s.columns, [&](Eigen::Index, Eigen::Index, double v, auto...) { H[*slot++] += v; });
       }
-      ++fi;
     }
-    diag.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) diag[i] = H[diagonalOf(i)];
-    return cost;
+    return out;
+  }
+  // The second half's sums among the shared columns, added after the first
+  // half's (an entry it summed is inside the envelope: a factor reached it).
+  void addSharedEntries(double* H, double* g) const {
+    const auto k = static_cast<Eigen::Index>(split.columns.size());
+    for (Eigen::Index q = 0; q < k; ++q) {
+      g[split.columns[static_cast<std::size_t>(q)]] += split.side_g[q];
+      for (Eigen::Index p = 0; p <= q; ++p)
+        if (split.side_h(p, q) != 0.0)
+          H[envelope.position(split.columns[static_cast<std::size_t>(p)], split.columns[static_cast<std::size_t>(q)])] +=
+              split.side_h(p, q);
+    }
   }
   const char* linearSolver() const {
     return use_envelope ? "envelope" : n <= internal::SparseCholesky::kDenseMax ? "dense" : "sparse";
@@ -552,6 +650,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   Impl& s = *impl_;
   s.has_solution = false;
   s.selected.reset();
+  s.threads = options_.threads;
   s.setup(graph, values);
 
   BatchSolverSummary sum;
@@ -595,6 +694,7 @@ void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
   Impl& s = *impl_;
   s.has_solution = false;
   s.selected.reset();
+  s.threads = options_.threads;
   s.setup(graph, values);
   Eigen::VectorXd g, diag;
   s.linearize(graph, values, g, diag);

@@ -54,6 +54,10 @@ struct BatchSolverOptions {
   /// linearization's. A converged solve costs one linearization and one
   /// factorization fewer (the paper window: 4 → 3 of each per solve).
   bool relinearize_at_solution = true;
+  /// Threads that may linearize a long chain (16384 factors or more, on the
+  /// envelope): its two halves side by side. The same bits with any count
+  /// (the halves' sums are combined in one fixed order).
+  int threads = 1;
   /// Empty when valid; otherwise says which field is wrong and why.
   bool validate(std::string* why = nullptr) const;
 };
