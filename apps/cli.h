@@ -9,9 +9,8 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
+
+#include <malloc.h>  // mallopt: glibc (Debian, the platform the project targets)
 
 namespace gssm::apps {
 
@@ -117,11 +116,9 @@ class CommandLine {
 // UWB log). Keep up to 1 GiB of it for reuse, and take blocks up to 32 MiB
 // (glibc's largest mapping threshold) from the heap, where they are reused.
 inline void keepFreedMemory() {
-#ifdef __GLIBC__
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TOP_PAD, 64 << 20);
-#endif
 }
 
 template <class Fn>
