@@ -577,7 +577,7 @@ class SmootherEstimator final : public Estimator {
 // by independent 1-D priors (mean = current estimate, variance = marginal
 // variance from the window last solved) on the oldest remaining x_c, which
 // then stands for that state's measurements too, and on each constant: one
-// solve of w states a step. This counts the window's
+// solve of w states a step (docs/DESIGN.md §4). This counts the window's
 // measurements again at every step, so it is over-confident; it exists to
 // reproduce the paper's figures, not as an estimator to deploy.
 class PaperWindowEstimator final : public Estimator {
