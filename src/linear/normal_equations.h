@@ -85,12 +85,12 @@ struct FactorColumns {
   }
   /// Column p's entries.
   const double* column(std::size_t p) const { return entries.data() + static_cast<Eigen::Index>(p) * rows; }
-  /// Column p dotted with a `rows`-vector.
-  double dot(std::size_t p, const double* other) const {
+  /// Column p dotted with a `rows`-vector, over rows [lo, hi) (all by default).
+  double dot(std::size_t p, const double* other, Eigen::Index lo = 0, Eigen::Index hi = -1) const {
     const double* a = column(p);
     if (rows == 1) return a[0] * other[0];  // a scalar residual: most factors of a 1-D sensor
     double v = 0;
-    for (Eigen::Index r = 0; r < rows; ++r) v += a[r] * other[r];
+    for (Eigen::Index r = lo, end = hi < 0 ? rows : hi; r < end; ++r) v += a[r] * other[r];
     return v;
   }
 
@@ -174,9 +174,7 @@ void forEachNonzeroGradientAndUpperJtJ(const FactorColumns& c, const double* r, 
       }
       const Eigen::Index lo = std::max(c.span[p].first, c.span[q].first), hi = std::min(c.span[p].second, c.span[q].second);
       if (lo >= hi) continue;  // no row holds both
-      double v = 0;
-      for (Eigen::Index r = lo; r < hi; ++r) v += c.column(p)[r] * c.column(q)[r];
-      emit(c.global[p], c.global[q], v, p, q);
+      emit(c.global[p], c.global[q], c.dot(p, c.column(q), lo, hi), p, q);
     }
 }
 

@@ -106,7 +106,6 @@ PlanarRigidBody::PlanarRigidBody(const Params& p)
       if (i_bias_ >= 0) ch.constants.push_back(i_bias_ + static_cast<int>(t * p.anchors.size() + a));
       if (i_scale_ >= 0) ch.constants.push_back(i_scale_);
       channels.push_back(std::move(ch));
-      links_.push_back({static_cast<int>(t), static_cast<int>(a)});
     }
   setChannels(std::move(channels));
   setAngleStates({2});
@@ -210,8 +209,8 @@ Eigen::VectorXd PlanarRigidBody::h(int channel, const Eigen::VectorXd& xc, const
 void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
                             Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
   if (channel < 0 || channel >= numChannels()) this->channel(channel);  // throws, naming the channels
-  const Link& link = links_[static_cast<std::size_t>(channel)];  // a table: no division per range
-  const auto t = static_cast<std::size_t>(link.tag), a = static_cast<std::size_t>(link.anchor);
+  const std::size_t t = static_cast<std::size_t>(channel) / p_.anchors.size();
+  const std::size_t a = static_cast<std::size_t>(channel) % p_.anchors.size();
   const Eigen::Vector3d& l = p_.tags[t];
   const double c = std::cos(xc[2]), s = std::sin(xc[2]);
   const Eigen::Vector2d rl(c * l.x() - s * l.y(), s * l.x() + c * l.y());

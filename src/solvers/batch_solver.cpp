@@ -327,7 +327,7 @@ struct BatchSolver::Impl {
     double* H = use_envelope ? envelope.values() : chol.values();
     std::fill(H, H + (use_envelope ? envelope.entries() : chol.nonzeros()), 0.0);
     RangeResult half[2];
-    std::vector<std::exception_ptr> errors(2);
+    std::vector<std::exception_ptr> errors;  // a split's, by half (none allocated for one part: a window's solves)
     if (split.at == 0) {
       half[0] = linearizeRange<false>(graph, x, 0, graph.size(), scratch[0], H, g.data());
     } else {
@@ -339,7 +339,7 @@ struct BatchSolver::Impl {
       });
     }
     for (std::size_t k = 0; k < 2; ++k) {  // in factor order: what one pass would have met first
-      if (errors[k]) std::rethrow_exception(errors[k]);
+      if (k < errors.size() && errors[k]) std::rethrow_exception(errors[k]);
       if (half[k].bad == npos) continue;
       if (trial) return std::numeric_limits<double>::infinity();
       throw NumericalError("BatchSolver: factor '" + graph[half[k].bad]->describe() +
@@ -384,21 +384,18 @@ struct BatchSolver::Impl {
       if (use_envelope) {
         for (std::size_t a = 0; a < count; ++a) s.used[a] = f.columnsOf(a);
         s.columns.gather(s.offs.data(), J, s.used.data());
+        const auto shared = [&](Eigen::Index i) { return kSecond ? split.shared[static_cast<std::size_t>(i)] : -1; };
         internal::forEachNonzeroGradientAndUpperJtJ(
             s.columns, s.r.data(),
             [&](Eigen::Index i, double v) {
-              if (kSecond && split.shared[static_cast<std::size_t>(i)] >= 0) split.side_g[split.shared[static_cast<std::size_t>(i)]] += v;
+              const int p = shared(i);
+              if (p >= 0) split.side_g[p] += v;
               else g[i] += v;
             },
             [&](Eigen::Index i, Eigen::Index j, double v, auto...) {
-              if (kSecond) {
-                const int p = split.shared[static_cast<std::size_t>(i)], q = split.shared[static_cast<std::size_t>(j)];
-                if (p >= 0 && q >= 0) {
-                  split.side_h(p, q) += v;
-                  return;
-                }
-              }
-              H[envelope.position(i, j)] += v;
+              const int p = shared(i), q = shared(j);
+              if (p >= 0 && q >= 0) split.side_h(p, q) += v;
+              else H[envelope.position(i, j)] += v;
             });
       } else {
         s.columns.gather(s.offs.data(), J);

@@ -89,10 +89,6 @@ class PlanarRigidBody final : public Model {
   Eigen::VectorXd meanTrueDistances(const Truth& truth) const;
   Params p_;
   int i_bias_ = -1, i_scale_ = -1;
-  struct Link {
-    int tag, anchor;  // indices into p_.tags, p_.anchors
-  };
-  std::vector<Link> links_;  // by channel
 };
 
 }  // namespace gssm::models
