@@ -108,21 +108,21 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   b.xc = z_.head(d.nc);
   b.xb = z_.tail(d.nb);
   model_->hInto(m.channel, b.xc, b.xb, b.yhat, &b.J_h_xc, &b.J_h_xb);
-  const int n = d.nc + d.nb;
-  b.H.resize(ch.dim(), n);
+  b.H.resize(ch.dim(), d.nc + d.nb);
   b.H << b.J_h_xc, b.J_h_xb;
-  const Eigen::MatrixXd& R = m.R.size() ? m.R : ch.R;
-  b.HP.noalias() = b.H * P_;  // m × n, shared by S, the gain and the covariance update
-  b.S = b.HP * b.H.transpose() + R;
+  innovationCovariance(m.R.size() ? m.R : ch.R);
   b.llt.compute(b.S);
   if (b.llt.info() != Eigen::Success || !b.S.allFinite())
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
                          ": innovation covariance S = HPHᵀ + R is not positive definite; "
                          "check R and the covariance P (filter unchanged)");
+  // S⁻¹ once: the gain, the NIS and the Joseph form all use it (a range's
+  // S is 1 × 1: a division, not two triangular solves of 31 columns)
+  if (b.S.size() == 1) b.S_inv.setConstant(1, 1, 1.0 / b.S(0, 0));
+  else b.S_inv = b.llt.solve(Eigen::MatrixXd::Identity(b.S.rows(), b.S.cols()));
   b.innov = y - b.yhat;
   wrapAngles(b.innov, ch.angles);
-  b.whitened = b.llt.solve(b.innov);
-  const double nis = b.innov.dot(b.whitened);
+  const double nis = b.innov.dot(b.S_inv.lazyProduct(b.innov));
   if (options_.use_gates && ch.ekf_gate > 0 && nis > ch.ekf_gate) {  // an outlier: leave the estimate as it is
     nis_ = nis;
     ++rejected_;
@@ -146,33 +146,32 @@ double ExtendedKalmanFilter::outlierLogDensity(int channel) const {
   return options_.outlier_log_density[static_cast<std::size_t>(channel)];
 }
 
+// S = H P Hᵀ + R from P's columns at H's nonzero columns (P is
+// symmetric): a range reaches 5 of a 31-state filter's columns, so P Hᵀ
+// reads 5 columns of P, not 31.
+void ExtendedKalmanFilter::innovationCovariance(const Eigen::MatrixXd& R) {
+  UpdateBuffers& b = u_;
+  const Eigen::Index m = b.H.rows();
+  b.nonzero.clear();
+  for (Eigen::Index c = 0; c < b.H.cols(); ++c)
+    if ((b.H.col(c).array() != 0.0).any()) b.nonzero.push_back(c);
+  b.PHt.setZero(P_.rows(), m);
+  b.S = R;
+  for (const Eigen::Index c : b.nonzero)
+    for (Eigen::Index r = 0; r < m; ++r) b.PHt.col(r) += b.H(r, c) * P_.col(c);
+  for (const Eigen::Index c : b.nonzero) b.S.noalias() += b.H.col(c) * b.PHt.row(c);
+}
+
 // The update with inlier weight w (1: the Kalman update): the moments of the
 // mixture w·N(inlier update) + (1 − w)·N(no update).
 void ExtendedKalmanFilter::commitUpdate(double w) {
   UpdateBuffers& b = u_;
-  b.KT = b.llt.solve(b.HP);  // Kᵀ = S⁻¹ H P (P, S symmetric)
-  b.K = b.KT.transpose();      // contiguous columns: the loops below vectorize
-  const Eigen::MatrixXd& K = b.K;
-  // Joseph form (I − KH) P (I − KH)ᵀ + K R Kᵀ, expanded as
-  // P − K(HP) − (K(HP))ᵀ + K S Kᵀ = P + M + Mᵀ with M = K (½ S Kᵀ − HP):
-  // one n × m × n product for an m-row update (a scalar range: one outer
-  // product) instead of two n×n×n products.
+  b.K.noalias() = b.PHt.lazyProduct(b.S_inv);  // K = P Hᵀ S⁻¹
   Eigen::MatrixXd& P = b.P;
-  if (options_.joseph_form) {
-    b.A.noalias() = 0.5 * b.S * K.transpose();  // m × n
-    b.A -= b.HP;
-    P = P_;
-    for (Eigen::Index j = 0; j < P.cols(); ++j) {  // the upper triangle by columns, then mirrored: exactly symmetric
-      auto upper = P.col(j).head(j + 1);
-      for (Eigen::Index c = 0; c < K.cols(); ++c)
-        upper += K.col(c).head(j + 1) * b.A(c, j) + b.A.row(c).head(j + 1).transpose() * K(j, c);
-    }
-    for (Eigen::Index j = 0; j < P.cols(); ++j)
-      for (Eigen::Index i = j + 1; i < P.rows(); ++i) P(i, j) = P(j, i);
-  } else {
-    P = P_ - K * b.HP;
-  }
-  b.dz.noalias() = K * b.innov;
+  bool finite = true;
+  if (options_.joseph_form) finite = josephUpdate();
+  else P = P_ - b.K * b.PHt.transpose();
+  b.dz.noalias() = b.K * b.innov;
   const Eigen::VectorXd& dz = b.dz;
   if (w < 1.0) P = w * P + (1.0 - w) * P_ + (w * (1.0 - w)) * dz * dz.transpose();
   if (!options_.joseph_form || w < 1.0) P = 0.5 * (P + P.transpose());
@@ -182,13 +181,40 @@ void ExtendedKalmanFilter::commitUpdate(double w) {
   // diagonal and only the non-Joseph form, which can lose definiteness to
   // cancellation, pays a Cholesky of P (it was 40% of a 31-state filter's
   // time).
-  if (!allFinite(P) || !(P.diagonal().array() > 0).all() ||
+  if (!options_.joseph_form || w < 1.0) finite = allFinite(P);
+  if (!finite || !(P.diagonal().array() > 0).all() ||
       (!options_.joseph_form && Eigen::LLT<Eigen::MatrixXd>(P).info() != Eigen::Success))
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
                          ": the updated covariance is not positive definite (filter unchanged)");
   z_ += w * dz;
   wrapAngles(z_, model_->angleStates());
   P_.swap(P);  // the old covariance's storage is the next candidate's
+}
+
+// Joseph form (I − KH) P (I − KH)ᵀ + K R Kᵀ into b.P, expanded as
+// P − K(HP) − (K(HP))ᵀ + K S Kᵀ = P + K Atᵀ + At Kᵀ with At = ½ K S − P Hᵀ:
+// one n × m × n product for an m-row update (a scalar range: one rank-2
+// update) instead of two n×n×n products. The upper triangle by columns, read
+// from P_ as it is written, then mirrored: exactly symmetric. Returns whether
+// every entry is finite (summed as written: a NaN or an infinity makes the
+// sum non-finite).
+bool ExtendedKalmanFilter::josephUpdate() {
+  UpdateBuffers& b = u_;
+  b.At.noalias() = b.K.lazyProduct(0.5 * b.S);
+  b.At -= b.PHt;
+  Eigen::MatrixXd& P = b.P;
+  P.resize(P_.rows(), P_.cols());
+  double sum = 0;
+  for (Eigen::Index j = 0; j < P.cols(); ++j) {
+    auto upper = P.col(j).head(j + 1);
+    upper = P_.col(j).head(j + 1) + (b.K.col(0).head(j + 1) * b.At(j, 0) + b.At.col(0).head(j + 1) * b.K(j, 0));
+    for (Eigen::Index c = 1; c < b.K.cols(); ++c)
+      upper += b.K.col(c).head(j + 1) * b.At(j, c) + b.At.col(c).head(j + 1) * b.K(j, c);
+    sum += upper.sum();
+  }
+  for (Eigen::Index j = 0; j < P.cols(); ++j)
+    for (Eigen::Index i = j + 1; i < P.rows(); ++i) P(i, j) = P(j, i);
+  return std::isfinite(sum);
 }
 
 void filterAlong(ExtendedKalmanFilter& filter, const std::vector<ScheduledStep>& schedule,
