@@ -237,9 +237,24 @@ struct ChannelColumn {
   static std::string text(double v) {
     return v == std::floor(v) ? std::to_string(static_cast<long long>(v)) : formatDouble(v);
   }
-  // The row's channel, or −1 with `problem` set.
-  int of(const CsvTable& m, const CsvRows::Row& row, const Model& model, std::string& problem) const {
+  // The row's channel, or −1 with `problem` set. A log names its few
+  // channels again on every row (UWB: 24 links over 323,514 rows): each one
+  // is matched by name once, then found by its column values.
+  int of(const CsvTable& m, const CsvRows::Row& row, const Model& model, std::string& problem) {
     if (columns.empty()) return 0;
+    key.resize(columns.size());
+    for (std::size_t i = 0; i < columns.size(); ++i) key[i] = row[static_cast<std::size_t>(columns[i])];
+    for (const auto& [values, c] : seen)
+      if (values == key) return c;
+    const int channel = byName(m, row, model, problem);
+    if (channel >= 0) seen.emplace_back(key, channel);
+    return channel;
+  }
+
+ private:
+  std::vector<double> key;                             // this row's channel columns
+  std::vector<std::pair<std::vector<double>, int>> seen;  // the column values of each channel found so far
+  int byName(const CsvTable& m, const CsvRows::Row& row, const Model& model, std::string& problem) const {
     const double v = row[static_cast<std::size_t>(columns[0])];
     std::string name = by == "index" ? "number " + formatDouble(v) : prefix + text(v);
     for (std::size_t i = 1; i < columns.size(); ++i) name += "_" + text(row[static_cast<std::size_t>(columns[i])]);
@@ -291,7 +306,7 @@ void readMeasurements(const std::string& path, const IniDocument& ini, const Mod
   std::vector<int> cols;
   for (const auto& n : words(ini.getString("dataset", "measurement_columns")))
     cols.push_back(requireColumn(m, n, "[dataset] measurement_columns"));
-  const ChannelColumn channels = channelColumn(ini, m);
+  ChannelColumn channels = channelColumn(ini, m);
   const double drop_at_or_below = ini.getDouble("dataset", "drop_at_or_below", -std::numeric_limits<double>::infinity());
   const bool strict = strictTimeOrder(ini);
   double latest = -std::numeric_limits<double>::infinity();
