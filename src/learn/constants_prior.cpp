@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "gssm/core/error.h"
+#include "gssm/core/parallel.h"
 #include "gssm/factors/problem.h"
 #include "learn/nelder_mead.h"
 
@@ -36,10 +37,9 @@ struct ExpectedLogPrior {
   }
 };
 
-// E-step: the batch posterior of x_b under `model`, from x (kept as the next start).
-void posteriorOfConstants(const Model& model, const std::vector<Measurement>& ms, const std::vector<Input>& inputs,
-                          double t0, const BatchSolverOptions& batch, Values& x, ExpectedLogPrior& q) {
-  const Problem p = buildProblem(model, ms, inputs, t0);
+// E-step: the batch posterior of x_b on p's graph (its model's), from x
+// (kept as the next start).
+void posteriorOfConstants(const Problem& p, const BatchSolverOptions& batch, Values& x, ExpectedLogPrior& q) {
   // The M-step needs the posterior far less exactly than a batch run: a
   // last step lowering the cost by < 1e-8 of it leaves σ unchanged to 9
   // digits on the UWB log, and saves two of ~11 linearizations of the log.
@@ -96,11 +96,22 @@ void learnConstantsPrior(const std::string& type_name, std::vector<LearntParamet
   ExpectedLogPrior q{base, params, type_name, {}, {}};
   ParamValues values = withSigmas(base, params, theta.array().exp().matrix());
   std::shared_ptr<const Model> model = values.build(type_name);
-  Values x = ekfInitialGuess(*model, o.ekf, measurements, inputs, t0);
+  // The EKF's pass (the first E-step's start) and the first E-step's graph
+  // are independent: on two threads when the batch may use two.
+  Values x;
+  Problem p;
+  const auto failed = runJobs(2, static_cast<std::size_t>(o.batch.threads), [&](std::size_t k) {
+    if (k == 0) x = ekfInitialGuess(*model, o.ekf, measurements, inputs, t0);
+    else p = buildProblem(*model, measurements, inputs, t0);
+  });
+  for (const auto& e : failed)
+    if (e) std::rethrow_exception(e);
   r.prior_converged = false;
   for (int it = 1; it <= o.prior_iterations && !r.prior_converged; ++it) {
     r.prior_iterations = it;
-    posteriorOfConstants(*model, measurements, inputs, t0, o.batch, x, q);
+    if (it > 1) p = buildProblem(*model, measurements, inputs, t0);
+    posteriorOfConstants(p, o.batch, x, q);
+    p = Problem();  // its factors refer to this model, which the M-step replaces
     if (it == 1) r.prior_start_expected_log_prior = -q.negative(theta);
     const NelderMeadResult m = nelderMead([&q](const Eigen::VectorXd& t) { return q.negative(t); }, theta, 0.5,
                                           200 * static_cast<int>(n + 1), 1e-12, 1e-9);
