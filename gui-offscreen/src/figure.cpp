@@ -351,14 +351,20 @@ void savePng(const Figure& fig, const std::string& path, int width, int height) 
   if (!img.saveToFile(path)) throw std::runtime_error(path + ": cannot write the PNG");
 }
 
-void savePngs(const std::vector<std::pair<Figure, std::string>>& figures, int threads) {
+void drawPngs(const std::vector<FigureJob>& jobs, int threads) {
   // MRPT unpacks its bitmap fonts into a global table on the first font
   // selection, unguarded: done here, before any worker draws.
   mrpt::img::CImage fonts(1, 1, mrpt::img::CH_RGB);
   fonts.selectTextFont("6x13");
-  for (const auto& e : runJobs(figures.size(), static_cast<std::size_t>(std::max(1, threads)),
-                               [&](std::size_t k) { savePng(figures[k].first, figures[k].second); }))
+  for (const auto& e : runJobs(jobs.size(), static_cast<std::size_t>(std::max(1, threads)),
+                               [&](std::size_t k) { savePng(jobs[k].make(), jobs[k].path); }))
     if (e) std::rethrow_exception(e);
+}
+
+void savePngs(const std::vector<std::pair<Figure, std::string>>& figures, int threads) {
+  std::vector<FigureJob> jobs;
+  for (const auto& f : figures) jobs.push_back({[&f] { return f.first; }, f.second});
+  drawPngs(jobs, threads);
 }
 
 Figure histogram(const std::vector<std::pair<std::string, std::vector<double>>>& groups, int bins,

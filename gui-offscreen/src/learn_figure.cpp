@@ -23,19 +23,27 @@ Figure traceFigure(const std::string& title, const std::string& xlabel, const st
 }
 }  // namespace
 
-std::string writeLearningFigure(const NoiseLearningReport& r, const std::string& dir, const std::string& label) {
-  const std::string path = (std::filesystem::path(dir) / "fig-learn-loglik.png").string();
+namespace {
+Figure learningFigure(const NoiseLearningReport& r, const std::string& label) {
   if (r.log_likelihood.empty() && !r.prior_expected_log_prior.empty())  // only the constants' prior, by EM
-    savePng(traceFigure(label + ": the constants' prior learnt by EM, expected log prior per E-step",
-                        "E-step (batch solve)", "E[log p(x_b | sigma)] after the M-step", r.prior_expected_log_prior,
-                        "learnt", "at the start sigma", r.prior_start_expected_log_prior),
-            path);
-  else
-    savePng(traceFigure(label + ": noise learnt from the log, log-likelihood per iteration", "Nelder-Mead iteration",
-                        "log-likelihood (EKF prediction errors)", r.log_likelihood, "learnt (best so far)",
-                        "at the INI's given values", r.given_log_likelihood),
-            path);
-  return path;
+    return traceFigure(label + ": the constants' prior learnt by EM, expected log prior per E-step",
+                       "E-step (batch solve)", "E[log p(x_b | sigma)] after the M-step", r.prior_expected_log_prior,
+                       "learnt", "at the start sigma", r.prior_start_expected_log_prior);
+  return traceFigure(label + ": noise learnt from the log, log-likelihood per iteration", "Nelder-Mead iteration",
+                     "log-likelihood (EKF prediction errors)", r.log_likelihood, "learnt (best so far)",
+                     "at the INI's given values", r.given_log_likelihood);
+}
+}  // namespace
+
+FigureJob learningFigureJob(const NoiseLearningReport& r, const std::string& dir, const std::string& label) {
+  return {[&r, label] { return learningFigure(r, label); },
+          (std::filesystem::path(dir) / "fig-learn-loglik.png").string()};
+}
+
+std::string writeLearningFigure(const NoiseLearningReport& r, const std::string& dir, const std::string& label) {
+  const FigureJob job = learningFigureJob(r, dir, label);
+  drawPngs({job}, 1);
+  return job.path;
 }
 
 }  // namespace gssm::plot

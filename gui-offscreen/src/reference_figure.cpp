@@ -6,8 +6,9 @@
 
 namespace gssm::plot {
 
-std::string writeConstantsReferenceFigure(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
-                                          const Truth* truth, const std::string& dir, const std::string& label) {
+namespace {
+Figure constantsReferenceFigure(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
+                                const Truth* truth, const std::string& label) {
   const int nb = model.dims().nb;
   const Gaussian xb{run.rows.back().mean.tail(nb), run.rows.back().covariance.bottomRightCorner(nb, nb)};
   const Gaussian compared = truth ? model.comparableConstants(xb, *truth) : xb;  // in the reference's terms
@@ -31,9 +32,14 @@ std::string writeConstantsReferenceFigure(const Model& model, const OfflineRun& 
   }
   fig.bands.push_back(std::move(band));
   fig.series = {std::move(est), std::move(ref)};
-  const std::string path = (std::filesystem::path(dir) / "fig-constants-vs-reference.png").string();
-  savePng(fig, path);
-  return path;
+  return fig;
+}
+}  // namespace
+
+FigureJob constantsReferenceFigureJob(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
+                                      const Truth* truth, const std::string& dir, const std::string& label) {
+  return {[&model, &run, &reference, truth, label] { return constantsReferenceFigure(model, run, reference, truth, label); },
+          (std::filesystem::path(dir) / "fig-constants-vs-reference.png").string()};
 }
 
 }  // namespace gssm::plot

@@ -173,29 +173,43 @@ std::optional<Figure> latencyFigure(const std::vector<OfflineRun>& runs, const s
 }
 }  // namespace
 
-std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
-                                         const Truth* truth, const std::string& dir,
-                                         const std::string& scenario_label, const std::optional<PlanView>& plan,
-                                         int threads) {
+std::vector<FigureJob> runFigureJobs(const Model& model, const std::vector<OfflineRun>& runs, const Truth* truth,
+                                     const std::string& dir, const std::string& scenario_label,
+                                     const std::optional<PlanView>& plan) {
   namespace fs = std::filesystem;
-  std::vector<std::pair<Figure, std::string>> figures;  // built first, then drawn `threads` at a time
-  const auto save = [&](Figure f, const std::string& name) { figures.emplace_back(std::move(f), (fs::path(dir) / name).string()); };
+  std::vector<FigureJob> jobs;
+  const auto add = [&](std::function<Figure()> make, const std::string& name) {
+    jobs.push_back({std::move(make), (fs::path(dir) / name).string()});
+  };
   const auto names = model.stackedStateNames();
   for (std::size_t i = 0; i < names.size(); ++i) {
     const bool constant = static_cast<int>(i) >= model.dims().nc;
     if (!constant && truthColumn(truth, static_cast<Eigen::Index>(i)) < 0) continue;  // an error needs the truth
-    save(stateFigure(model, runs, truth, i, scenario_label), "fig-" + names[i] + (constant ? "" : "-error") + ".png");
+    add([&model, &runs, truth, i, scenario_label] { return stateFigure(model, runs, truth, i, scenario_label); },
+        "fig-" + names[i] + (constant ? "" : "-error") + ".png");
   }
   if (plan) {
-    save(planFigure(names, runs, truth, *plan, scenario_label), "fig-trajectory.png");
+    add([names, &runs, truth, &plan, scenario_label] { return planFigure(names, runs, truth, *plan, scenario_label); },
+        "fig-trajectory.png");
     const Eigen::Index tx = truthColumn(truth, plan->x), ty = truthColumn(truth, plan->y);
     if (tx >= 0 && ty >= 0)
-      save(positionErrorFigure(runs, *truth, plan->x, plan->y, tx, ty, scenario_label), "fig-position-error.png");
+      add([&runs, truth, &plan, tx, ty, scenario_label] {
+        return positionErrorFigure(runs, *truth, plan->x, plan->y, tx, ty, scenario_label);
+      }, "fig-position-error.png");
   }
-  if (const auto latency = latencyFigure(runs, scenario_label)) save(*latency, "fig-latency.png");
-  savePngs(figures, threads);
+  if (auto latency = latencyFigure(runs, scenario_label))
+    add([figure = std::move(*latency)] { return figure; }, "fig-latency.png");
+  return jobs;
+}
+
+std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
+                                         const Truth* truth, const std::string& dir,
+                                         const std::string& scenario_label, const std::optional<PlanView>& plan,
+                                         int threads) {
+  const std::vector<FigureJob> jobs = runFigureJobs(model, runs, truth, dir, scenario_label, plan);
+  drawPngs(jobs, threads);
   std::vector<std::string> written;
-  for (const auto& f : figures) written.push_back(f.second);
+  for (const auto& j : jobs) written.push_back(j.path);
   return written;
 }
 
@@ -230,15 +244,21 @@ std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const s
     }
     addBodyPointTracks(model, r, *plan);
   }
-  std::vector<std::string> files =
-      writeRunFigures(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan, threads);
-  if (r.learnt) files.push_back(writeLearningFigure(*r.learnt, dir, r.label));
+  // One list, drawn `threads` at a time: the run figures, the learning's,
+  // the constants against their reference.
+  std::vector<FigureJob> jobs =
+      runFigureJobs(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan);
+  if (r.learnt) jobs.push_back(learningFigureJob(*r.learnt, dir, r.label));
   if (r.dataset.constants_reference && !r.runs.empty() && model.dims().nb > 0) {
     const auto batch = std::find_if(r.runs.begin(), r.runs.end(), [](const OfflineRun& x) { return x.method == Method::Batch; });
     const OfflineRun& run = batch != r.runs.end() ? *batch : r.runs.back();
-    if (!run.rows.empty()) files.push_back(writeConstantsReferenceFigure(model, run, *r.dataset.constants_reference,
-                                                                     r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label));
+    if (!run.rows.empty())
+      jobs.push_back(constantsReferenceFigureJob(model, run, *r.dataset.constants_reference,
+                                                 r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label));
   }
+  drawPngs(jobs, threads);
+  std::vector<std::string> files;
+  for (const auto& j : jobs) files.push_back(j.path);
   return files;
 }
 

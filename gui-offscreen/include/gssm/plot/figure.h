@@ -3,6 +3,7 @@
 // system): title, axis labels, round-number ticks, grid, legend, line series,
 // shaded ±kσ bands, truth as a reference line, and an automatic y range that a
 // first-step outlier cannot squash.
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -55,9 +56,19 @@ struct Figure {
 /// Draws the figure into a PNG of the given size; throws std::runtime_error
 /// if the file cannot be written.
 void savePng(const Figure& fig, const std::string& path, int width = 960, int height = 600);
-/// savePng of each (figure, path), up to `threads` at a time (drawing and
-/// PNG encoding are most of a figure's cost): the same files as one after
-/// another. An error is rethrown once every figure was tried.
+/// A figure to draw into `path`, built by `make` on the thread that draws
+/// it: building one reads a column of every row of every run (a UWB run's
+/// 13,500 rows × 5 methods, each row's covariance a heap block of its own),
+/// as much work as drawing it.
+struct FigureJob {
+  std::function<Figure()> make;
+  std::string path;
+};
+/// Builds and draws each job's figure (savePng), up to `threads` at a time
+/// in the jobs' order: the same files as one after another. An error is
+/// rethrown once every figure was tried.
+void drawPngs(const std::vector<FigureJob>& jobs, int threads);
+/// drawPngs of figures already built.
 void savePngs(const std::vector<std::pair<Figure, std::string>>& figures, int threads);
 
 /// A histogram figure of `values` (e.g. latencies) with `bins` bins per group;

@@ -5,9 +5,12 @@
 #include <string>
 
 #include "gssm/learn/noise_learning.h"
+#include "gssm/plot/figure.h"
 
 namespace gssm::plot {
 
+/// dir/fig-learn-loglik.png, to draw (drawPngs); `report` must outlive it.
+FigureJob learningFigureJob(const NoiseLearningReport& report, const std::string& dir, const std::string& label);
 /// Writes dir/fig-learn-loglik.png; returns its path.
 std::string writeLearningFigure(const NoiseLearningReport& report, const std::string& dir, const std::string& label);
 

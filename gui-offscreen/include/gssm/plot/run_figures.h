@@ -13,6 +13,7 @@
 #include "gssm/model/model.h"
 #include "gssm/analysis/offline.h"
 #include "gssm/io/process.h"
+#include "gssm/plot/figure.h"
 
 namespace gssm::plot {
 
@@ -34,11 +35,18 @@ std::vector<std::string> writeRunFigures(const Model& model, const std::vector<O
                                          const std::string& scenario_label,
                                          const std::optional<PlanView>& plan = std::nullopt, int threads = 1);
 
-/// fig-constants-vs-reference.png: the run's final constants ±2σ, in the
-/// reference's terms along `truth` (Model::comparableConstants), against a
-/// calibration reference (NaN entries left out); returns its path.
-std::string writeConstantsReferenceFigure(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
-                                          const Truth* truth, const std::string& dir, const std::string& label);
+/// The figures writeRunFigures draws, to draw (drawPngs); the arguments
+/// must outlive them.
+std::vector<FigureJob> runFigureJobs(const Model& model, const std::vector<OfflineRun>& runs, const Truth* truth,
+                                     const std::string& dir, const std::string& scenario_label,
+                                     const std::optional<PlanView>& plan = std::nullopt);
+
+/// fig-constants-vs-reference.png, to draw: the run's final constants ±2σ,
+/// in the reference's terms along `truth` (Model::comparableConstants),
+/// against a calibration reference (NaN entries left out). The arguments
+/// must outlive it.
+FigureJob constantsReferenceFigureJob(const Model& model, const OfflineRun& run, const Eigen::VectorXd& reference,
+                                      const Truth* truth, const std::string& dir, const std::string& label);
 
 /// The figures of a processed dataset (gssm-process's, gssm.process's):
 /// writeRunFigures with a plan view when the model has px and py (its
