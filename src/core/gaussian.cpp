@@ -92,7 +92,10 @@ void GaussianNoise::whitenInPlace(Eigen::VectorXd& v) const {
 
 void GaussianNoise::whitenInPlace(Eigen::MatrixXd& m) const {
   if (data_->diagonal) {
-    for (Eigen::Index i = 0; i < m.rows(); ++i) m.row(i) *= data_->inverse_diagonal[i];
+    // A scalar measurement's Jacobian (1 × n): one contiguous multiply (a
+    // row of a dynamic matrix is strided to Eigen, so not vectorized)
+    if (m.rows() == 1) m *= data_->inverse_diagonal[0];
+    else m.array().colwise() *= data_->inverse_diagonal.array();
   } else if (!(m.array() == 0.0).all()) {
     data_->L.triangularView<Eigen::Lower>().solveInPlace(m);
   }

@@ -73,11 +73,9 @@ Eigen::VectorXd Model::h(int channel, const Eigen::VectorXd& xc, const Eigen::Ve
   return h(xc, xb, J_h_xc, J_h_xb);
 }
 
-const MeasurementChannel& Model::channel(int c) const {
-  if (c < 0 || c >= numChannels())
-    throw InvalidArgument("model '" + name() + "': no channel " + std::to_string(c) + " (it has " +
-                          std::to_string(numChannels()) + ")");
-  return channels_[static_cast<std::size_t>(c)];
+void Model::throwNoChannel(int c) const {
+  throw InvalidArgument("model '" + name() + "': no channel " + std::to_string(c) + " (it has " +
+                        std::to_string(numChannels()) + ")");
 }
 
 int Model::channelIndex(const std::string& channel_name) const {

@@ -97,7 +97,12 @@ class Model {
 
   /// The measurement channels (at least one; channel 0 has n_y components).
   int numChannels() const { return static_cast<int>(channels_.size()); }
-  const MeasurementChannel& channel(int c) const;
+  /// Channel c; InvalidArgument naming the count if there is none (inline:
+  /// every linearization of a measurement asks for its channel).
+  const MeasurementChannel& channel(int c) const {
+    if (c < 0 || c >= numChannels()) throwNoChannel(c);
+    return channels_[static_cast<std::size_t>(c)];
+  }
   /// The channel called `name`; InvalidArgument naming the known ones otherwise.
   int channelIndex(const std::string& name) const;
   /// R of channel c as a whitening noise model (factored once).
@@ -172,6 +177,7 @@ class Model {
   void setAngleStates(std::vector<int> stacked_components);
 
  private:
+  [[noreturn]] void throwNoChannel(int c) const;
   std::vector<MeasurementChannel> channels_;
   std::vector<GaussianNoise> channel_noise_;
   std::vector<int> angle_states_;
