@@ -228,6 +228,37 @@ TEST(PlanarRigidBody, IncrementalSmootherEqualsTheBatchOnTheLayout) {
 // stationary point of the expected log prior at the batch posterior of x_b
 // computed here independently (dQ/dσ² = ½ tr(Σ⁻¹SΣ⁻¹) − ½ tr(Σ⁻¹) = 0 with
 // S = P + m mᵀ), and it recovers the spread the biases were drawn with.
+// EM's E-steps share one graph: the priors re-made from a model that
+// differs in its constants' prior alone must give the graph that model
+// builds (the same cost and gradient everywhere), its start included.
+TEST(PlanarRigidBody, ReplacedPriorsGiveTheGraphOfTheModelWithThosePriors) {
+  PlanarRigidBody::Params a = simulatedLayout(), b = a;
+  a.bias_sd = 0.3;
+  b.bias_sd = 0.05;
+  const PlanarRigidBody model_a(a), model_b(b);
+  const SimulatedRun run = layoutRun(model_a, 5, 72);
+  const Problem original = buildProblem(model_a, run.measurements);
+  Problem replaced = buildProblem(model_a, run.measurements);
+  replacePriors(replaced, model_b);
+  const Problem built = buildProblem(model_b, run.measurements);
+  ASSERT_EQ(replaced.graph.size(), built.graph.size());
+  EXPECT_TRUE(replaced.initial.at(Key::constants()).isApprox(built.initial.at(Key::constants()), 0));
+  std::mt19937 rng(6);
+  std::normal_distribution<double> n01;
+  for (int trial = 0; trial < 3; ++trial) {
+    Values x = built.initial;
+    for (auto& [key, v] : x) v += 0.1 * Eigen::VectorXd::NullaryExpr(v.size(), [&] { return n01(rng); });
+    EXPECT_DOUBLE_EQ(replaced.graph.cost(x), built.graph.cost(x));
+    EXPECT_GT(std::abs(original.graph.cost(x) - built.graph.cost(x)), 1.0);  // the priors do differ
+    for (std::size_t i = 0; i < built.graph.size(); ++i) {
+      Eigen::VectorXd r1, r2;
+      built.graph[i]->linearize(x, r1, nullptr);
+      replaced.graph[i]->linearize(x, r2, nullptr);
+      ASSERT_TRUE(r1.isApprox(r2, 1e-14)) << "factor " << i;
+    }
+  }
+}
+
 TEST(PlanarRigidBody, LinkBiasSpreadLearntByEmIsAStationaryPointOfTheExpectedLogPrior) {
   PlanarRigidBody::Params truth = simulatedLayout();
   truth.bias_sd = 0.06;

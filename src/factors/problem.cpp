@@ -87,4 +87,11 @@ Problem buildProblem(const Model& model, const std::vector<Measurement>& measure
   return p;
 }
 
+void replacePriors(Problem& p, const Model& model) {
+  const auto priors = priorFactors(model, model.priorState(), model.priorConstants());
+  for (std::size_t i = 0; i < priors.size(); ++i) p.graph.replace(i, priors[i]);
+  p.initial.at(Key::state(0)) = model.priorState().mean;
+  if (model.dims().nb > 0) p.initial.at(Key::constants()) = model.priorConstants().mean;
+}
+
 }  // namespace gssm

@@ -96,8 +96,11 @@ void learnConstantsPrior(const std::string& type_name, std::vector<LearntParamet
   ExpectedLogPrior q{base, params, type_name, {}, {}};
   ParamValues values = withSigmas(base, params, theta.array().exp().matrix());
   std::shared_ptr<const Model> model = values.build(type_name);
-  // The EKF's pass (the first E-step's start) and the first E-step's graph
-  // are independent: on two threads when the batch may use two.
+  // The EKF's pass (the first E-step's start) and the E-steps' graph are
+  // independent: on two threads when the batch may use two. EM changes the
+  // constants' prior alone, so every E-step solves this graph with its
+  // model's priors (its other factors refer to this first model, kept).
+  const std::shared_ptr<const Model> graph_model = model;
   Values x;
   Problem p;
   const auto failed = runJobs(2, static_cast<std::size_t>(o.batch.threads), [&](std::size_t k) {
@@ -109,9 +112,8 @@ void learnConstantsPrior(const std::string& type_name, std::vector<LearntParamet
   r.prior_converged = false;
   for (int it = 1; it <= o.prior_iterations && !r.prior_converged; ++it) {
     r.prior_iterations = it;
-    if (it > 1) p = buildProblem(*model, measurements, inputs, t0);
+    if (it > 1) replacePriors(p, *model);
     posteriorOfConstants(p, o.batch, x, q);
-    p = Problem();  // its factors refer to this model, which the M-step replaces
     if (it == 1) r.prior_start_expected_log_prior = -q.negative(theta);
     const NelderMeadResult m = nelderMead([&q](const Eigen::VectorXd& t) { return q.negative(t); }, theta, 0.5,
                                           200 * static_cast<int>(n + 1), 1e-12, 1e-9);

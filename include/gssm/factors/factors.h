@@ -159,6 +159,8 @@ class LinearGaussianFactor final : public Factor {
 class FactorGraph {
  public:
   void add(FactorPtr f) { factors_.push_back(std::move(f)); }
+  /// Puts f in the place of factor i.
+  void replace(std::size_t i, FactorPtr f) { factors_.at(i) = std::move(f); }
   std::size_t size() const { return factors_.size(); }
   const FactorPtr& operator[](std::size_t i) const { return factors_[i]; }
   auto begin() const { return factors_.begin(); }

@@ -35,6 +35,12 @@ std::vector<FactorPtr> stepFactors(const Model& model, std::int64_t k, double dt
 Problem buildProblem(const Model& model, const std::vector<Measurement>& measurements,
                      const std::vector<Input>& inputs = {}, double t0 = 0.0);
 
+/// p's priors (buildProblem puts them first) re-made from `model`'s: for a
+/// model that differs from the one p was built with in its priors alone
+/// (EM's constants' prior σs), whose other factors p keeps (they refer to
+/// p's model, which must outlive p).
+void replacePriors(Problem& p, const Model& model);
+
 /// One state of a run after x_c(0): its time and the measurements taken at it.
 struct ScheduledStep {
   double t = 0;
