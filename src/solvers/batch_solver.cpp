@@ -17,6 +17,17 @@
 
 namespace gssm {
 
+namespace {
+// The next states' factors add to the same columns of H a few rows further
+// down: a long chain's constants columns (one per link on UWB, 650 KB each)
+// are ~25 streams at once, more than the hardware prefetcher follows, so
+// their next lines are asked for ahead (16 rows: ~3 states of 6). A hint: it
+// never faults, and past the envelope's end it loads nothing needed.
+inline void prefetchRowsAhead(const double* entry) {
+  __builtin_prefetch(reinterpret_cast<const void*>(reinterpret_cast<std::uintptr_t>(entry) + 16 * sizeof(double)), 1);
+}
+}  // namespace
+
 const char* BatchSolverOptions::methodName(Method m) {
   return m == Method::GaussNewton ? "gauss-newton" : "levenberg-marquardt";
 }
@@ -394,8 +405,13 @@ struct BatchSolver::Impl {
             },
             [&](Eigen::Index i, Eigen::Index j, double v, auto...) {
               const int p = shared(i), q = shared(j);
-              if (p >= 0 && q >= 0) split.side_h(p, q) += v;
-              else H[envelope.position(i, j)] += v;
+              if (p >= 0 && q >= 0) {
+                split.side_h(p, q) += v;
+              } else {
+                double* entry = H + envelope.position(i, j);
+                prefetchRowsAhead(entry);
+                *entry += v;
+              }
             });
       } else {
         s.columns.gather(s.offs.data(), J);
