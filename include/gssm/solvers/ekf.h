@@ -85,9 +85,9 @@ class ExtendedKalmanFilter {
   // that none allocates (a 31-state filter's 24 ranges an epoch made ~15
   // allocations each); `P` is the candidate covariance, swapped in on success.
   struct UpdateBuffers {
-    Eigen::VectorXd xc, xb, yhat, innov, dz;
-    // PHt = P Hᵀ, K = PHt S⁻¹, At = ½ K S − PHt: n × m, contiguous columns
-    Eigen::MatrixXd J_h_xc, J_h_xb, H, PHt, S, S_inv, K, At, P;
+    Eigen::VectorXd xc, xb, yhat, innov, whitened, dz;
+    // PHt = P Hᵀ, K = PHt S⁻¹ (KT: Kᵀ), At = ½ K S − PHt: n × m, contiguous columns
+    Eigen::MatrixXd J_h_xc, J_h_xb, H, PHt, S, K, KT, At, P;
     std::vector<Eigen::Index> nonzero;  // H's nonzero columns
     Eigen::LLT<Eigen::MatrixXd> llt;
   };
