@@ -265,7 +265,8 @@ TEST(BatchSolver, MarginalCovariancesEqualDenseInverse) {
   }
 }
 
-TEST(BatchSolver, ALastGaussNewtonStepWithoutRelinearizationKeepsTheFactorizationItCameFrom) {
+// Gauss–Newton's last step, or Levenberg–Marquardt's undamped finishing one.
+TEST(BatchSolver, ALastUndampedStepWithoutRelinearizationKeepsTheFactorizationItCameFrom) {
   // Priors at the truth (the paper's, 143σ off, leave residuals so large
   // that the Gauss–Newton model overstates every step's decrease).
   models::Radar2D::Params params;
@@ -274,43 +275,47 @@ TEST(BatchSolver, ALastGaussNewtonStepWithoutRelinearizationKeepsTheFactorizatio
   const models::Radar2D radar(params);
   const SimulatedRun run = radarPaperRun(radar, 25, 3);
   const Problem p = buildProblem(radar, run.measurements);
-  BatchSolverOptions o;
-  o.method = BatchSolverOptions::Method::GaussNewton;
-  o.relative_cost_tolerance = 1e-9;
-  Values x_ref = p.initial, x = p.initial;
-  BatchSolver reference(o);
-  const BatchSolverSummary ref = reference.solve(p.graph, x_ref);
-  o.relinearize_at_solution = false;
-  BatchSolver solver(o);
-  const BatchSolverSummary sum = solver.solve(p.graph, x);
-  ASSERT_TRUE(ref.converged && sum.converged) << ref.toString() << "\n" << sum.toString();
-  EXPECT_LT(sum.factorizations, ref.factorizations) << "one linearization and factorization fewer";
-  // The same iterate: the last step was taken either way.
-  for (const auto& kv : x)
-    EXPECT_LT((kv.second - x_ref.at(kv.first)).norm(), 1e-6 * (1 + kv.second.norm())) << kv.first.toString();
-  // The covariances are the dense inverse of JᵀJ at the point before the
-  // last step, which is within that step of the solution.
-  const Values at = solver.factoredAt(x);
-  Eigen::MatrixXd H;
-  Eigen::VectorXd g;
-  denseNormalEquations(p.graph, at, H, g);
-  const Eigen::MatrixXd Sigma = H.inverse();
-  const Eigen::Index nb0 = 26;
-  EXPECT_LT(relativeError(solver.marginalCovariance(Key::constants()), Sigma.block(nb0, nb0, 2, 2)), 1e-8);
-  EXPECT_NEAR(solver.marginalCovariance(Key::state(7))(0, 0), Sigma(7, 7), 1e-8 * Sigma(7, 7));
-  EXPECT_LT(relativeError(solver.marginalCovariance(Key::constants()), reference.marginalCovariance(Key::constants())), 1e-4);
-  double moved = 0;
-  for (const auto& kv : x) moved = std::max(moved, (kv.second - at.at(kv.first)).norm());
-  EXPECT_GT(moved, 0.0) << "the last step was taken after the factorization";
-  // Restoring from that point reproduces the factorization exactly.
-  BatchSolver restored(o);
-  restored.evaluateAt(p.graph, at);
-  EXPECT_EQ(restored.marginalCovariance(Key::constants()), solver.marginalCovariance(Key::constants()));
-  // Only for Gauss–Newton without a polish.
-  o.method = BatchSolverOptions::Method::LevenbergMarquardt;
-  std::string why;
-  EXPECT_FALSE(o.validate(&why));
-  EXPECT_NE(why.find("relinearize_at_solution"), std::string::npos) << why;
+  for (const auto method : {BatchSolverOptions::Method::GaussNewton, BatchSolverOptions::Method::LevenbergMarquardt}) {
+    SCOPED_TRACE(BatchSolverOptions::methodName(method));
+    BatchSolverOptions o;
+    o.method = method;
+    o.relative_cost_tolerance = 1e-9;
+    Values x_ref = p.initial, x = p.initial;
+    BatchSolver reference(o);
+    const BatchSolverSummary ref = reference.solve(p.graph, x_ref);
+    o.relinearize_at_solution = false;
+    BatchSolver solver(o);
+    const BatchSolverSummary sum = solver.solve(p.graph, x);
+    ASSERT_TRUE(ref.converged && sum.converged) << ref.toString() << "\n" << sum.toString();
+    EXPECT_LT(sum.factorizations, ref.factorizations) << "one linearization and factorization fewer";
+    // The same iterate: the last step was taken either way.
+    for (const auto& kv : x)
+      EXPECT_LT((kv.second - x_ref.at(kv.first)).norm(), 1e-6 * (1 + kv.second.norm())) << kv.first.toString();
+    // The covariances are the dense inverse of JᵀJ at the point before the
+    // last step, which is within that step of the solution.
+    const Values at = solver.factoredAt(x);
+    Eigen::MatrixXd H;
+    Eigen::VectorXd g;
+    denseNormalEquations(p.graph, at, H, g);
+    const Eigen::MatrixXd Sigma = H.inverse();
+    const Eigen::Index nb0 = 26;
+    EXPECT_LT(relativeError(solver.marginalCovariance(Key::constants()), Sigma.block(nb0, nb0, 2, 2)), 1e-8);
+    EXPECT_NEAR(solver.marginalCovariance(Key::state(7))(0, 0), Sigma(7, 7), 1e-8 * Sigma(7, 7));
+    EXPECT_LT(relativeError(solver.marginalCovariance(Key::constants()), reference.marginalCovariance(Key::constants())),
+              1e-4);
+    double moved = 0;
+    for (const auto& kv : x) moved = std::max(moved, (kv.second - at.at(kv.first)).norm());
+    EXPECT_GT(moved, 0.0) << "the last step was taken after the factorization";
+    // Restoring from that point reproduces the factorization exactly.
+    BatchSolver restored(o);
+    restored.evaluateAt(p.graph, at);
+    EXPECT_EQ(restored.marginalCovariance(Key::constants()), solver.marginalCovariance(Key::constants()));
+    // Not with a Newton polish, which relinearizes at the solution.
+    o.newton_polish_steps = 1;
+    std::string why;
+    EXPECT_FALSE(o.validate(&why));
+    EXPECT_NE(why.find("relinearize_at_solution"), std::string::npos) << why;
+  }
 }
 
 TEST(BatchSolver, SingularSystemNamesTheVariableAndLeavesValuesUnchanged) {

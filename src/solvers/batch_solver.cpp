@@ -51,8 +51,8 @@ bool BatchSolverOptions::validate(std::string* why) const {
   if (!(max_lambda > initial_lambda)) return fail("max_lambda must exceed initial_lambda");
   if (newton_polish_steps < 0) return fail("newton_polish_steps must be >= 0");
   if (threads < 1) return fail("threads must be >= 1, got " + std::to_string(threads));
-  if (!relinearize_at_solution && (method != Method::GaussNewton || newton_polish_steps > 0))
-    return fail("relinearize_at_solution = false needs Gauss-Newton without a Newton polish");
+  if (!relinearize_at_solution && newton_polish_steps > 0)
+    return fail("relinearize_at_solution = false needs no Newton polish (the polish relinearizes at the solution)");
   return true;
 }
 
@@ -567,7 +567,7 @@ struct BatchSolver::Impl::Iteration {
     delta = -g;
     s.solveInPlace(delta);  // −H⁻¹g, exactly the negated solution
     const double predicted = -0.5 * g.dot(delta);  // the Gauss–Newton model's decrease
-    if (!options.relinearize_at_solution && predicted <= options.relative_cost_tolerance * cost) {
+    if (!options.relinearize_at_solution && policy.undamped() && predicted <= options.relative_cost_tolerance * cost) {
       internal::flatten(x, s.factored_point);
       internal::addStep(x, delta, x);  // the last step: H as factored stays the solution's
       ++sum.iterations;
