@@ -358,13 +358,13 @@ OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
 OfflineRun runOffline(const Model& model, const EstimatorOptions& options,
                       const std::vector<Measurement>& measurements, const std::vector<Input>& inputs,
                       const std::function<void(std::size_t, std::size_t)>& progress,
-                      const StreamingCheckpoints& checkpoints, RowTimes rows) {
+                      const StreamingCheckpoints& checkpoints, RowTimes rows, const Values* batch_start) {
   if (methodInfo(options.method).streaming)
     return runStreaming(model, options, measurements, inputs, progress, checkpoints, rows);
   if (!checkpoints.path.empty() || !checkpoints.resume_from.empty())
     throw InvalidArgument(std::string("runOffline: checkpoints apply to streaming methods, not '") +
                           methodName(options.method) + "'");
-  return runBatch(model, options, measurements, inputs, rows);
+  return runBatch(model, options, measurements, inputs, rows, batch_start);
 }
 
 }  // namespace gssm

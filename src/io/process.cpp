@@ -100,9 +100,8 @@ OfflineRun runMethod(const ProcessOptions& o, const Model& model, const ProcessR
   // The batch starts where learning's last E-step left the run (a batch
   // solve under σ within the learning tolerance): a few iterations, no EKF.
   const Values* start = r.learnt && !r.learnt->posterior.empty() ? &r.learnt->posterior : nullptr;
-  OfflineRun run =
-      streaming ? runOffline(model, options, r.dataset.measurements, r.dataset.inputs, progress, checkpoints, r.dataset.rows)
-                : runBatch(model, options, r.dataset.measurements, r.dataset.inputs, r.dataset.rows, start);
+  OfflineRun run = runOffline(model, options, r.dataset.measurements, r.dataset.inputs, progress, checkpoints,
+                              r.dataset.rows, start);
   if (!streaming)
     for (const auto& row : run.rows) files.row(row);
   files.finish();

@@ -208,7 +208,7 @@ Eigen::VectorXd PlanarRigidBody::h(int channel, const Eigen::VectorXd& xc, const
 
 void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
                             Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
-  if (channel < 0 || channel >= numChannels()) this->channel(channel);  // throws, naming the channels
+  this->channel(channel);  // range check: throws, naming the channels
   const std::size_t t = static_cast<std::size_t>(channel) / p_.anchors.size();
   const std::size_t a = static_cast<std::size_t>(channel) % p_.anchors.size();
   const Eigen::Vector3d& l = p_.tags[t];

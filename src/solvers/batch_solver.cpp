@@ -144,9 +144,12 @@ struct BatchSolver::Impl {
   mutable bool envelope_inverse = false;  // envelope.selectedInverse() done for this solution
   mutable bool envelope_block_used = false;  // envelope.inverseBlock() answered once for this solution
 
-  // The variables' layout, each factor's variables and shape, then the
-  // linear solver for the graph's pattern.
-  void setup(const FactorGraph& graph, const Values& values) {
+  // A new graph: no solution yet; the variables' layout, each factor's
+  // variables and shape, then the linear solver for the graph's pattern.
+  void setup(const FactorGraph& graph, const Values& values, int thread_count) {
+    has_solution = false;
+    selected.reset();
+    threads = thread_count;
     layoutVariables(values);
     indexFactors(graph, values);
     if (!chooseEnvelope(graph)) assembleSparsePattern(graph);
@@ -661,10 +664,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   Impl& s = *impl_;
-  s.has_solution = false;
-  s.selected.reset();
-  s.threads = options_.threads;
-  s.setup(graph, values);
+  s.setup(graph, values, options_.threads);
 
   BatchSolverSummary sum;
   sum.num_factors = graph.size();
@@ -705,10 +705,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
 
 void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
   Impl& s = *impl_;
-  s.has_solution = false;
-  s.selected.reset();
-  s.threads = options_.threads;
-  s.setup(graph, values);
+  s.setup(graph, values, options_.threads);
   Eigen::VectorXd g, diag;
   s.linearize(graph, values, g, diag);
   s.setDamping(diag, 0.0);

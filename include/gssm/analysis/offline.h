@@ -102,12 +102,14 @@ OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
                     const std::vector<Input>& inputs = {}, RowTimes rows = RowTimes::Measurements,
                     const Values* start = nullptr);
 
-/// options.method over the whole recording: runBatch for the batch,
-/// runStreaming for the others (progress and checkpoints apply to those).
+/// options.method over the whole recording: runBatch for the batch (from
+/// `batch_start` when given), runStreaming for the others (progress and
+/// checkpoints apply to those).
 OfflineRun runOffline(const Model& model, const EstimatorOptions& options,
                       const std::vector<Measurement>& measurements,
                       const std::vector<Input>& inputs = {},
                       const std::function<void(std::size_t, std::size_t)>& progress = {},
-                      const StreamingCheckpoints& checkpoints = {}, RowTimes rows = RowTimes::Measurements);
+                      const StreamingCheckpoints& checkpoints = {}, RowTimes rows = RowTimes::Measurements,
+                      const Values* batch_start = nullptr);
 
 }  // namespace gssm
