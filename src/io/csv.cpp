@@ -6,6 +6,7 @@
 
 #include "gssm/core/error.h"
 #include "gssm/io/number_text.h"
+#include "io/byte_order_mark.h"
 
 namespace gssm::io {
 
@@ -54,8 +55,8 @@ CsvTable parseCsv(const std::string& text, const std::string& source, std::vecto
   bool have_header = false;
   std::vector<Cell> cells;
   std::vector<double> row;
-  const char* p = text.data();
-  const char* const text_end = p + text.size();
+  const char* p = text.data() + byteOrderMarkLength(text);  // a spreadsheet's UTF-8 mark is no header text
+  const char* const text_end = text.data() + text.size();
   while (p < text_end) {
     const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(text_end - p)));
     if (!eol) eol = text_end;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "gssm/core/error.h"
+#include "io/byte_order_mark.h"
 
 namespace gssm::io {
 
@@ -86,7 +87,7 @@ bool parseRows(const std::string& value, std::vector<std::vector<double>>& rows,
 IniDocument IniDocument::parse(const std::string& text, const std::string& source) {
   IniDocument doc;
   doc.source_ = source;
-  std::stringstream ss(text);
+  std::stringstream ss(text.substr(byteOrderMarkLength(text)));  // an editor's UTF-8 mark is no key text
   std::string raw;
   int lineno = 0;
   Section* current = nullptr;

@@ -8,6 +8,7 @@
 #include "gssm/core/error.h"
 #include "gssm/io/config.h"
 #include "gssm/io/json_text.h"
+#include "io/byte_order_mark.h"
 
 namespace gssm::io {
 
@@ -68,6 +69,7 @@ std::vector<std::string> linesOf(const IniDocument& input) {
     return lines;
   }
   for (std::string l; std::getline(in, l);) lines.push_back(l);
+  if (!lines.empty()) lines.front().erase(0, byteOrderMarkLength(lines.front()));
   return lines;
 }
 

@@ -6,6 +6,11 @@
 
 namespace gssm {
 
+/// `text` with every character a reader cannot see written as its code
+/// point (<U+200B>; a byte that is not UTF-8 as <0xC3>). Tabs and line
+/// breaks stay as they are.
+std::string showInvisible(const std::string& text);
+
 /// Base of every exception gssm throws.
 class Error : public std::runtime_error {
  public:
@@ -20,10 +25,12 @@ class InvalidArgument : public Error {
 };
 
 /// A file or configuration could not be read: the message names the file,
-/// line, column/field and offending value.
+/// line, column/field and offending value. Characters a reader cannot see
+/// (controls, zero-width and non-breaking spaces, a byte-order mark, bytes
+/// that are not UTF-8) are shown as their code point, e.g. <U+FEFF>.
 class InputError : public Error {
  public:
-  using Error::Error;
+  explicit InputError(const std::string& what) : Error(showInvisible(what)) {}
 };
 
 /// The numbers went wrong: a covariance that is not positive definite, a

@@ -81,7 +81,7 @@ struct EstimatorOptions {
     EliminationOrdering ordering = EliminationOrdering::ConstrainedColamd;  ///< [smoother] ordering
   } incremental;
   struct Window {
-    int window = 10;                ///< states x_c kept (the newest): fixed lag ≥ 1, paper window ≥ 2
+    int window = 10;                ///< states x_c kept (the newest), ≥ 1; the paper window solves one more, then drops the oldest
   };
   Window fixed_lag;                 ///< [fixed_lag] window; always time-ordered
   Window paper_window;              ///< [paper_window] window
