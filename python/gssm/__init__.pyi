@@ -43,7 +43,6 @@ class BatchOptions:
     algorithm: str
     max_iterations: int
     relative_cost_tolerance: float
-    absolute_cost_tolerance: float
     step_tolerance: float
     gradient_tolerance: float
     initial_lambda: float

@@ -45,7 +45,6 @@ bool BatchSolverOptions::validate(std::string* why) const {
   };
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(relative_cost_tolerance >= 0)) return fail("relative_cost_tolerance must be >= 0");
-  if (!(absolute_cost_tolerance >= 0)) return fail("absolute_cost_tolerance must be >= 0");
   if (!(step_tolerance >= 0)) return fail("step_tolerance must be >= 0");
   if (!(gradient_tolerance >= 0)) return fail("gradient_tolerance must be >= 0");
   if (!(initial_lambda > 0)) return fail("initial_lambda must be > 0");
@@ -530,10 +529,6 @@ struct BatchSolver::Impl::Iteration {
     sum.initial_cost = cost;
   }
 
-  // A decrease of the cost from `from` small enough to stop.
-  bool smallDecrease(double decrease, double from) const {
-    return decrease <= options.relative_cost_tolerance * from || decrease <= options.absolute_cost_tolerance;
-  }
   bool stepConverged(const Eigen::VectorXd& d, const Values& at) const {
     return d.norm() <= options.step_tolerance * (internal::norm(at) + options.step_tolerance);
   }
@@ -575,7 +570,7 @@ struct BatchSolver::Impl::Iteration {
     delta = -g;
     s.solveInPlace(delta);  // −H⁻¹g, exactly the negated solution
     const double predicted = -0.5 * g.dot(delta);  // the Gauss–Newton model's decrease
-    if (!options.relinearize_at_solution && policy.undamped() && smallDecrease(predicted, cost)) {
+    if (!options.relinearize_at_solution && policy.undamped() && predicted <= options.relative_cost_tolerance * cost) {
       internal::flatten(x, s.factored_point);
       internal::addStep(x, delta, x);  // the last step: H as factored stays the solution's
       ++sum.iterations;
@@ -624,7 +619,7 @@ struct BatchSolver::Impl::Iteration {
     cost = new_cost;
     policy.accepted();
     if (g.lpNorm<Eigen::Infinity>() <= options.gradient_tolerance) return !converge(Termination::GradientConverged);
-    if (smallDecrease(old_cost - cost, old_cost)) return !converge(Termination::CostConverged);
+    if (old_cost - cost <= options.relative_cost_tolerance * old_cost) return !converge(Termination::CostConverged);
     return true;
   }
 

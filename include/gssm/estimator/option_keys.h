@@ -53,7 +53,6 @@ void optionKeys(Visitor& v, BatchSolverOptions& o) {
   v("algorithm", algorithm);
   v("max_iterations", o.max_iterations);
   v("relative_cost_tolerance", o.relative_cost_tolerance);
-  v("absolute_cost_tolerance", o.absolute_cost_tolerance);
   v("step_tolerance", o.step_tolerance);
   v("gradient_tolerance", o.gradient_tolerance);
   v("initial_lambda", o.initial_lambda);

@@ -27,13 +27,6 @@ struct BatchSolverOptions {
   int max_iterations = 100;
   /// Stop when an accepted step lowers the cost by less than this fraction.
   double relative_cost_tolerance = 1e-12;
-  /// Stop also when an accepted step lowers the cost by less than this, in
-  /// the cost's own units: a step of s posterior standard deviations lowers
-  /// ½Σ‖r‖² by about ½s², whatever the cost. 0: off. For a cost dominated by
-  /// a large residual (the radar's start 143σ from its prior), where
-  /// Gauss–Newton converges at a rate near 1, a fraction of the cost stops
-  /// it a large part of a σ from the minimum.
-  double absolute_cost_tolerance = 0;
   /// Stop when ‖δ‖ ≤ tol·(‖x‖ + tol).
   double step_tolerance = 1e-10;
   /// Stop when max |Jᵀr| ≤ tol.
@@ -54,7 +47,7 @@ struct BatchSolverOptions {
   int newton_polish_steps = 0;
   /// No polish with false. false: an undamped step (Gauss–Newton's, or
   /// Levenberg–Marquardt's finishing one) whose predicted decrease −½gᵀδ is
-  /// below relative_cost_tolerance·cost (or absolute_cost_tolerance) is the last one — taken, not
+  /// below relative_cost_tolerance·cost is the last one — taken, not
   /// followed by a linearization — and the covariances come from the
   /// factorization that computed it, at the point before it (for a step
   /// that small the difference is of its own order); the summary's
