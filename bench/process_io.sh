@@ -9,6 +9,8 @@ new="$1"; base="${2:-}"
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 "$(dirname "$new")/gssm-simulate" --scenario paper --seed 1 --steps 200000 --out "$dir/data" > /dev/null
+echo "machine: $("$(dirname "$0")/../scripts/machine")"
+echo
 echo "| binary | run | whole process (s) | estimator total_s (s) | ratio | peak RSS (MB) |"
 echo "| --- | --- | --- | --- | --- | --- |"
 for run in 1 2 3; do

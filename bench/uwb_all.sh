@@ -13,6 +13,8 @@ src="$(cd "$(dirname "$0")/.." && pwd)/datasets/uwb-fast"
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 seconds() { grep -o "\"$2\": [0-9.e-]*" "$1" | head -1 | awk '{print $2}'; }
+echo "machine: $("$(dirname "$0")/../scripts/machine")"
+echo
 echo "| binary | run | wall (s) | learning (s) | ekf | batch | incremental | fixed-lag | paper-window | peak RSS (MB) |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 for run in 1 2 3; do

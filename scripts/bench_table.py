@@ -5,19 +5,14 @@ import json, sys, datetime, platform, os
 
 data = json.load(open(sys.argv[1]))
 cmd = sys.argv[2]
-cpu = "unknown"
-try:
-    for line in open("/proc/cpuinfo"):
-        if line.startswith("model name"):
-            cpu = line.split(":", 1)[1].strip()
-            break
-except OSError:
-    pass
+import subprocess
+machine = subprocess.run([os.path.join(os.path.dirname(os.path.abspath(__file__)), "machine")],
+                         capture_output=True, text=True, check=True).stdout.strip()
 rows = {b["name"]: b for b in data["benchmarks"]}
 ekf = next(b for n, b in rows.items() if "/ekf/" in n)
 us = lambda s: f"{s * 1e6:.1f}"
 print("# Benchmark results\n")
-print(f"- machine: {cpu}, {os.cpu_count()} cores")
+print(f"- machine: {machine}")
 print(f"- date: {datetime.date.today().isoformat()}")
 print(f"- command: `{cmd}` (via `scripts/bench`)")
 print("- scenario: radar paper scenario, 2000 steps of T = 0.05 s; per-update wall time of `addMeasurement`\n")
