@@ -623,7 +623,7 @@ class PaperWindowEstimator final : public Estimator {
     const Eigen::VectorXd xb = model_.dims().nb ? values.at(Key::constants()) : Eigen::VectorXd();
     values.insert(Key::state(k), predictState(model_, values.at(Key::state(k - 1)), xb, u, dt, k));
     times.push_back(times.back() + dt);
-    BatchSolver solver(gaussNewton());
+    BatchSolver& solver = spare_;  // the committed solver_ stays as it is until the step succeeds
     BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state, prior_constants, oldest), values);
     if (static_cast<int>(times.size()) > window_) {
       // w + 1 states: the oldest leaves, new 1-D priors from this solve.
@@ -646,7 +646,7 @@ class PaperWindowEstimator final : public Estimator {
     prior_state_ = std::move(prior_state);
     prior_constants_ = std::move(prior_constants);
     oldest_ = oldest;
-    commitSolve(std::move(solver), sum);
+    commitSolve(sum);
   }
 
  private:
@@ -654,14 +654,16 @@ class PaperWindowEstimator final : public Estimator {
     auto steps = steps_;
     Values values = values_;
     for (std::size_t i = 0; i < count; ++i) steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, ms[i]));
-    BatchSolver solver(gaussNewton());
+    BatchSolver& solver = spare_;
     const BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state_, prior_constants_, oldest_), values);
     steps_ = std::move(steps);
     values_ = std::move(values);
-    commitSolve(std::move(solver), sum);
+    commitSolve(sum);
   }
-  void commitSolve(BatchSolver&& solver, const BatchSolverSummary& sum) {
-    solver_ = std::move(solver);
+  // The spare solver, which solved the step, becomes the window's; the old
+  // one is the next step's spare (its buffers are reused, not reallocated).
+  void commitSolve(const BatchSolverSummary& sum) {
+    std::swap(solver_, spare_);
     report_.iterations = sum.iterations;
     last_summary_ = sum;
     markDetail();
@@ -761,6 +763,7 @@ class PaperWindowEstimator final : public Estimator {
   Gaussian prior_state_, prior_constants_;
   std::int64_t oldest_ = 0;
   BatchSolver solver_{gaussNewton()};
+  BatchSolver spare_{gaussNewton()};  // what a step solves in
 };
 
 }  // namespace
