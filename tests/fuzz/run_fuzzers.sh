@@ -7,7 +7,7 @@ set -euo pipefail
 secs="${1:-30}"
 src="$(cd "$(dirname "$0")/../.." && pwd)"
 bin="${2:?build directory of a -DGSSM_FUZZ=ON build}/tests"
-for t in csv ini checkpoint; do
+for t in csv ini checkpoint pos; do
   work="$bin/fuzz-$t"
   rm -rf "$work"; mkdir -p "$work"; cp -r "$src/tests/fuzz/corpus/$t" "$work/corpus"
   echo "fuzz_$t: ${secs}s"
