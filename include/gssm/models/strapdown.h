@@ -1,0 +1,64 @@
+#pragma once
+// Strapdown inertial navigation in a local-level north-east-down frame fixed
+// to the Earth at an anchor point (the first GNSS fix): attitude on SO(3),
+// velocity and position in that frame, the IMU's rates and specific forces
+// held over each sample interval; Earth rotation and normal gravity included
+// (Groves, "Principles of GNSS, Inertial, and Multisensor Integrated
+// Navigation Systems", 2nd ed., §5.2: the Earth-frame mechanization, with
+// the frame's axes those of NED at the anchor). The navigation model of issue
+// #37 propagates its states with strapdownStep.
+#include <Eigen/Core>
+
+#include "gssm/core/so3.h"
+#include "gssm/models/geodesy.h"
+
+namespace gssm::strapdown {
+
+/// Attitude (body → frame), velocity over the Earth and position, in the anchored NED frame.
+struct NavState {
+  so3::Matrix3 R = so3::Matrix3::Identity();
+  so3::Vector3 v = so3::Vector3::Zero();
+  so3::Vector3 p = so3::Vector3::Zero();
+};
+
+/// Jacobians of one step in the tangent order (δθ, δv, δp): δθ the
+/// body-frame rotation of R ⊕ δθ = R·Exp(δθ).
+struct StepJacobians {
+  Eigen::Matrix<double, 9, 9> J_next_x;
+  Eigen::Matrix<double, 9, 3> J_next_bg;  ///< gyro bias
+  Eigen::Matrix<double, 9, 3> J_next_ba;  ///< accelerometer bias
+};
+
+/// The anchored frame: the Earth's rotation in it (constant: the frame turns
+/// with the Earth) and normal gravity at any point of it.
+class NavFrame {
+ public:
+  explicit NavFrame(const geodesy::Geodetic& anchor);
+  const geodesy::LocalFrame& local() const { return local_; }
+  /// ω_ie in the frame's axes.
+  const so3::Vector3& earthRate() const { return earth_rate_; }
+  /// Normal gravity at position p of the frame, along that point's own
+  /// down (which tilts by the distance over the Earth's radius).
+  so3::Vector3 gravity(const so3::Vector3& p) const;
+  /// ∂gravity/∂p: the tilt of the down direction and the height gradient
+  /// (γ/R_E·diag(−1, −1, 2), a spherical Earth's; ellipsoidal terms 0.3 % of it).
+  so3::Matrix3 gravityGradient(const so3::Vector3& p) const;
+
+ private:
+  geodesy::LocalFrame local_;
+  so3::Vector3 earth_rate_;
+  so3::Matrix3 ecef_to_frame_;
+};
+
+/// One IMU interval of dt seconds with the measured rate `gyro` (rad/s) and
+/// specific force `accel` (m/s²), both in body axes, less the biases bg, ba:
+///   R' = Exp(−ω_ie·dt)·R·Exp((ω̃ − b_g)·dt)
+///   v' = v + a·dt,  p' = p + v·dt + ½·a·dt²,  a = R(f̃ − b_a) + g(p) − 2 ω_ie × v.
+NavState step(const NavState& x, const so3::Vector3& gyro, const so3::Vector3& accel, const so3::Vector3& bg,
+              const so3::Vector3& ba, double dt, const NavFrame& frame, StepJacobians* J = nullptr);
+
+/// Roll and pitch (rad) of a body at rest from its specific force, which is
+/// then the reaction to gravity: f = −Rᵀ·(0, 0, g).
+Eigen::Vector2d rollPitchFromSpecificForce(const so3::Vector3& f);
+
+}  // namespace gssm::strapdown
