@@ -10,9 +10,11 @@
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
 #include "gssm/model/simulation.h"
+#include "expect_error.h"
 #include "reference_kalman.h"
 
 using namespace gssm;
+using gssm::testing::expectThrowsNaming;
 using gssm::testing::relativeError;
 
 namespace {
@@ -39,15 +41,6 @@ struct Snapshot {
   }
 };
 
-template <class Fn>
-void expectThrowsNaming(Fn fn, const std::string& fragment) {
-  try {
-    fn();
-    FAIL() << "no exception; expected one naming '" << fragment << "'";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
-}
 }  // namespace
 
 TEST(Estimator, EveryThrowingPathLeavesTheEstimatorUnchanged) {

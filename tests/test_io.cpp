@@ -8,6 +8,7 @@
 #include <random>
 
 #include "gssm/core/error.h"
+#include "expect_error.h"
 #include "gssm/io/config.h"
 #include "gssm/io/csv.h"
 #include "gssm/io/ini.h"
@@ -17,22 +18,8 @@
 #include "gssm/models/radar2d.h"
 
 using namespace gssm;
+using gssm::testing::expectThrowsNaming;
 using namespace gssm::io;
-
-namespace {
-// Asserts that `fn` throws InputError whose message contains every fragment.
-template <class Fn>
-void expectInputError(Fn fn, std::initializer_list<const char*> fragments) {
-  try {
-    fn();
-    FAIL() << "no error thrown";
-  } catch (const InputError& e) {
-    for (const char* f : fragments)
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
-          << "message '" << e.what() << "' lacks '" << f << "'";
-  }
-}
-}  // namespace
 
 TEST(IniDocument, ParsesSectionsCommentsAndMatrices) {
   const auto ini = IniDocument::parse(
@@ -49,15 +36,15 @@ TEST(IniDocument, ParsesSectionsCommentsAndMatrices) {
 }
 
 TEST(IniDocument, ErrorsNameFileLineSectionKeyAndValue) {
-  expectInputError([] { IniDocument::parse("[a]\nx = 1\nnot a pair\n", "f.ini"); },
+  expectThrowsNaming<InputError>([] { IniDocument::parse("[a]\nx = 1\nnot a pair\n", "f.ini"); },
                    {"f.ini:3", "key = value"});
-  expectInputError([] { IniDocument::parse("x = 1\n", "f.ini"); }, {"f.ini:1", "before any"});
-  expectInputError([] { IniDocument::parse("[a]\nx = 1\nx = 2\n", "f.ini"); },
+  expectThrowsNaming<InputError>([] { IniDocument::parse("x = 1\n", "f.ini"); }, {"f.ini:1", "before any"});
+  expectThrowsNaming<InputError>([] { IniDocument::parse("[a]\nx = 1\nx = 2\n", "f.ini"); },
                    {"f.ini:3", "repeated", "line 2"});
   const auto ini = IniDocument::parse("[m]\nT = abc\nQ = [1 2; 3]\n", "f.ini");
-  expectInputError([&] { ini.getDouble("m", "T"); }, {"f.ini:2", "[m] T", "abc", "number"});
-  expectInputError([&] { ini.getMatrix("m", "Q"); }, {"f.ini:3", "row 2"});
-  expectInputError([&] { ini.getDouble("m", "R"); }, {"missing", "'R'", "[m]"});
+  expectThrowsNaming<InputError>([&] { ini.getDouble("m", "T"); }, {"f.ini:2", "[m] T", "abc", "number"});
+  expectThrowsNaming<InputError>([&] { ini.getMatrix("m", "Q"); }, {"f.ini:3", "row 2"});
+  expectThrowsNaming<InputError>([&] { ini.getDouble("m", "R"); }, {"missing", "'R'", "[m]"});
 }
 
 TEST(IniDocument, WriteThenParseRoundTripsBits) {
@@ -90,15 +77,15 @@ TEST(Config, BuiltinScenarioBuildsThePaperModel) {
 TEST(Config, BadModelConfigsNameTheProblem) {
   auto base = builtinScenario("paper", 1, 10);
   base.set("model", "type", "radar3d");
-  expectInputError([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
+  expectThrowsNaming<InputError>([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
                    {"c.ini", "radar3d", "unknown model"});
   base = builtinScenario("paper", 1, 10);
   base.set("prior", "constants_cov", "[49 0; 0 -1]");
-  expectInputError([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
+  expectThrowsNaming<InputError>([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
                    {"c.ini", "positive definite", "x_b"});
   base = builtinScenario("paper", 1, 10);
   base.set("model", "Qq", "1");
-  expectInputError([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
+  expectThrowsNaming<InputError>([&] { makeModel(IniDocument::parse(base.toString(), "c.ini")); },
                    {"unknown key 'Qq'"});
 }
 
@@ -107,12 +94,12 @@ TEST(Csv, ParsesAndReportsLineColumnValue) {
   ASSERT_EQ(t.rows.size(), 2u);
   EXPECT_EQ(t.line_of_row[1], 4);
   EXPECT_EQ(t.rows[1][1], 1001.5);
-  expectInputError([] { parseCsv("t,range\n0.05,abc\n", "m.csv"); },
+  expectThrowsNaming<InputError>([] { parseCsv("t,range\n0.05,abc\n", "m.csv"); },
                    {"m.csv:2", "'range'", "'abc'"});
-  expectInputError([] { parseCsv("t,range\n0.05,nan\n", "m.csv"); }, {"m.csv:2", "nan"});
-  expectInputError([] { parseCsv("t,range\n0.05\n", "m.csv"); }, {"m.csv:2", "1 fields"});
-  expectInputError([] { parseCsv("0.05,1000\n", "m.csv"); }, {"m.csv:1", "header"});
-  expectInputError([] { parseCsv("", "m.csv"); }, {"m.csv", "empty"});
+  expectThrowsNaming<InputError>([] { parseCsv("t,range\n0.05,nan\n", "m.csv"); }, {"m.csv:2", "nan"});
+  expectThrowsNaming<InputError>([] { parseCsv("t,range\n0.05\n", "m.csv"); }, {"m.csv:2", "1 fields"});
+  expectThrowsNaming<InputError>([] { parseCsv("0.05,1000\n", "m.csv"); }, {"m.csv:1", "header"});
+  expectThrowsNaming<InputError>([] { parseCsv("", "m.csv"); }, {"m.csv", "empty"});
 }
 
 TEST(Config, EstimatorSectionsAreReadAndChecked) {
@@ -141,22 +128,22 @@ TEST(Config, EstimatorSectionsAreReadAndChecked) {
   EXPECT_EQ(estimatorOptions(parsed, *model, Method::PaperWindow).window(), 10);
   EXPECT_EQ(estimatorOptions(parsed, *model, Method::FixedLag).window(), 25);
   ini.set("smoother", "wildfire", "1");
-  expectInputError([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
+  expectThrowsNaming<InputError>([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
                    {"s.ini", "unknown key 'wildfire'", "[smoother]"});
   ini = builtinScenario("paper", 1, 10);
   ini.set("fixed_lag", "window", "0");
-  expectInputError([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
+  expectThrowsNaming<InputError>([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
                    {"s.ini", "[fixed_lag]", "window"});
   ini = builtinScenario("paper", 1, 10);
   ini.set("batch", "algorithm", "newton");
-  expectInputError([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
+  expectThrowsNaming<InputError>([&] { estimatorOptions(IniDocument::parse(ini.toString(), "s.ini"), *model); },
                    {"s.ini", "[batch] algorithm", "'newton'"});
 }
 
 TEST(Config, MethodNamesAreParsedAtTheEdge) {
   EXPECT_EQ(parseMethod("fixed-lag", "option --method"), Method::FixedLag);
   EXPECT_EQ(parseMethod("batch", "option --method"), Method::Batch);
-  expectInputError([] { parseMethod("kalman", "option --method"); },
+  expectThrowsNaming<InputError>([] { parseMethod("kalman", "option --method"); },
                    {"option --method", "'kalman'", "ekf, batch, incremental, fixed-lag, paper-window"});
 }
 

@@ -9,8 +9,10 @@
 
 #include "gssm/core/error.h"
 #include "gssm/io/rtklib_pos.h"
+#include "expect_error.h"
 
 using namespace gssm;
+using gssm::testing::expectThrowsNaming;
 
 namespace {
 // The head of the shipped drive's gnss.pos (RTKLIB's own output), one cross term made negative.
@@ -29,15 +31,6 @@ const std::string kLine2 =
     "0.0000000 0.0000000 0.0000000 0.0000000 0.0000000 0.0010000 0.0020000 -0.0060000 0.0558614 0.0558614 0.0558614 "
     "0.0000000 0.0000000 0.0000000\n";
 
-template <class Fn>
-void expectRefused(Fn fn, const std::string& fragment) {
-  try {
-    fn();
-    FAIL() << "accepted; expected an error naming '" << fragment << "'";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
-}
 }  // namespace
 
 TEST(RtklibPos, GpsTimeOfTheCalendar) {
@@ -98,26 +91,26 @@ TEST(RtklibPos, AWrittenSolutionReadsBack) {
 
 TEST(RtklibPos, EveryUnusableInputIsNamed) {
   const auto parse = [](const std::string& text) { return [text] { io::parseRtklibPos(text, "g.pos"); }; };
-  expectRefused(parse("%  GPST   x-ecef(m)  y-ecef(m)  z-ecef(m)  Q  ns\n2025/07/08 19:34:18.499 1 2 3 1 9\n"),
+  expectThrowsNaming<InputError>(parse("%  GPST   x-ecef(m)  y-ecef(m)  z-ecef(m)  Q  ns\n2025/07/08 19:34:18.499 1 2 3 1 9\n"),
                 "g.pos:2 (the header before it): column 'x-ecef(m)': an ECEF x/y/z solution");
-  expectRefused(parse("%  GPST   e-baseline(m) n-baseline(m) u-baseline(m) Q ns\n2025/07/08 19:34:18.499 1 2 3 1 9\n"),
+  expectThrowsNaming<InputError>(parse("%  GPST   e-baseline(m) n-baseline(m) u-baseline(m) Q ns\n2025/07/08 19:34:18.499 1 2 3 1 9\n"),
                 "east/north/up baseline");
-  expectRefused(parse("%  UTC   latitude(deg) longitude(deg) height(m) Q ns sdn(m) sde(m) sdu(m)\n"
+  expectThrowsNaming<InputError>(parse("%  UTC   latitude(deg) longitude(deg) height(m) Q ns sdn(m) sde(m) sdu(m)\n"
                       "2025/07/08 19:34:00.499 40 -105 1600 1 9 0.01 0.01 0.01\n"),
                 "times are UTC");
-  expectRefused(parse("2025/07/08 19:34:18.499 40 -105 1600 1 9\n"), "expected the column header");
+  expectThrowsNaming<InputError>(parse("2025/07/08 19:34:18.499 40 -105 1600 1 9\n"), "expected the column header");
   std::string bad_lat = kLine1;
   bad_lat.replace(bad_lat.find("40.0966268"), 10, "4O.0966268");  // a letter O
   bad_lat.replace(bad_lat.find("18.499"), 6, "19.000");
-  expectRefused(parse(kHeader + kLine1 + kLine2 + bad_lat), "g.pos:6:3: latitude '4O.0966268' is not a finite number");
-  expectRefused(parse(kHeader + kLine2 + kLine1), "g.pos:5:1: time 2025/07/08 19:34:18.499 is not after");
-  expectRefused(parse(kHeader + kLine1.substr(0, 60) + "\n"), "g.pos:4: 5 fields, the column header has 24");
+  expectThrowsNaming<InputError>(parse(kHeader + kLine1 + kLine2 + bad_lat), "g.pos:6:3: latitude '4O.0966268' is not a finite number");
+  expectThrowsNaming<InputError>(parse(kHeader + kLine2 + kLine1), "g.pos:5:1: time 2025/07/08 19:34:18.499 is not after");
+  expectThrowsNaming<InputError>(parse(kHeader + kLine1.substr(0, 60) + "\n"), "g.pos:4: 5 fields, the column header has 24");
   std::string bad_q = kLine1;
   bad_q.replace(bad_q.find(" 1.0000000 21."), 10, " 9.0000000");
-  expectRefused(parse(kHeader + bad_q), "g.pos:4:6: Q must be 1-6");
-  expectRefused(parse(kHeader + "2025/13/08 19:34:18.499" + kLine1.substr(23)), "g.pos:4:1: date '2025/13/08'");
-  expectRefused(parse(kHeader), "g.pos: no solution lines");
-  expectRefused([] { io::readRtklibPos("/nonexistent/g.pos"); }, "/nonexistent/g.pos: cannot open");
+  expectThrowsNaming<InputError>(parse(kHeader + bad_q), "g.pos:4:6: Q must be 1-6");
+  expectThrowsNaming<InputError>(parse(kHeader + "2025/13/08 19:34:18.499" + kLine1.substr(23)), "g.pos:4:1: date '2025/13/08'");
+  expectThrowsNaming<InputError>(parse(kHeader), "g.pos: no solution lines");
+  expectThrowsNaming<InputError>([] { io::readRtklibPos("/nonexistent/g.pos"); }, "/nonexistent/g.pos: cannot open");
 }
 
 TEST(RtklibPos, ReadsTheDrivesSolutionFile) {
