@@ -1,11 +1,10 @@
 #!/usr/bin/env python3
 """Formats Google Benchmark JSON from gssm_bench_latency as a Markdown table,
 each latency as a ratio to the EKF measured in the same run."""
-import json, sys, datetime, platform, os
+import json, sys, datetime, platform, os, subprocess
 
 data = json.load(open(sys.argv[1]))
 cmd = sys.argv[2]
-import subprocess
 machine = subprocess.run([os.path.join(os.path.dirname(os.path.abspath(__file__)), "machine")],
                          capture_output=True, text=True, check=True).stdout.strip()
 rows = {b["name"]: b for b in data["benchmarks"]}

@@ -2,11 +2,11 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
 
 #include "gssm/core/error.h"
 #include "gssm/io/number_text.h"
 #include "io/byte_order_mark.h"
+#include "io/text_file.h"
 
 namespace gssm::io {
 
@@ -110,18 +110,7 @@ CsvTable parseCsv(const std::string& text, const std::string& source, std::vecto
 }
 
 CsvTable readCsv(const std::string& path, std::vector<CsvRowError>* row_errors) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the file");
-  std::string text;
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size > 0) {
-    text.resize(static_cast<std::size_t>(size));
-    in.seekg(0);
-    in.read(text.data(), size);
-  }
-  if (!in) throw InputError(path + ": read failed");
-  return parseCsv(text, path, row_errors);
+  return parseCsv(readTextFile(path), path, row_errors);
 }
 
 namespace {

@@ -10,6 +10,7 @@
 
 #include "gssm/core/error.h"
 #include "io/byte_order_mark.h"
+#include "io/text_file.h"
 
 namespace gssm::io {
 
@@ -129,11 +130,7 @@ IniDocument IniDocument::parse(const std::string& text, const std::string& sourc
 }
 
 IniDocument IniDocument::load(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), path);
+  return parse(readTextFile(path, "configuration file"), path);
 }
 
 bool IniDocument::hasSection(const std::string& section) const {

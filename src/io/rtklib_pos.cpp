@@ -2,13 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "gssm/core/error.h"
 #include "gssm/io/append_file.h"
 #include "gssm/io/number_text.h"
 #include "io/byte_order_mark.h"
+#include "io/text_file.h"
 
 namespace gssm::io {
 
@@ -221,13 +221,7 @@ GnssSolution parseRtklibPos(const std::string& text, const std::string& source) 
   return out;
 }
 
-GnssSolution readRtklibPos(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseRtklibPos(ss.str(), path);
-}
+GnssSolution readRtklibPos(const std::string& path) { return parseRtklibPos(readTextFile(path), path); }
 
 void writeRtklibPos(const std::string& path, const GnssSolution& solution, const std::string& program) {
   std::string out = "% program   : " + program + "\n% pos mode  : smoothed GSSM solution (" + solution.source +

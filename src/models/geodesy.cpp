@@ -40,7 +40,6 @@ Geodetic toGeodetic(const Eigen::Vector3d& x) {
     const double N = transverseRadius(g.lat);
     const double h = r > 1e-9 ? r / std::cos(g.lat) - N : std::abs(x.z()) - N * (1 - kEccentricity2);
     const double lat = std::atan2(x.z(), r * (1 - kEccentricity2 * N / (N + h)));
-    g.height = h;
     if (std::abs(lat - g.lat) < 1e-14) {
       g.lat = lat;
       break;

@@ -10,15 +10,11 @@ NavFrame::NavFrame(const geodesy::Geodetic& anchor)
   earth_rate_ = geodesy::earthRateNed(anchor.lat);
 }
 
-so3::Vector3 NavFrame::gravity(const so3::Vector3& p) const {
+so3::Vector3 NavFrame::gravity(const so3::Vector3& p, so3::Matrix3* J_g_p) const {
   const geodesy::Geodetic g = local_.toGeodetic(p);
-  return geodesy::normalGravity(g.lat, g.height) * (ecef_to_frame_ * geodesy::nedToEcef(g).col(2));
-}
-
-so3::Matrix3 NavFrame::gravityGradient(const so3::Vector3& p) const {
-  const geodesy::Geodetic g = local_.toGeodetic(p);
-  const double k = geodesy::normalGravity(g.lat, g.height) / (geodesy::transverseRadius(g.lat) + g.height);
-  return k * so3::Vector3(-1, -1, 2).asDiagonal();
+  const double gamma = geodesy::normalGravity(g.lat, g.height);
+  if (J_g_p) *J_g_p = gamma / (geodesy::transverseRadius(g.lat) + g.height) * so3::Vector3(-1, -1, 2).asDiagonal();
+  return gamma * (ecef_to_frame_ * geodesy::nedToEcef(g).col(2));
 }
 
 NavState step(const NavState& x, const so3::Vector3& gyro, const so3::Vector3& accel, const so3::Vector3& bg,
@@ -28,14 +24,15 @@ NavState step(const NavState& x, const so3::Vector3& gyro, const so3::Vector3& a
   const so3::Vector3 a_body = accel - ba;
   Matrix3 Jr_w;
   const Matrix3 dR = so3::Exp((gyro - bg) * dt, J ? &Jr_w : nullptr);
-  const so3::Vector3 a = x.R * a_body + frame.gravity(x.p) - 2 * w_ie.cross(x.v);
+  Matrix3 a_p;  // ∂g/∂p
+  const so3::Vector3 a = x.R * a_body + frame.gravity(x.p, J ? &a_p : nullptr) - 2 * w_ie.cross(x.v);
   NavState n;
   n.R = so3::Exp(-w_ie * dt) * x.R * dR;
   n.v = x.v + a * dt;
   n.p = x.p + x.v * dt + 0.5 * a * dt * dt;
   if (J) {
     // ∂a/∂θ = −R·hat(a_body), ∂a/∂v = −2·hat(ω_ie), ∂a/∂p = ∂g/∂p, ∂a/∂b_a = −R.
-    const Matrix3 a_theta = -x.R * so3::hat(a_body), a_v = -2 * so3::hat(w_ie), a_p = frame.gravityGradient(x.p);
+    const Matrix3 a_theta = -x.R * so3::hat(a_body), a_v = -2 * so3::hat(w_ie);
     const Matrix3 I = Matrix3::Identity();
     J->J_next_x.setZero();
     J->J_next_x.block<3, 3>(0, 0) = dR.transpose();

@@ -38,11 +38,11 @@ class NavFrame {
   /// ω_ie in the frame's axes.
   const so3::Vector3& earthRate() const { return earth_rate_; }
   /// Normal gravity at position p of the frame, along that point's own
-  /// down (which tilts by the distance over the Earth's radius).
-  so3::Vector3 gravity(const so3::Vector3& p) const;
-  /// ∂gravity/∂p: the tilt of the down direction and the height gradient
-  /// (γ/R_E·diag(−1, −1, 2), a spherical Earth's; ellipsoidal terms 0.3 % of it).
-  so3::Matrix3 gravityGradient(const so3::Vector3& p) const;
+  /// down (which tilts by the distance over the Earth's radius); J_g_p the
+  /// tilt of the down direction and the height gradient (γ/R_E·diag(−1, −1,
+  /// 2), a spherical Earth's; ellipsoidal terms 0.3 % of it), from the same
+  /// geodetic point (one iteration of the coordinates per IMU sample).
+  so3::Vector3 gravity(const so3::Vector3& p, so3::Matrix3* J_g_p = nullptr) const;
 
  private:
   geodesy::LocalFrame local_;
