@@ -15,6 +15,7 @@
 #include "gssm/io/config.h"
 #include "gssm/learn/noise_learning.h"
 #include "gssm/model/simulation.h"
+#include "gssm/model/colored_noise.h"
 #include "gssm/models/planar_rigid_body.h"
 #include "jacobian_check.h"
 
@@ -41,8 +42,10 @@ TEST(PlanarRigidBody, AnalyticJacobiansMatchCentralDifferencesOnEveryLink) {
     const bool scale = variant == 1, errors = variant == 2;
     PlanarRigidBody::Params p = uwbLayout();
     p.range_scale = scale;
-    p.range_error_tau = errors ? 0.3 : 0.0;  // a Gauss–Markov error state per link
-    const PlanarRigidBody model(p);
+    ColoredNoise gm;  // a Gauss–Markov error state per link
+    if (errors) gm.channels = {"all"}, gm.tau = 0.3, gm.sd = 0.05;
+    const std::unique_ptr<Model> wrapped = withColoredNoise(std::make_unique<PlanarRigidBody>(p), gm);
+    const Model& model = *wrapped;
     ASSERT_EQ(model.numChannels(), 24);
     ASSERT_EQ(model.dims().nb, 24 + (scale ? 1 : 0));
     ASSERT_EQ(model.dims().nc, errors ? 30 : 6);
@@ -95,40 +98,29 @@ TEST(PlanarRigidBody, RoundTripsThroughItsIniForm) {
   EXPECT_EQ(q.bias_common_sd, 0.4);
 }
 
-// Each link's Gauss–Markov range error: x' = φx with φ = exp(−dt/τ) and
-// process noise σ_e²(1 − φ²), so its stationary σ stays σ_e (the prior's);
-// it adds to its own link's range only.
-TEST(PlanarRigidBody, RangeErrorStatesAreFirstOrderGaussMarkov) {
-  PlanarRigidBody::Params p = uwbLayout();
-  p.range_error_tau = 0.3;
-  p.range_error_sd = 0.05;
-  const PlanarRigidBody model(p);
-  EXPECT_EQ(model.names().state[6], "err_0_0");
-  EXPECT_EQ(model.names().state[29], "err_2_7");
-  const double dt = 0.013, phi = std::exp(-dt / 0.3);
-  const Eigen::MatrixXd Q = model.processNoise(dt);
-  const Eigen::MatrixXd P0 = model.priorState().covariance;
-  for (int i = 6; i < 30; ++i) {
-    EXPECT_NEAR(Q(i, i), 0.05 * 0.05 * (1 - phi * phi), 1e-15);
-    EXPECT_NEAR(phi * P0(i, i) * phi + Q(i, i), P0(i, i), 1e-15);  // stationary
-  }
+// A link's Gauss–Markov range error (the general mechanism,
+// test_colored_noise.cpp) adds to its own link's range only.
+TEST(PlanarRigidBody, ColoredNoiseIsPerLink) {
+  ColoredNoise gm;
+  gm.channels = {"all"}, gm.tau = 0.3, gm.sd = 0.05;
+  const std::unique_ptr<Model> model = withColoredNoise(std::make_unique<PlanarRigidBody>(uwbLayout()), gm);
+  const auto& body = dynamic_cast<const PlanarRigidBody&>(withoutColoredNoise(*model));
+  EXPECT_EQ(model->names().state[6], "err_range_0_0");
+  EXPECT_EQ(model->names().state[29], "err_range_2_7");
   Eigen::VectorXd xc = Eigen::VectorXd::Zero(30), xb = Eigen::VectorXd::Zero(24);
   xc.head<3>() << 0.5, -0.3, 0.4;
-  const int c = model.channelOf(1, 3);
-  const double r0 = model.h(c, xc, xb)[0];
+  const int c = body.channelOf(1, 3);
+  const double r0 = model->h(c, xc, xb)[0];
   xc[6 + c] = 0.02;
-  EXPECT_NEAR(model.h(c, xc, xb)[0], r0 + 0.02, 1e-15);
+  EXPECT_NEAR(model->h(c, xc, xb)[0], r0 + 0.02, 1e-15);
   Eigen::VectorXd no_errors = xc;
   no_errors.tail(24).setZero();
-  EXPECT_EQ(model.h(model.channelOf(0, 0), xc, xb)[0], model.h(model.channelOf(0, 0), no_errors, xb)[0]);
-  EXPECT_NEAR(model.f(xc, xb, Eigen::VectorXd(0), dt)[6 + c], phi * 0.02, 1e-15);
+  EXPECT_EQ(model->h(body.channelOf(0, 0), xc, xb)[0], model->h(body.channelOf(0, 0), no_errors, xb)[0]);
   io::IniDocument ini;
-  io::writeModel(model, ini);
+  io::writeModel(*model, ini);
   const auto again = io::makeModel(io::IniDocument::parse(ini.toString(), "uwb.ini"));
   EXPECT_EQ(again->dims().nc, 30);
-  EXPECT_EQ(again->noise().Q, model.noise().Q);
-  p.range_error_tau = -1;
-  EXPECT_THROW(PlanarRigidBody{p}, gssm::InvalidArgument);
+  EXPECT_EQ(again->noise().Q, model->noise().Q);
 }
 
 // b_ij = c + d_ij marginalized: bias_sd²·I + bias_common_sd²·11ᵀ on the

@@ -92,8 +92,9 @@ def test_planar_rigid_body_from_keywords_and_from_the_uwb_log(repo):
     assert np.all(np.abs(run.mean[-1, 6:] - data.truth_x[-1, 6:]) < 4 * run.sd[-1, 6:])
     # A part every link shares in the bias prior; a Gauss-Markov error state per link.
     shared = gssm.models.PlanarRigidBody(anchors=anchors, tags=tags, height=1.0, prior_bias_sd=0.05, prior_bias_common_sd=0.4,
-                                         range_error_tau=0.2)
-    assert shared.nc == 12 and shared.state_names[6] == "err_0_0"
+                                         colored_noise_channels=["all"], colored_noise_tau=0.2)
+    assert shared.nc == 12 and shared.state_names[6] == "err_range_0_0"
+    assert isinstance(shared, gssm.models.PlanarRigidBody) and shared.name == "planar_rigid_body"
     P = 0.05 ** 2 * np.eye(6) + 0.4 ** 2
     np.testing.assert_allclose(shared.prior_constants[1], P, atol=1e-15)
     spread = gssm.learn(m, data, parameters=["bias_sd"], start=0.3)

@@ -5,6 +5,7 @@
 #include <mutex>
 
 #include "gssm/core/error.h"
+#include "gssm/model/colored_noise.h"
 
 namespace gssm {
 
@@ -35,6 +36,20 @@ void requireComplete(const ModelType& t) {
       if (t.params[i].pythonKey() == t.params[j].pythonKey())
         throw InvalidArgument("registerModelType '" + t.name + "': parameter '" + t.params[i].pythonKey() +
                               "' declared twice");
+}
+// Every type takes coloured measurement noise on any of its channels
+// (docs/DESIGN.md §9): the [colored_noise] keys, the wrapper applied after
+// its own read, its own write and owns seeing through the wrapper.
+ModelType takingColoredNoise(ModelType t) {
+  if (t.param("colored_noise", "channels")) return t;
+  for (auto& p : coloredNoiseParams()) t.params.push_back(std::move(p));
+  t.read = [read = std::move(t.read)](const ParamSource& in) { return withColoredNoise(read(in), readColoredNoise(in)); };
+  t.write = [write = std::move(t.write)](const Model& m, ParamSink& out) {
+    write(withoutColoredNoise(m), out);
+    if (const ColoredNoise* c = coloredNoiseOf(m)) writeColoredNoise(*c, out);
+  };
+  t.owns = [owns = std::move(t.owns)](const Model& m) { return owns(withoutColoredNoise(m)); };
+  return t;
 }
 }  // namespace
 
@@ -74,6 +89,7 @@ std::vector<std::string> ModelType::keysOf(const std::string& section) const {
 
 void registerModelType(ModelType type) {
   requireComplete(type);
+  type = takingColoredNoise(std::move(type));
   Registry& r = registry();
   const std::lock_guard<std::mutex> lock(r.mutex);
   for (const auto& t : r.types) {

@@ -14,19 +14,12 @@ std::string linkName(const PlanarRigidBody::Params& p, std::size_t i, std::size_
   return std::to_string(p.tag_ids[i]) + "_" + std::to_string(p.anchor_ids[j]);
 }
 
-int countLinks(const PlanarRigidBody::Params& p) { return static_cast<int>(p.tags.size() * p.anchors.size()); }
-// x_c: the body's six, then one range error per link when they are states.
-int countStates(const PlanarRigidBody::Params& p) { return 6 + (p.range_error_tau > 0 ? countLinks(p) : 0); }
-
 int countConstants(const PlanarRigidBody::Params& p) {
   return (p.link_biases ? static_cast<int>(p.tags.size() * p.anchors.size()) : 0) + (p.range_scale ? 1 : 0);
 }
 
 ModelNames bodyNames(const PlanarRigidBody::Params& p) {
   ModelNames n{{"px", "py", "yaw", "vx", "vy", "omega"}, {}, {}, {}};
-  if (p.range_error_tau > 0)
-    for (std::size_t i = 0; i < p.tags.size(); ++i)
-      for (std::size_t j = 0; j < p.anchors.size(); ++j) n.state.push_back("err_" + linkName(p, i, j));
   if (p.link_biases)
     for (std::size_t i = 0; i < p.tags.size(); ++i)
       for (std::size_t j = 0; j < p.anchors.size(); ++j) n.constants.push_back("bias_" + linkName(p, i, j));
@@ -35,16 +28,10 @@ ModelNames bodyNames(const PlanarRigidBody::Params& p) {
   return n;
 }
 
-// q²·[[dt³/3, dt²/2], [dt²/2, dt]] on each (position, rate) pair; with
-// range-error states σ_e²(1 − φ²), φ = exp(−dt/τ), on each (stationary σ_e).
+// q²·[[dt³/3, dt²/2], [dt²/2, dt]] on each (position, rate) pair.
 Eigen::MatrixXd bodyProcessNoise(const PlanarRigidBody::Params& p, double dt) {
   const double q_xy = p.accel_sd, q_yaw = p.yaw_accel_sd;
-  const int n = countStates(p);
-  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(n, n);
-  if (n > 6) {
-    const double phi = std::exp(-dt / p.range_error_tau);
-    Q.bottomRightCorner(n - 6, n - 6).diagonal().setConstant(p.range_error_sd * p.range_error_sd * (1 - phi * phi));
-  }
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(6, 6);
   for (int i = 0; i < 3; ++i) {
     const double a = (i < 2 ? q_xy : q_yaw) * (i < 2 ? q_xy : q_yaw);
     Q(i, i) = a * dt * dt * dt / 3;
@@ -58,20 +45,17 @@ ModelNoise bodyNoise(const PlanarRigidBody::Params& p) {
   if (p.tags.empty() || p.anchors.empty() || p.tags.size() != p.tag_ids.size() || p.anchors.size() != p.anchor_ids.size())
     throw InvalidArgument("PlanarRigidBody: need at least one tag and one anchor, each with an id");
   for (double v : {p.accel_sd, p.yaw_accel_sd, p.range_sd, p.position_sd, p.yaw_sd, p.velocity_sd, p.omega_sd,
-                   p.bias_sd, p.range_scale_sd, p.T, p.range_error_sd})
+                   p.bias_sd, p.range_scale_sd, p.T})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("PlanarRigidBody: every σ and T must be > 0");
-  if (!(p.range_error_tau >= 0) || !std::isfinite(p.range_error_tau))
-    throw InvalidArgument("PlanarRigidBody: range_error_tau must be >= 0 (0: white range noise, no error states)");
   if (!(p.bias_common_sd >= 0) || !std::isfinite(p.bias_common_sd))
     throw InvalidArgument("PlanarRigidBody: bias_common_sd must be >= 0 (0: the links' biases independent)");
   ModelNoise n;
   n.T = p.T;
   n.Q = bodyProcessNoise(p, p.T);
   n.R = Eigen::MatrixXd::Constant(1, 1, p.range_sd * p.range_sd);
-  const int nc = countStates(p);
-  Eigen::VectorXd mean = Eigen::VectorXd::Zero(nc), sd = Eigen::VectorXd::Constant(nc, p.range_error_sd);
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(6), sd(6);
   mean.head<3>() = p.start;
-  sd.head<6>() << p.position_sd, p.position_sd, p.yaw_sd, p.velocity_sd, p.velocity_sd, p.omega_sd;
+  sd << p.position_sd, p.position_sd, p.yaw_sd, p.velocity_sd, p.velocity_sd, p.omega_sd;
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
   const int nb = countConstants(p);
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(nb), bsd = Eigen::VectorXd::Constant(nb, p.bias_sd);
@@ -87,7 +71,7 @@ ModelNoise bodyNoise(const PlanarRigidBody::Params& p) {
 }  // namespace
 
 PlanarRigidBody::PlanarRigidBody(const Params& p)
-    : Model({countStates(p), countConstants(p), 0, 1}, bodyNames(p), bodyNoise(p)), p_(p) {
+    : Model({6, countConstants(p), 0, 1}, bodyNames(p), bodyNoise(p)), p_(p) {
   int i = 0;
   if (p.link_biases) {
     i_bias_ = i;
@@ -128,7 +112,7 @@ Eigen::VectorXd PlanarRigidBody::meanTrueDistances(const Truth& truth) const {
   const Eigen::VectorXd xb0 = priorConstants().mean;  // biases 0, scale 1: h is the geometric range
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(numChannels());
   for (const auto& row : truth.states) {  // the truth's components into x_c (velocities do not enter h)
-    Eigen::VectorXd xc = Eigen::VectorXd::Zero(dims().nc);
+    Eigen::VectorXd xc = Eigen::VectorXd::Zero(6);
     for (Eigen::Index i = 0; i < row.size(); ++i) {
       const int k = truth.components.empty() ? static_cast<int>(i) : truth.components[static_cast<std::size_t>(i)];
       if (k < 6) xc[k] = row[i];
@@ -177,17 +161,13 @@ std::vector<std::string> PlanarRigidBody::bodyPointNames() const {
 Eigen::VectorXd PlanarRigidBody::f(const Eigen::VectorXd& xc, const Eigen::VectorXd& /*xb*/,
                                    const Eigen::VectorXd& /*u*/, double dt, Eigen::MatrixXd* J_f_xc,
                                    Eigen::MatrixXd* J_f_xb) const {
-  const int nc = dims().nc;
-  const double phi = nc > 6 ? std::exp(-dt / p_.range_error_tau) : 1.0;  // first-order Gauss–Markov errors
   Eigen::VectorXd out = xc;
   out.head<3>() += dt * xc.segment<3>(3);
-  out.tail(nc - 6) *= phi;
   if (J_f_xc) {
-    *J_f_xc = Eigen::MatrixXd::Identity(nc, nc);
+    *J_f_xc = Eigen::MatrixXd::Identity(6, 6);
     J_f_xc->block<3, 3>(0, 3).diagonal().setConstant(dt);
-    J_f_xc->bottomRightCorner(nc - 6, nc - 6).diagonal().setConstant(phi);
   }
-  if (J_f_xb) *J_f_xb = Eigen::MatrixXd::Zero(nc, dims().nb);
+  if (J_f_xb) *J_f_xb = Eigen::MatrixXd::Zero(6, dims().nb);
   return out;
 }
 
@@ -220,8 +200,7 @@ void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen:
   const double scale = i_scale_ >= 0 ? xb[i_scale_] : 1.0;
   const int ib = biasIndex(channel);
   if (J_h_xc) {
-    *J_h_xc = Eigen::MatrixXd::Zero(1, dims().nc);
-    if (dims().nc > 6) (*J_h_xc)(0, 6 + channel) = 1.0;
+    *J_h_xc = Eigen::MatrixXd::Zero(1, 6);
     if (rho > 0) {
       (*J_h_xc)(0, 0) = scale * d.x() / rho;
       (*J_h_xc)(0, 1) = scale * d.y() / rho;
@@ -233,9 +212,8 @@ void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen:
     if (ib >= 0) (*J_h_xb)(0, ib) = 1.0;
     if (i_scale_ >= 0) (*J_h_xb)(0, i_scale_) = rho;
   }
-  const double error = dims().nc > 6 ? xc[6 + channel] : 0.0;
   out.resize(1);
-  out[0] = scale * rho + (ib >= 0 ? xb[ib] : 0.0) + error;
+  out[0] = scale * rho + (ib >= 0 ? xb[ib] : 0.0);
 }
 
 Eigen::MatrixXd PlanarRigidBody::processNoise(double dt) const {
@@ -254,8 +232,6 @@ std::vector<ParamSpec> bodyParams() {
       learnable(real("model", "yaw_accel_sd", "white angular acceleration, rad/s² per √Hz")),
       learnable(real("model", "range_sd", "σ of one range (m)")),
       flag("model", "link_biases", "estimate a bias per link (bias_<tag>_<anchor>)"),
-      real("model", "range_error_tau", "> 0: each link's range error a first-order Gauss–Markov state err_<tag>_<anchor> with this time constant (s); range_sd is then its white part"),
-      real("model", "range_error_sd", "stationary σ of each link's Gauss–Markov range error (m)"),
       flag("model", "range_scale", "estimate a common range scale")};
   for (auto& l : lossParams("model")) p.push_back(l);
   for (auto& q : {real("model", "ekf_gate", "EKF NIS gate of every range (0: none)"),
@@ -286,8 +262,7 @@ PlanarRigidBody::Params readBody(const ParamSource& in) {
   readPoints(in, "anchors", "anchor", p.anchor_ids, p.anchors);
   readPoints(in, "tags", "tag", p.tag_ids, p.tags);
   for (auto [key, value] : {std::pair{"T", &p.T}, {"height", &p.height}, {"accel_sd", &p.accel_sd},
-                            {"yaw_accel_sd", &p.yaw_accel_sd}, {"range_sd", &p.range_sd}, {"ekf_gate", &p.ekf_gate},
-                            {"range_error_tau", &p.range_error_tau}, {"range_error_sd", &p.range_error_sd}})
+                            {"yaw_accel_sd", &p.yaw_accel_sd}, {"range_sd", &p.range_sd}, {"ekf_gate", &p.ekf_gate}})
     *value = in.real("model", key, *value);
   p.link_biases = in.flag("model", "link_biases", p.link_biases);
   p.range_scale = in.flag("model", "range_scale", p.range_scale);
@@ -317,8 +292,7 @@ void writeBody(const PlanarRigidBody::Params& p, ParamSink& out) {
   out.matrix("model", "anchors", pointRows(p.anchor_ids, p.anchors));
   out.matrix("model", "tags", pointRows(p.tag_ids, p.tags));
   for (auto [key, value] : {std::pair{"height", p.height}, {"accel_sd", p.accel_sd}, {"yaw_accel_sd", p.yaw_accel_sd},
-                            {"range_sd", p.range_sd}, {"range_error_tau", p.range_error_tau},
-                            {"range_error_sd", p.range_error_sd}})
+                            {"range_sd", p.range_sd}})
     out.real("model", key, value);
   out.flag("model", "link_biases", p.link_biases);
   out.flag("model", "range_scale", p.range_scale);

@@ -39,7 +39,7 @@ struct ParamSpec {
   std::vector<std::string> columns;  ///< Table: its data file's columns, in order
   std::string subsection;   ///< Sections: the prefix of its sub-sections ("channel")
   /// A noise level learning may fit (docs/DESIGN.md §10): a Real is a
-  /// standard deviation (> 0, in its unit); a Matrix a covariance whose
+  /// standard deviation or a correlation time (> 0, searched in its log); a Matrix a covariance whose
   /// diagonal scales are fitted (each entry a variance, correlations kept).
   bool learnable = false;
   /// A learnable σ of the constants' prior (their spread across links,

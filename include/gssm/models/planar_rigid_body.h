@@ -29,12 +29,8 @@ class PlanarRigidBody final : public Model {
     double height = 0.0;                    ///< the body origin's known height (m)
     double accel_sd = 1.0;                  ///< white acceleration, m/s² per √Hz, each axis
     double yaw_accel_sd = 1.0;              ///< white angular acceleration, rad/s² per √Hz
-    double range_sd = 0.07;                 ///< σ of one range (m): its white part with error states
-    /// > 0: each link's range error is a first-order Gauss–Markov state
-    /// (err_<tag>_<anchor>, appended to x_c) with this time constant (s) and
-    /// stationary σ range_error_sd; 0: the range noise is white.
-    double range_error_tau = 0.0;
-    double range_error_sd = 0.05;
+    /// σ of one range (m); with [colored_noise] on the links, its white part
+    double range_sd = 0.07;
     bool link_biases = true;                ///< a bias per link
     bool range_scale = false;               ///< a common range scale
     RobustLoss range_loss;                  ///< on every range
