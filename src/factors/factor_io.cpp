@@ -67,7 +67,12 @@ FactorPtr readFactor(ByteReader& in, const Model& model, const std::string& what
       if (static_cast<FactorTag>(tag) == FactorTag::PriorWithAngles) angles = in.ints(what + " angle components");
       for (int a : angles)
         if (a < 0 || a >= g.mean.size()) in.fail(what + ": angle component " + std::to_string(a) + " out of range");
-      return std::make_shared<PriorFactor>(k, g, std::move(angles));
+      // Its rotation blocks are the model's in its variable (every prior is on a state or on x_b).
+      std::vector<int> rotations;
+      const int nc = model.dims().nc;
+      for (int b : model.rotationBlocks())
+        if (k.isConstants() ? b >= nc : b < nc) rotations.push_back(k.isConstants() ? b - nc : b);
+      return std::make_shared<PriorFactor>(k, g, std::move(angles), std::move(rotations));
     }
     case FactorTag::Process: {
       const std::int64_t k = in.i64((what + " step").c_str());

@@ -4,6 +4,7 @@
 
 #include "gssm/core/angles.h"
 #include "gssm/core/error.h"
+#include "gssm/core/rotation_blocks.h"
 #include "factors/model_factors.h"
 
 namespace gssm {
@@ -86,22 +87,26 @@ double FactorGraph::cost(const Values& x) const {
 }
 
 // ---- PriorFactor -------------------------------------------------------------
-PriorFactor::PriorFactor(Key key, const Gaussian& prior, std::vector<int> angles)
+PriorFactor::PriorFactor(Key key, const Gaussian& prior, std::vector<int> angles, std::vector<int> rotations)
     : Factor({key}, static_cast<int>(prior.mean.size())),
       mean_(prior.mean),
       noise_(prior.covariance, "prior on " + key.toString()),
-      angles_(std::move(angles)) {
+      angles_(std::move(angles)),
+      rotations_(std::move(rotations)) {
   requireVector(prior.mean, noise_.dim(), "prior mean of " + key.toString());
 }
 
 void PriorFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                               std::vector<Eigen::MatrixXd>* J) const {
-  r = *x[0] - mean_;
+  std::vector<Eigen::Matrix3d> J_r_x;  // per rotation block: r = x ⊖ mean there
+  if (rotations_.empty()) r = *x[0] - mean_;
+  else localBlocks(*x[0], mean_, r, rotations_, 0, J ? &J_r_x : nullptr);
   wrapAngles(r, angles_);
   noise_.whitenInPlace(r);
   if (J) {
     J->resize(1);
     (*J)[0].setIdentity(dim(), dim());  // whitened in place: L⁻¹ (1/σ for independent components), no temporaries
+    if (!J_r_x.empty()) premultiplyBlocks((*J)[0], J_r_x, rotations_);
     noise_.whitenInPlace((*J)[0]);
   }
 }
@@ -166,17 +171,40 @@ void internal::processResidual(const Model& model, const Eigen::VectorXd& u, dou
   if (J) J->resize(has_constants ? 3 : 2);
   Eigen::MatrixXd* J_f_xc = J ? &(*J)[0] : nullptr;
   Eigen::MatrixXd* J_f_xb = J ? (has_constants ? &(*J)[2] : &no_constants) : nullptr;
-  r = xk1 - model.f(xk, xb, u, dt, J_f_xc, J_f_xb);
+  const std::vector<int>& rot = model.rotationBlocks();
+  std::vector<Eigen::Matrix3d> J_r_next, J_r_f;  // per rotation block (none: nothing allocated)
+  if (!hasRotationIn(rot, model.dims().nc)) {
+    r = xk1 - model.f(xk, xb, u, dt, J_f_xc, J_f_xb);
+  } else {  // r = x_c(k+1) ⊖ f on the rotation blocks (docs/DESIGN.md §12)
+    localBlocks(xk1, model.f(xk, xb, u, dt, J_f_xc, J_f_xb), r, rot, 0, J ? &J_r_next : nullptr,
+                J ? &J_r_f : nullptr);
+    // J_r_f = −Jr⁻¹(−r) on a block: its rows of J_f become Jr⁻¹(−r)·J_f, negated below with the rest.
+    for (auto& M : J_r_f) M = -M;
+    if (J) premultiplyBlocks(*J_f_xc, J_r_f, rot);
+    if (J && has_constants) premultiplyBlocks(*J_f_xb, J_r_f, rot);
+  }
   wrapAngles(r, model.angleStates());  // stacked indices below n_c are x_c's
   noise.whitenInPlace(r);
   if (J) {
     const int nc = model.dims().nc;
     (*J)[0] *= -1.0;
     (*J)[1].setIdentity(nc, nc);
+    if (!J_r_next.empty()) premultiplyBlocks((*J)[1], J_r_next, rot);
     if (has_constants) (*J)[2] *= -1.0;
     for (auto& block : *J) noise.whitenInPlace(block);
   }
 }
+
+namespace {
+// The model's rotation blocks in a factor's variable: x_c from 0, x_b from n_c.
+Factor::Rotations modelRotations(const Model& model, bool constants) {
+  if (model.rotationBlocks().empty()) return {};
+  return {&model.rotationBlocks(), constants ? model.dims().nc : 0};
+}
+}  // namespace
+
+Factor::Rotations ProcessFactor::rotationsOf(std::size_t a) const { return modelRotations(*model_, a == 2); }
+Factor::Rotations MeasurementFactor::rotationsOf(std::size_t a) const { return modelRotations(*model_, a == 1); }
 
 void ProcessFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                                 std::vector<Eigen::MatrixXd>* J) const {

@@ -85,6 +85,10 @@ class ColoredNoiseModel final : public Model {
     for (int& i : angles)
       if (i >= a_.inner_nc) i += a_.count;  // a constant: after the error states
     setAngleStates(std::move(angles));
+    std::vector<int> rotations = inner_->rotationBlocks();
+    for (int& i : rotations)
+      if (i >= a_.inner_nc) i += a_.count;
+    setRotationBlocks(std::move(rotations));
   }
 
   const Model& inner() const { return *inner_; }

@@ -8,6 +8,7 @@
 
 #include "gssm/core/angles.h"
 #include "gssm/core/error.h"
+#include "gssm/core/rotation_blocks.h"
 #include "model/central_differences.h"
 
 namespace gssm {
@@ -133,8 +134,25 @@ void Model::setAngleStates(std::vector<int> stacked_components) {
   angle_states_ = std::move(stacked_components);
 }
 
+void Model::setRotationBlocks(std::vector<int> first_components) {
+  std::sort(first_components.begin(), first_components.end());
+  const int nc = dims_.nc, n = nc + dims_.nb;
+  for (std::size_t i = 0; i < first_components.size(); ++i) {
+    const int b = first_components[i];
+    const std::string what = "model: rotation block at stacked component " + std::to_string(b);
+    if (b < 0 || b + 3 > n || (b < nc && b + 3 > nc))
+      throw InvalidArgument(what + " does not fit in x_c (" + std::to_string(nc) + ") or x_b (" +
+                            std::to_string(dims_.nb) + ")");
+    if (i > 0 && first_components[i - 1] + 3 > b) throw InvalidArgument(what + " overlaps the block before it");
+    for (int a : angle_states_)
+      if (a >= b && a < b + 3) throw InvalidArgument(what + " holds angle component " + std::to_string(a));
+  }
+  rotation_blocks_ = std::move(first_components);
+}
+
 Eigen::VectorXd Model::wrapStacked(Eigen::VectorXd z) const {
   wrapAngles(z, angle_states_);
+  normalizeBlocks(z, rotation_blocks_);
   return z;
 }
 
@@ -198,16 +216,22 @@ JacobianCheck checkJacobians(const Model& model, const Eigen::VectorXd& xc,
   const ModelDims& d = model.dims();
   JacobianCheck out;
   Eigen::MatrixXd J_f_xc, J_f_xb, J_h_xc, J_h_xb;
+  // On the tangents: x moved by ⊕, f's values compared by ⊖ (rotation blocks).
+  const std::vector<int>& rot = model.rotationBlocks();
+  const int nc = d.nc;
+  auto differences = [&](auto g, const Eigen::VectorXd& x, Eigen::Index rows, int in_offset, bool out_state) {
+    return internal::tangentDifferences(g, x, rows, eps, rot, in_offset, out_state ? rot : std::vector<int>{}, 0);
+  };
   model.f(xc, xb, u, dt, &J_f_xc, &J_f_xb);
-  compare(J_f_xc, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.f(v, xb, u, dt); }, xc, d.nc, eps), "J_f_xc", out);
-  compare(J_f_xb, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.f(xc, v, u, dt); }, xb, d.nc, eps), "J_f_xb", out);
+  compare(J_f_xc, differences([&](const Eigen::VectorXd& v) { return model.f(v, xb, u, dt); }, xc, nc, 0, true), "J_f_xc", out);
+  compare(J_f_xb, differences([&](const Eigen::VectorXd& v) { return model.f(xc, v, u, dt); }, xb, nc, nc, true), "J_f_xb", out);
   // Every channel's h (channel 0 is the default h).
   for (int c = 0; c < model.numChannels(); ++c) {
     const int ny = model.channel(c).dim();
     const std::string at = c == 0 ? "" : "[" + model.channel(c).name + "]";
     model.h(c, xc, xb, &J_h_xc, &J_h_xb);
-    compare(J_h_xc, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.h(c, v, xb); }, xc, ny, eps), "J_h_xc" + at, out);
-    compare(J_h_xb, internal::centralDifferences([&](const Eigen::VectorXd& v) { return model.h(c, xc, v); }, xb, ny, eps), "J_h_xb" + at, out);
+    compare(J_h_xc, differences([&](const Eigen::VectorXd& v) { return model.h(c, v, xb); }, xc, ny, 0, false), "J_h_xc" + at, out);
+    compare(J_h_xb, differences([&](const Eigen::VectorXd& v) { return model.h(c, xc, v); }, xb, ny, nc, false), "J_h_xb" + at, out);
   }
   return out;
 }

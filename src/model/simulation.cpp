@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 
 #include "gssm/core/angles.h"
+#include "gssm/core/rotation_blocks.h"
 #include "gssm/core/error.h"
 
 namespace gssm {
@@ -22,12 +23,16 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
   const ModelDims& d = model.dims();
   SimulatedRun run;
   // Draw order is fixed (x0, xb, then per step q then r) so a seed gives one run.
-  run.states.push_back(spec.x0 ? *spec.x0
-                               : sampleGaussian(model.priorState().mean,
-                                                model.priorState().covariance, draw));
-  run.constants = spec.xb ? *spec.xb
-                          : sampleGaussian(model.priorConstants().mean,
-                                           model.priorConstants().covariance, draw);
+  // x ~ mean ⊕ N(0, P) on the rotation blocks (docs/DESIGN.md §12), mean + N(0, P) elsewhere.
+  const std::vector<int>& rot = model.rotationBlocks();
+  auto around = [&](const Gaussian& g, int offset) {
+    if (!hasRotationIn(rot, g.mean.size(), offset)) return sampleGaussian(g.mean, g.covariance, draw);
+    Eigen::VectorXd x = g.mean;
+    retractBlocks(x, sampleGaussian(Eigen::VectorXd::Zero(g.mean.size()), g.covariance, draw), rot, offset);
+    return x;
+  };
+  run.states.push_back(spec.x0 ? *spec.x0 : around(model.priorState(), 0));
+  run.constants = spec.xb ? *spec.xb : around(model.priorConstants(), d.nc);
   requireVector(run.states[0], d.nc, "simulate: true x_c(0)");
   requireVector(run.constants, d.nb, "simulate: true x_b");
   const double T = model.nominalStep();
@@ -41,7 +46,7 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
     requireVector(u, d.nu, "simulate: input at t = " + std::to_string(t_prev));
     if (spec.input) run.inputs.push_back({t_prev, u});
     Eigen::VectorXd x = model.f(run.states.back(), run.constants, u, T);
-    if (spec.process_noise) x += sampleGaussian(zc, model.processNoiseOf(T, u), draw);
+    if (spec.process_noise) retractBlocks(x, sampleGaussian(zc, model.processNoiseOf(T, u), draw), rot);
     wrapAngles(x, model.angleStates());  // stacked indices below n_c are x_c's
     const double t = k * T;
     if (k % spec.measure_every == 0) {

@@ -522,9 +522,10 @@ struct BatchSolver::Impl::Iteration {
   // steps.
   Eigen::VectorXd x_before;
   bool factored_at_solution = false;  // the last step kept its factorization (relinearize_at_solution false)
+  const internal::Retraction retraction;  // x ⊕ δ on rotation blocks (docs/DESIGN.md §12)
 
   Iteration(Impl& impl, const BatchSolverOptions& o, const FactorGraph& gr, Values& values, BatchSolverSummary& summary)
-      : s(impl), options(o), graph(gr), x(values), sum(summary) {
+      : s(impl), options(o), graph(gr), x(values), sum(summary), retraction(internal::Retraction::of(gr, values)) {
     cost = s.linearize(graph, x, g, diag);
     sum.initial_cost = cost;
   }
@@ -572,7 +573,7 @@ struct BatchSolver::Impl::Iteration {
     const double predicted = -0.5 * g.dot(delta);  // the Gauss–Newton model's decrease
     if (!options.relinearize_at_solution && policy.undamped() && predicted <= options.relative_cost_tolerance * cost) {
       internal::flatten(x, s.factored_point);
-      internal::addStep(x, delta, x);  // the last step: H as factored stays the solution's
+      internal::addStep(x, delta, x, &retraction);  // the last step: H as factored stays the solution's
       ++sum.iterations;
       cost -= predicted;
       factored_at_solution = true;
@@ -581,7 +582,7 @@ struct BatchSolver::Impl::Iteration {
     }
     if (stepConverged(delta, x)) {
       if (policy.undamped()) {  // a tiny undamped step is still the exact correction: take it
-        internal::addStep(x, delta, x);
+        internal::addStep(x, delta, x, &retraction);
         cost = s.linearize(graph, x, g, diag);
       }
       return !converge(Termination::StepConverged);
@@ -592,7 +593,7 @@ struct BatchSolver::Impl::Iteration {
   // x ⊕ δ, kept if the policy accepts its cost; false when the solve is done.
   bool tryStep() {
     internal::flatten(x, x_before);
-    internal::addStep(x, delta, x);
+    internal::addStep(x, delta, x, &retraction);
     // Linearize at the candidate right away (its cost comes with it): one
     // pass over the factors per accepted step instead of two; a rejected
     // step refills H, g and the diagonal at the point it goes back to (so
@@ -687,7 +688,8 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   } restore{values, start_flat};
   Impl::Iteration it(s, options_, graph, values, sum);
   it.run();
-  if (isConverged(sum.termination) && options_.newton_polish_steps > 0) it.polish();
+  // The polish's curvature differences are taken in +: not on rotation blocks.
+  if (isConverged(sum.termination) && options_.newton_polish_steps > 0 && it.retraction.trivial()) it.polish();
   if (!it.factored_at_solution) {
     it.factorAtSolution();
     internal::flatten(values, s.factored_point);

@@ -13,10 +13,27 @@
 #include <unordered_set>
 
 #include "gssm/core/error.h"
+#include "gssm/core/rotation_blocks.h"
+#include "gssm/core/so3.h"
 #include "linear/dot.h"
 #include "solvers/newton.h"
 
 namespace gssm::internal {
+
+namespace {
+// J ← J·Jr(δ̂) on each rotation block's columns: the Jacobian of a factor
+// in the chart x = anchor ⊕ δ of its variable at δ̂.
+void chartJacobian(const std::vector<int>& blocks, int offset, const Eigen::Ref<const Eigen::VectorXd>& delta,
+                   Eigen::MatrixXd& J) {
+  if (!hasRotationIn(blocks, delta.size(), offset)) return;
+  std::vector<Eigen::Matrix3d> Jr;
+  for (int b : blocks) {
+    const Eigen::Index j = b - offset;
+    if (j >= 0 && j + 3 <= delta.size()) Jr.push_back(so3::rightJacobian(delta.segment<3>(j)));
+  }
+  postmultiplyBlocks(J, Jr, blocks, offset);
+}
+}  // namespace
 
 namespace {
 // Key → value table for the variables of one update: a linear scan over an
@@ -229,10 +246,26 @@ int BayesTreeEngine::allocSlot() {
   return static_cast<int>(slots_.size()) - 1;
 }
 
+Factor::Rotations BayesTreeEngine::rotationsOf(const Key& k) const {
+  if (!model_ || model_->rotationBlocks().empty()) return {};
+  return {&model_->rotationBlocks(), k.isConstants() ? model_->dims().nc : 0};
+}
+
+void BayesTreeEngine::estimateInto(const Key& k, const Var& v, Eigen::VectorXd& out) const {
+  out = v.anchor() + v.delta();
+  const Factor::Rotations r = rotationsOf(k);
+  if (r.blocks && hasRotationIn(*r.blocks, out.size(), r.offset)) {  // anchor ⊕ δ (docs/DESIGN.md §12)
+    out = v.anchor();
+    retractBlocks(out, v.delta(), *r.blocks, r.offset);
+  }
+}
+
 Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {
   const Var* v = vars_.find(k);
   if (!v) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
-  return v->estimate();
+  Eigen::VectorXd out;
+  estimateInto(k, *v, out);
+  return out;
 }
 
 template <class Keys>
@@ -252,7 +285,7 @@ void BayesTreeEngine::pointAt(const Keys& keys, const Values* extra) const {
       // one factor and x_b in the next (process, then measurement), and one
       // buffer resized between their sizes reallocated every time.
       Eigen::VectorXd& p = k.isConstants() ? scratch_.constants_point : points[i];
-      p = v->anchor() + v->delta();
+      estimateInto(k, *v, p);
       x.push_back(&p);
     } else {
       x.push_back(&extra->at(k));
@@ -282,11 +315,19 @@ LinearFactor BayesTreeEngine::linearize(const SlotFactor& f, const Model* model,
   if (!finite)
     throw NumericalError("factor '" + f.toFactor(model, keys)->describe() +
                          "' has a non-finite residual or Jacobian at the current estimate");
+  // On a rotation block δ is a chart at the anchor: x = anchor ⊕ δ, so
+  // ∂r/∂δ = J·Jr(δ̂) there (docs/DESIGN.md §12).
+  std::size_t i = 0;
+  for (const auto& k : keys) {
+    const Factor::Rotations rot = rotationsOf(k);
+    if (known[i] && rot.blocks) chartJacobian(*rot.blocks, rot.offset, known[i]->delta(), J[i]);
+    ++i;
+  }
   lf.setBlocks(J, r.size());
   auto b = lf.Ab.col(lf.Ab.cols() - 1);
   b = -r;
-  for (std::size_t i = 0; i < known.size(); ++i)
-    if (known[i]) b += J[i] * known[i]->delta();
+  for (std::size_t j = 0; j < known.size(); ++j)
+    if (known[j]) b += J[j] * known[j]->delta();
   return lf;
 }
 
@@ -848,16 +889,23 @@ void BayesTreeEngine::backSubstitute(int c) {
 }
 
 void BayesTreeEngine::setEstimates(const Values& x) {
+  Eigen::VectorXd d;
   for (const auto& kv : x) {
     Var& v = vars_.at(kv.first);
-    v.delta() = kv.second - v.anchor();
+    const Factor::Rotations r = rotationsOf(kv.first);
+    if (r.blocks) {  // δ = x ⊖ anchor
+      localBlocks(kv.second, v.anchor(), d, *r.blocks, r.offset);
+      v.delta() = d;
+    } else {
+      v.delta() = kv.second - v.anchor();
+    }
   }
 }
 
 Values BayesTreeEngine::allEstimates() const {
   Values out;
   out.reserve(vars_.size());
-  vars_.forEach([&](const Key& k, const Var& v) { out.insert(k, v.estimate()); });
+  vars_.forEach([&](const Key& k, const Var&) { out.insert(k, estimate(k)); });
   return out;
 }
 
@@ -889,9 +937,24 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   for (const auto& k : keys)
     if (!vars_.contains(k)) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
   const int root_of_one = keys.size() == 1 ? vars_.at(keys[0]).clique : -1;
-  if (root_of_one >= 0 && cliques_[static_cast<std::size_t>(root_of_one)].parent < 0)
-    return rootCovariance(cliques_[static_cast<std::size_t>(root_of_one)]);
-  return bayesNetCovariance(keys);
+  Eigen::MatrixXd S = root_of_one >= 0 && cliques_[static_cast<std::size_t>(root_of_one)].parent < 0
+                          ? rootCovariance(cliques_[static_cast<std::size_t>(root_of_one)])
+                          : bayesNetCovariance(keys);
+  // Of δ in the anchor's chart; on a rotation block the tangent at the
+  // estimate anchor ⊕ δ̂ moves by Jr(δ̂)·dδ: Σ ← Jr Σ Jrᵀ there (§12).
+  Eigen::Index at = 0;
+  for (const auto& k : keys) {
+    const Var& v = vars_.at(k);
+    const Factor::Rotations rot = rotationsOf(k);
+    if (rot.blocks) {
+      Eigen::MatrixXd J = Eigen::MatrixXd::Identity(v.dim(), v.dim());
+      chartJacobian(*rot.blocks, rot.offset, v.delta(), J);
+      S.middleRows(at, v.dim()) = (J * S.middleRows(at, v.dim())).eval();
+      S.middleCols(at, v.dim()) = (S.middleCols(at, v.dim()) * J.transpose()).eval();
+    }
+    at += v.dim();
+  }
+  return S;
 }
 
 // One clique, the root (the constants, checked after every update): Σ =

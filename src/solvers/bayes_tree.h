@@ -444,6 +444,10 @@ class BayesTreeEngine {
   /// keys[i]'s variable, null if new.
   template <class Keys>
   void pointAt(const Keys& keys, const Values* extra) const;
+  /// Where k's variable holds rotations (the model's blocks; none without a model).
+  Factor::Rotations rotationsOf(const Key& k) const;
+  /// anchor ⊕ δ of k's variable v into `out`.
+  void estimateInto(const Key& k, const Var& v, Eigen::VectorXd& out) const;
   /// The elimination order of `keys` into `out`.
   void order(const std::vector<Key>& keys, const std::vector<std::pair<LinearView, InputSource>>& factors,
              const Values& new_vars, std::vector<Key>& out) const;

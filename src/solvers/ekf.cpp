@@ -5,6 +5,7 @@
 
 #include "core/byte_stream.h"
 #include "gssm/core/angles.h"
+#include "gssm/core/rotation_blocks.h"
 #include "gssm/core/error.h"
 #include "gssm/core/gaussian.h"
 #include "gssm/core/key.h"
@@ -196,7 +197,11 @@ void ExtendedKalmanFilter::commitUpdate(double w) {
       (!options_.joseph_form && Eigen::LLT<Eigen::MatrixXd>(P).info() != Eigen::Success))
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
                          ": the updated covariance is not positive definite (filter unchanged)");
-  z_ += w * dz;
+  // z ⊕ w·dz: an error-state update on the rotation blocks (docs/DESIGN.md
+  // §12), P kept as the covariance of the tangent at the new estimate (the
+  // reset Jacobian I − ½[w·dz]× of an error-state filter is dropped, as is usual).
+  if (model_->rotationBlocks().empty()) z_ += w * dz;
+  else retractBlocks(z_, w * dz, model_->rotationBlocks());
   wrapAngles(z_, model_->angleStates());
   P_.swap(P);  // the old covariance's storage is the next candidate's
 }

@@ -1,6 +1,9 @@
 #include "solvers/newton.h"
 
 #include <cmath>
+#include <unordered_map>
+
+#include "gssm/core/rotation_blocks.h"
 
 #include "linear/normal_equations.h"
 
@@ -70,17 +73,42 @@ bool NewtonSystem::solve(Eigen::VectorXd& delta) {
   return delta.allFinite();
 }
 
-Values addStep(const Values& x, const Eigen::VectorXd& delta) {
-  Values out = x;
-  addStep(x, delta, out);
+Retraction Retraction::of(const FactorGraph& graph, const Values& x) {
+  std::unordered_map<Key, Factor::Rotations, KeyHash> found;
+  for (const auto& f : graph)
+    for (std::size_t a = 0; a < f->keys().size(); ++a) {
+      const Factor::Rotations r = f->rotationsOf(a);
+      if (r.blocks && x.contains(f->keys()[a]) && hasRotationIn(*r.blocks, x.at(f->keys()[a]).size(), r.offset))
+        found.emplace(f->keys()[a], r);
+    }
+  Retraction out;
+  if (found.empty()) return out;
+  for (const auto& kv : x) {
+    const auto it = found.find(kv.first);
+    out.by_position.push_back(it == found.end() ? Factor::Rotations{} : it->second);
+  }
   return out;
 }
 
-void addStep(const Values& x, const Eigen::VectorXd& delta, Values& out) {
+Values addStep(const Values& x, const Eigen::VectorXd& delta, const Retraction* retraction) {
+  Values out = x;
+  addStep(x, delta, out, retraction);
+  return out;
+}
+
+void addStep(const Values& x, const Eigen::VectorXd& delta, Values& out, const Retraction* retraction) {
+  const bool plain = !retraction || retraction->trivial();
   auto it = out.begin();
   Eigen::Index off = 0;
+  std::size_t i = 0;
   for (const auto& kv : x) {
-    it->second = kv.second + delta.segment(off, kv.second.size());
+    const Factor::Rotations* r = plain ? nullptr : &retraction->by_position[i++];
+    if (r && r->blocks) {
+      it->second = kv.second;
+      retractBlocks(it->second, delta.segment(off, kv.second.size()), *r->blocks, r->offset);
+    } else {
+      it->second = kv.second + delta.segment(off, kv.second.size());
+    }
     off += kv.second.size();
     ++it;
   }

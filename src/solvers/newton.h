@@ -37,10 +37,18 @@ class NewtonSystem {
   SparseCholesky chol_;
 };
 
-/// x ⊕ δ for δ stacked in x's order.
-Values addStep(const Values& x, const Eigen::VectorXd& delta);
+/// Where x ⊕ δ is not x + δ (docs/DESIGN.md §12): each variable's rotation
+/// blocks, by its position in a Values, as its factors declare them.
+struct Retraction {
+  std::vector<Factor::Rotations> by_position;  ///< empty: x + δ everywhere
+  bool trivial() const { return by_position.empty(); }
+  static Retraction of(const FactorGraph& graph, const Values& x);
+};
+
+/// x ⊕ δ for δ stacked in x's order (+ without a retraction).
+Values addStep(const Values& x, const Eigen::VectorXd& delta, const Retraction* retraction = nullptr);
 /// out = x ⊕ δ in place; out holds x's keys and sizes (no allocation) and may be x itself.
-void addStep(const Values& x, const Eigen::VectorXd& delta, Values& out);
+void addStep(const Values& x, const Eigen::VectorXd& delta, Values& out, const Retraction* retraction = nullptr);
 /// x's vectors stacked in its order into `flat` (resized to x.dim()).
 void flatten(const Values& x, Eigen::VectorXd& flat);
 /// The inverse: x's vectors overwritten from `flat` (same sizes: no allocation).

@@ -48,6 +48,14 @@ class Factor {
   /// ascending; nullptr: any. A solver may skip the others (they are zero at
   /// every point).
   virtual const std::vector<int>* columnsOf(std::size_t /*a*/) const { return nullptr; }
+  /// Where keys()[a] holds rotations (docs/DESIGN.md §12): the stacked
+  /// first components of its rotation blocks and the stacked index its
+  /// vector starts at; a solver moves it by ⊕ there. `blocks` null: none.
+  struct Rotations {
+    const std::vector<int>* blocks = nullptr;
+    int offset = 0;
+  };
+  virtual Rotations rotationsOf(std::size_t /*a*/) const { return {}; }
 
  protected:
   Factor(std::vector<Key> keys, int dim, RobustLoss loss = {})
@@ -62,22 +70,26 @@ class Factor {
 
 using FactorPtr = std::shared_ptr<const Factor>;
 
-/// E[x] = mean with covariance Σ: r = L⁻¹ (x − mean), the listed angle
-/// components of x − mean wrapped to (−π, π].
+/// E[x] = mean with covariance Σ: r = L⁻¹ (x ⊖ mean), the listed angle
+/// components wrapped to (−π, π], ⊖ on the listed rotation blocks (first
+/// components; docs/DESIGN.md §12), − elsewhere.
 class PriorFactor final : public Factor {
  public:
-  PriorFactor(Key key, const Gaussian& prior, std::vector<int> angles = {});
+  PriorFactor(Key key, const Gaussian& prior, std::vector<int> angles = {}, std::vector<int> rotations = {});
   void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                    std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
   const Eigen::VectorXd& mean() const { return mean_; }
   const GaussianNoise& noise() const { return noise_; }
   const std::vector<int>& angles() const { return angles_; }
+  const std::vector<int>& rotations() const { return rotations_; }
+  Rotations rotationsOf(std::size_t) const override { return {rotations_.empty() ? nullptr : &rotations_, 0}; }
 
  private:
   Eigen::VectorXd mean_;
   GaussianNoise noise_;
   std::vector<int> angles_;
+  std::vector<int> rotations_;
 };
 
 /// x_c(k+1) = f(x_c(k), x_b, u_k, dt) + q:  r = L_Q⁻¹ (x_c(k+1) − f(...)),
@@ -98,6 +110,7 @@ class ProcessFactor final : public Factor {
   const Eigen::VectorXd& input() const { return u_; }
   const GaussianNoise& noise() const { return noise_; }
   const Model& model() const { return *model_; }
+  Rotations rotationsOf(std::size_t a) const override;
 
  private:
   const Model* model_;
@@ -127,6 +140,7 @@ class MeasurementFactor final : public Factor {
   int channel() const { return channel_; }
   const GaussianNoise& noise() const { return noise_; }
   const Model& model() const { return *model_; }
+  Rotations rotationsOf(std::size_t a) const override;
 
  private:
   const Model* model_;

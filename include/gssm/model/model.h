@@ -112,7 +112,15 @@ class Model {
   void setChannelLoss(int c, const RobustLoss& loss, double ekf_gate);
   /// Components of the stacked state [x_c; x_b] that are angles.
   const std::vector<int>& angleStates() const { return angle_states_; }
-  /// The stacked state with its angle components wrapped to (−π, π].
+  /// Rotation blocks of the stacked state [x_c; x_b] (docs/DESIGN.md §12):
+  /// the first index of each three components that hold a rotation vector φ
+  /// (R = Exp(φ)). Every estimator moves them by R ⊕ δ = R·Exp(δ) and
+  /// compares them by ⊖ (core/rotation_blocks.h); the model's Jacobians are
+  /// with respect to that body-frame tangent δ, its covariances of δ. Empty
+  /// for a model of vectors and angles only (every model before #37).
+  const std::vector<int>& rotationBlocks() const { return rotation_blocks_; }
+  /// The stacked state with its angle components wrapped to (−π, π] and its
+  /// rotation vectors to |φ| ≤ π.
   Eigen::VectorXd wrapStacked(Eigen::VectorXd z) const;
 
   /// Process noise covariance of a step of length dt. Default: Q·dt/T (a
@@ -175,12 +183,17 @@ class Model {
   void setChannels(std::vector<MeasurementChannel> channels);
   /// Marks components of the stacked state [x_c; x_b] as angles.
   void setAngleStates(std::vector<int> stacked_components);
+  /// Marks rotation blocks (their first stacked components); InvalidArgument
+  /// for a block that does not fit in x_c or in x_b, or overlaps another
+  /// block or an angle.
+  void setRotationBlocks(std::vector<int> first_components);
 
  private:
   [[noreturn]] void throwNoChannel(int c) const;
   std::vector<MeasurementChannel> channels_;
   std::vector<GaussianNoise> channel_noise_;
   std::vector<int> angle_states_;
+  std::vector<int> rotation_blocks_;
   ModelDims dims_;
   ModelNames names_;
   ModelNoise noise_;
