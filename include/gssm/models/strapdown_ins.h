@@ -1,0 +1,76 @@
+#pragma once
+// Strapdown GNSS/INS (issue #37; docs/DESIGN.md §12): one state per IMU
+// sample, the IMU's rates and specific forces as inputs held over each
+// interval, attitude on SO(3) (a rotation block), velocity and position in
+// a NED frame fixed to the Earth at an anchor (strapdown.h). The sensor's
+// constants are single nodes, each only in the factors that involve it:
+//
+//   x_c = [θ (IMU → NED, rotation block), v (m/s, NED), p (m, NED)]
+//   x_b = [b_g (rad/s), b_a (m/s²), ℓ (IMU → antenna in vehicle axes, m),
+//          μ (mounting misalignment, rad: R_vb = Exp(μ)·R_vb0)]
+//   u   = [ω̃ (rad/s), f̃ (m/s²)] in the IMU's axes
+//
+// Channels: `gnss` (the antenna's NED position, p + R_nb·R_vbᵀ·ℓ), `nhc`
+// (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z),
+// `zupt` (the velocity, zero while standing). R_vb maps the IMU's axes to
+// the vehicle's (forward, right, down); R_vb0 is its nominal value.
+#include <Eigen/Core>
+
+#include "gssm/model/model.h"
+#include "gssm/models/geodesy.h"
+#include "gssm/models/strapdown.h"
+
+namespace gssm::models {
+
+class StrapdownIns final : public Model {
+ public:
+  struct Params {
+    double T = 0.01;                           ///< nominal IMU interval (s)
+    geodesy::Geodetic anchor;                  ///< the frame's origin (rad, rad, m)
+    Eigen::Vector3d mount_rpy{0, 0, 0};        ///< R_vb0 as roll, pitch, yaw (rad), IMU → vehicle
+    double gyro_sd = 1e-3;                     ///< gyro white noise, rad/s/√Hz
+    double accel_sd = 1e-2;                    ///< accelerometer white noise, m/s²/√Hz
+    double gnss_sd = 0.02;                     ///< σ of each GNSS coordinate (m) unless a fix gives its own
+    double nhc_sd = 0.1;                       ///< σ of the vehicle's sideways and vertical velocity (m/s)
+    double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)
+    Eigen::Vector3d start_rpy{0, 0, 0};        ///< prior mean of the IMU's attitude, roll, pitch, yaw (rad)
+    Eigen::Vector3d start_velocity{0, 0, 0};   ///< prior mean of v(0) (m/s, NED)
+    Eigen::Vector3d start_position{0, 0, 0};   ///< prior mean of p(0) (m, NED)
+    double attitude_sd = 0.1, velocity_sd = 1.0, position_sd = 1.0;  ///< their σ (rad, m/s, m)
+    double gyro_bias_sd = 0.01;                ///< prior σ of b_g (rad/s), mean 0
+    double accel_bias_sd = 0.1;                ///< prior σ of b_a (m/s²), mean 0
+    Eigen::Vector3d lever{0, 0, 0};            ///< prior mean of ℓ (m)
+    double lever_sd = 0.1;                     ///< its σ (m)
+    double mount_sd = 0.1;                     ///< prior σ of μ (rad), mean 0
+  };
+
+  explicit StrapdownIns(const Params& p);
+  std::string name() const override { return "strapdown_ins"; }
+  const Params& params() const { return p_; }
+  const strapdown::NavFrame& frame() const { return frame_; }
+  /// R_vb = Exp(μ)·R_vb0 at the constants x_b.
+  Eigen::Matrix3d mounting(const Eigen::VectorXd& xb) const;
+
+  Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u, double dt,
+                    Eigen::MatrixXd* J_f_xc = nullptr, Eigen::MatrixXd* J_f_xb = nullptr) const override;
+  Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc = nullptr,
+                    Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                    Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  Eigen::MatrixXd processNoise(double dt) const override;
+
+  // Where each part of x_b starts.
+  static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9;
+  enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2 };
+
+ private:
+  Eigen::VectorXd antenna(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
+                          Eigen::MatrixXd* J_h_xb) const;
+  Eigen::VectorXd vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
+                                  Eigen::MatrixXd* J_h_xb) const;
+  Params p_;
+  strapdown::NavFrame frame_;
+  Eigen::Matrix3d mount0_;  // R_vb0
+};
+
+}  // namespace gssm::models

@@ -1,0 +1,88 @@
+#pragma once
+// A simulated car drive for the strapdown GNSS/INS tests (issue #37): a
+// known vehicle trajectory (standing, pulling away, turns, hills), the IMU
+// mounted in it with a misalignment, readings generated through the model's
+// own step so that the truth is what the model says plus its process noise,
+// GNSS fixes of the antenna at 4 Hz, the vehicle constraints at 10 Hz.
+#include <Eigen/Core>
+#include <cmath>
+#include <vector>
+
+#include "gssm/core/data.h"
+#include "gssm/core/rotation_blocks.h"
+#include "gssm/core/so3.h"
+#include "gssm/model/simulation.h"
+#include "gssm/models/strapdown_ins.h"
+
+namespace gssm::testing {
+
+struct SimulatedDrive {
+  std::vector<Measurement> measurements;
+  std::vector<Input> inputs;
+  std::vector<Eigen::VectorXd> states;  ///< true x_c at each IMU time
+  Eigen::VectorXd constants;            ///< true x_b
+};
+
+/// The vehicle's desired attitude (roll 0, a pitch for the hills, a yaw
+/// for the turns) and forward speed at t: standing 5 s, then driving.
+inline void vehicleAt(double t, Eigen::Matrix3d& R_nv, double& speed) {
+  const double drive = std::max(0.0, t - 5.0);
+  speed = std::min(10.0, 2.0 * drive);
+  const double yaw = 0.3 + (drive > 0 ? 0.25 * 30 / (2 * M_PI) * (1 - std::cos(2 * M_PI * drive / 30)) : 0.0);
+  const double pitch = 0.05 * std::sin(2 * M_PI * drive / 40);
+  R_nv = so3::fromRollPitchYaw(Eigen::Vector3d(0.0, pitch, yaw));
+}
+
+/// Drives `seconds` with `model` (its T the IMU interval); the constants
+/// drawn from the model's prior, the start its prior mean.
+inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double seconds, const NormalSampler& draw) {
+  SimulatedDrive d;
+  const double T = model.nominalStep();
+  d.constants = sampleGaussian(model.priorConstants().mean, model.priorConstants().covariance, draw);
+  const Eigen::Matrix3d R_vb = model.mounting(d.constants);
+  Eigen::Matrix3d R_nv;
+  double speed;
+  vehicleAt(0, R_nv, speed);
+  Eigen::VectorXd x(9);
+  x << so3::Log(R_nv * R_vb), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero();
+  d.states.push_back(x);
+  const Eigen::VectorXd bias = d.constants.head<6>();
+  const int steps = static_cast<int>(std::lround(seconds / T));
+  for (int k = 0; k < steps; ++k) {
+    const double t = k * T;
+    // The IMU's true rate and specific force that take the state to the
+    // desired attitude and velocity at t + T under the model's step.
+    vehicleAt(t + T, R_nv, speed);
+    const Eigen::Matrix3d R = so3::Exp(x.head<3>());
+    const Eigen::Matrix3d R_next = R_nv * R_vb;
+    const Eigen::Vector3d v = x.segment<3>(3), v_next = R_nv * Eigen::Vector3d(speed, 0, 0);
+    const Eigen::Vector3d w_ie = model.frame().earthRate();
+    const Eigen::Vector3d gyro = so3::Log(R.transpose() * so3::Exp(w_ie * T) * R_next) / T;
+    const Eigen::Vector3d accel =
+        R.transpose() * ((v_next - v) / T - model.frame().gravity(x.segment<3>(6)) + 2 * w_ie.cross(v));
+    Eigen::VectorXd u(6);
+    u << gyro, accel;
+    u += bias;  // what the IMU reads
+    d.inputs.push_back({t, u});
+    x = model.f(x, d.constants, u, T);
+    retractBlocks(x, sampleGaussian(Eigen::VectorXd::Zero(9), model.processNoise(T), draw), model.rotationBlocks());
+    d.states.push_back(x);
+    const double tn = (k + 1) * T;
+    const int n = k + 1;
+    const int per_gnss = static_cast<int>(std::lround(0.25 / T)), per_constraint = static_cast<int>(std::lround(0.1 / T));
+    using Ins = models::StrapdownIns;
+    if (n % per_gnss == 0) {
+      const Eigen::Vector3d y = model.h(Ins::kGnss, x, d.constants) +
+                                sampleGaussian(Eigen::Vector3d::Zero(), model.channel(Ins::kGnss).R, draw);
+      d.measurements.push_back({tn, y, Ins::kGnss, {}});
+    }
+    if (n % per_constraint == 0) {
+      const bool standing = tn < 5.0;
+      const int c = standing ? Ins::kZupt : Ins::kNhc;
+      d.measurements.push_back({tn, Eigen::VectorXd::Zero(model.channel(c).dim()), c, {}});
+    }
+  }
+  return d;
+}
+
+}  // namespace gssm::testing
