@@ -36,7 +36,7 @@ StrapdownIns::Params driveParams(double T) {
   p.attitude_sd = 0.05, p.velocity_sd = 0.1, p.position_sd = 0.1;
   p.gyro_bias_sd = 2e-3, p.accel_bias_sd = 0.05;
   p.lever = Eigen::Vector3d(0.0, -0.05, 0.0);
-  p.lever_sd = 0.3, p.mount_sd = 0.05;
+  p.lever_sd = 0.3, p.mount_sd = 0.05, p.delay_sd = 0.1;
   return p;
 }
 
@@ -48,7 +48,7 @@ TEST(StrapdownIns, JacobiansMatchTangentDifferencesAtEveryAttitude) {
     testing::JacobianPoint p;
     p.xc = testing::uniformVector(rng, 9, -20, 20);
     p.xc.head<3>() = so3::Log(so3::fromRollPitchYaw(rpy[std::uniform_int_distribution<std::size_t>(0, rpy.size() - 1)(rng)]));
-    p.xb = testing::uniformVector(rng, 12, -0.1, 0.1);
+    p.xb = testing::uniformVector(rng, StrapdownIns::kConstants, -0.1, 0.1);
     p.xb.segment<3>(StrapdownIns::kLever) = testing::uniformVector(rng, 3, -1, 1);
     p.u = testing::uniformVector(rng, 6, -1, 1);
     p.u[5] -= 9.8;
@@ -81,7 +81,7 @@ TEST(StrapdownIns, BatchRecoversTheConstantsOfASimulatedDrive) {
     const testing::SimulatedDrive d = testing::simulateDrive(model, 60.0, testing::normalSampler(400 + seed));
     const OfflineRun r = runOffline(model, {Method::Batch}, d.measurements, d.inputs);
     const EstimateRow& end = r.rows.back();
-    for (int i = 0; i < 12; ++i, ++total) {
+    for (int i = 0; i < StrapdownIns::kConstants; ++i, ++total) {
       const double err = end.mean[9 + i] - d.constants[i], sd = std::sqrt(end.covariance(9 + i, 9 + i));
       const bool ok = std::abs(err) <= 2 * sd;
       inside += ok;
@@ -118,7 +118,7 @@ TEST(StrapdownIns, OnlineMethodsOnASimulatedDrive) {
   for (Method method : {Method::Ekf, Method::FixedLag}) {
     const OfflineRun o = runOffline(model, {method}, d.measurements, d.inputs);
     const EstimateRow& end = o.rows.back();
-    for (int i = 0; i < 12; ++i)
+    for (int i = 0; i < StrapdownIns::kConstants; ++i)
       EXPECT_LE(std::abs(end.mean[9 + i] - d.constants[i]), 3 * std::sqrt(end.covariance(9 + i, 9 + i)))
           << methodName(method) << " " << model.names().constants[static_cast<std::size_t>(i)];
   }

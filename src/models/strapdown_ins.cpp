@@ -15,7 +15,7 @@ ModelNames insNames() {
   ModelNames n;
   n.state = {"att_x", "att_y", "att_z", "vn", "ve", "vd", "pn", "pe", "pd"};
   n.constants = {"bg_x", "bg_y", "bg_z", "ba_x", "ba_y", "ba_z", "lever_f", "lever_r", "lever_d",
-                 "mount_x", "mount_y", "mount_z"};
+                 "mount_x", "mount_y", "mount_z", "imu_delay"};
   n.input = {"gx", "gy", "gz", "ax", "ay", "az"};
   n.measurement = {"gnss_n", "gnss_e", "gnss_d"};
   return n;
@@ -37,7 +37,7 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
 
 ModelNoise insNoise(const StrapdownIns::Params& p) {
   for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.nhc_sd, p.zupt_sd, p.attitude_sd, p.velocity_sd,
-                   p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd})
+                   p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
   ModelNoise n;
   n.T = p.T;
@@ -48,10 +48,10 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   sd << Eigen::Vector3d::Constant(p.attitude_sd), Eigen::Vector3d::Constant(p.velocity_sd),
       Eigen::Vector3d::Constant(p.position_sd);
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
-  Eigen::VectorXd bmean = Eigen::VectorXd::Zero(12), bsd(12);
+  Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
   bmean.segment<3>(StrapdownIns::kLever) = p.lever;
   bsd << Eigen::Vector3d::Constant(p.gyro_bias_sd), Eigen::Vector3d::Constant(p.accel_bias_sd),
-      Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd);
+      Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd;
   n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
   return n;
 }
@@ -69,11 +69,11 @@ MeasurementChannel channelOf(const std::string& name, std::vector<std::string> c
 }  // namespace
 
 StrapdownIns::StrapdownIns(const Params& p)
-    : Model({9, 12, 6, 3}, insNames(), insNoise(p)),
+    : Model({9, kConstants, 6, 3}, insNames(), insNoise(p)),
       p_(p),
       frame_(p.anchor),
       mount0_(so3::fromRollPitchYaw(p.mount_rpy)) {
-  setChannels({channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, p.gnss_sd, {6, 7, 8, 9, 10, 11}),
+  setChannels({channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, p.gnss_sd, {6, 7, 8, 9, 10, 11, kDelay}),
                channelOf("nhc", {"nhc_right", "nhc_down"}, p.nhc_sd, {9, 10, 11}),
                channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, p.zupt_sd, {})});
   setRotationBlocks({0});
@@ -95,7 +95,7 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
                                                    J_f_xc || J_f_xb ? &J : nullptr);
   if (J_f_xc) *J_f_xc = J.J_next_x;
   if (J_f_xb) {
-    J_f_xb->setZero(9, 12);
+    J_f_xb->setZero(9, kConstants);
     J_f_xb->middleCols<3>(kGyroBias) = J.J_next_bg;
     J_f_xb->middleCols<3>(kAccelBias) = J.J_next_ba;
   }
@@ -118,29 +118,35 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
     J_h_xc->setZero(3, 9);
     J_h_xc->middleCols<3>(3).setIdentity();
   }
-  if (J_h_xb) J_h_xb->setZero(3, 12);
+  if (J_h_xb) J_h_xb->setZero(3, kConstants);
   return xc.segment<3>(3);
 }
 
-// y = p + R·w, w = R_vbᵀ·ℓ = R_vb0ᵀ·Exp(−μ)·ℓ: ∂y/∂δθ = −R·[w]×, ∂y/∂ℓ = R·R_vbᵀ,
-// ∂y/∂μ = R·R_vb0ᵀ·Exp(−μ)·[ℓ]×·Jr(−μ) (from ∂(Exp(φ)ℓ)/∂φ = −Exp(φ)[ℓ]×Jr(φ)).
+// The antenna at the GNSS time of the fix: the state at IMU time t is the
+// true time t + d (d = imu_delay, added to the IMU's stamps), so to first
+// order y = p + R·w − d·v, w = R_vbᵀ·ℓ = R_vb0ᵀ·Exp(−μ)·ℓ: ∂y/∂δθ = −R·[w]×,
+// ∂y/∂v = −d·I, ∂y/∂ℓ = R·R_vbᵀ, ∂y/∂μ = R·R_vb0ᵀ·Exp(−μ)·[ℓ]×·Jr(−μ) (from
+// ∂(Exp(φ)ℓ)/∂φ = −Exp(φ)[ℓ]×Jr(φ)), ∂y/∂d = −v.
 Eigen::VectorXd StrapdownIns::antenna(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                                       Eigen::MatrixXd* J_h_xb) const {
   const Eigen::Matrix3d R = so3::Exp(xc.head<3>());
-  const Eigen::Vector3d mu = xb.segment<3>(kMount), lever = xb.segment<3>(kLever);
+  const Eigen::Vector3d v = xc.segment<3>(3), mu = xb.segment<3>(kMount), lever = xb.segment<3>(kLever);
+  const double delay = xb[kDelay];
   const Eigen::Matrix3d Emu_t = so3::Exp(-mu);
   const Eigen::Vector3d w = mount0_.transpose() * (Emu_t * lever);
   if (J_h_xc) {
     J_h_xc->setZero(3, 9);
     J_h_xc->leftCols<3>() = -R * hat(w);
+    J_h_xc->middleCols<3>(3).diagonal().setConstant(-delay);
     J_h_xc->rightCols<3>().setIdentity();
   }
   if (J_h_xb) {
-    J_h_xb->setZero(3, 12);
+    J_h_xb->setZero(3, kConstants);
     J_h_xb->middleCols<3>(kLever) = R * mount0_.transpose() * Emu_t;
     J_h_xb->middleCols<3>(kMount) = R * mount0_.transpose() * Emu_t * hat(lever) * so3::rightJacobian(-mu);
+    J_h_xb->col(kDelay) = -v;
   }
-  return xc.segment<3>(6) + R * w;
+  return xc.segment<3>(6) + R * w - delay * v;
 }
 
 // The vehicle's velocity w = R_vb·Rᵀ·v, its right and down parts: with
@@ -158,7 +164,7 @@ Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const E
     J_h_xc->middleCols<3>(3) = (M * R.transpose()).bottomRows<2>();
   }
   if (J_h_xb) {
-    J_h_xb->setZero(2, 12);
+    J_h_xb->setZero(2, kConstants);
     J_h_xb->middleCols<3>(kMount) = (-Emu * hat(mount0_ * u) * so3::rightJacobian(mu)).bottomRows<2>();
   }
   return w.tail<2>();
@@ -194,7 +200,8 @@ std::vector<ParamSpec> insParams() {
       real("prior", "accel_bias_sd", "prior σ of the accelerometer bias (m/s²), mean 0"),
       vector("prior", "lever", "prior mean of the lever arm IMU → antenna, vehicle axes (m)"),
       real("prior", "lever_sd", "its σ (m)"),
-      real("prior", "mount_sd", "prior σ of the mounting misalignment (deg), mean 0")};
+      real("prior", "mount_sd", "prior σ of the mounting misalignment (deg), mean 0"),
+      real("prior", "delay_sd", "prior σ of the IMU's time delay (s, added to its stamps), mean 0")};
   return p;
 }
 
@@ -214,7 +221,7 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   p.mount_sd = in.real("prior", "mount_sd", p.mount_sd / kDeg) * kDeg;
   for (auto [key, value] : {std::pair{"velocity_sd", &p.velocity_sd}, {"position_sd", &p.position_sd},
                             {"gyro_bias_sd", &p.gyro_bias_sd}, {"accel_bias_sd", &p.accel_bias_sd},
-                            {"lever_sd", &p.lever_sd}})
+                            {"lever_sd", &p.lever_sd}, {"delay_sd", &p.delay_sd}})
     *value = in.real("prior", key, *value);
   return p;
 }
@@ -232,7 +239,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("prior", "lever", p.lever);
   for (auto [key, value] : {std::pair{"attitude_sd", p.attitude_sd / kDeg}, {"velocity_sd", p.velocity_sd},
                             {"position_sd", p.position_sd}, {"gyro_bias_sd", p.gyro_bias_sd},
-                            {"accel_bias_sd", p.accel_bias_sd}, {"lever_sd", p.lever_sd}, {"mount_sd", p.mount_sd / kDeg}})
+                            {"accel_bias_sd", p.accel_bias_sd}, {"lever_sd", p.lever_sd}, {"mount_sd", p.mount_sd / kDeg},
+                            {"delay_sd", p.delay_sd}})
     out.real("prior", key, value);
 }
 

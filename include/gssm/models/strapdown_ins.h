@@ -7,10 +7,12 @@
 //
 //   x_c = [θ (IMU → NED, rotation block), v (m/s, NED), p (m, NED)]
 //   x_b = [b_g (rad/s), b_a (m/s²), ℓ (IMU → antenna in vehicle axes, m),
-//          μ (mounting misalignment, rad: R_vb = Exp(μ)·R_vb0)]
+//          μ (mounting misalignment, rad: R_vb = Exp(μ)·R_vb0),
+//          d (the IMU's time delay, s: added to its stamps gives GNSS time)]
 //   u   = [ω̃ (rad/s), f̃ (m/s²)] in the IMU's axes
 //
-// Channels: `gnss` (the antenna's NED position, p + R_nb·R_vbᵀ·ℓ), `nhc`
+// Channels: `gnss` (the antenna's NED position at the fix's time,
+// p + R_nb·R_vbᵀ·ℓ − d·v), `nhc`
 // (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z),
 // `zupt` (the velocity, zero while standing). R_vb maps the IMU's axes to
 // the vehicle's (forward, right, down); R_vb0 is its nominal value.
@@ -42,6 +44,7 @@ class StrapdownIns final : public Model {
     Eigen::Vector3d lever{0, 0, 0};            ///< prior mean of ℓ (m)
     double lever_sd = 0.1;                     ///< its σ (m)
     double mount_sd = 0.1;                     ///< prior σ of μ (rad), mean 0
+    double delay_sd = 0.1;                     ///< prior σ of d (s), mean 0
   };
 
   explicit StrapdownIns(const Params& p);
@@ -60,7 +63,7 @@ class StrapdownIns final : public Model {
   Eigen::MatrixXd processNoise(double dt) const override;
 
   // Where each part of x_b starts.
-  static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9;
+  static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kConstants = 13;
   enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2 };
 
  private:
