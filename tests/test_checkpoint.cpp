@@ -13,8 +13,10 @@
 #include "gssm/models/linear.h"
 #include "gssm/models/nav2d.h"
 #include "gssm/models/radar2d.h"
+#include "gssm/models/strapdown_ins.h"
 #include "gssm/model/simulation.h"
 #include "reference_kalman.h"
+#include "simulated_drive.h"
 
 using namespace gssm;
 
@@ -24,22 +26,24 @@ struct Event {
   double t;
   bool is_input;
   Eigen::VectorXd v;
+  int channel = 0;
 };
 
 // Inputs and measurements in time order (an input first at equal times).
-std::vector<Event> eventsOf(const SimulatedRun& run) {
+std::vector<Event> eventsOf(const std::vector<Input>& inputs, const std::vector<Measurement>& measurements) {
   std::vector<Event> ev;
-  for (const auto& u : run.inputs) ev.push_back({u.t, true, u.u});
-  for (const auto& m : run.measurements) ev.push_back({m.t, false, m.y});
+  for (const auto& u : inputs) ev.push_back({u.t, true, u.u});
+  for (const auto& m : measurements) ev.push_back({m.t, false, m.y, m.channel});
   std::stable_sort(ev.begin(), ev.end(), [](const Event& a, const Event& b) {
     return a.t < b.t || (a.t == b.t && a.is_input && !b.is_input);
   });
   return ev;
 }
+std::vector<Event> eventsOf(const SimulatedRun& run) { return eventsOf(run.inputs, run.measurements); }
 
 void apply(Estimator& e, const Event& ev) {
   if (ev.is_input) e.addInput(ev.t, ev.v);
-  else e.addMeasurement(ev.t, ev.v);
+  else e.addMeasurement(Measurement{ev.t, ev.v, ev.channel, {}});
 }
 
 // What a user reads after each event, as raw bits (NaN-safe comparison).
@@ -331,4 +335,27 @@ TEST(Checkpoint, OptionsThatWouldStallAnUpdateAreRefused) {
   std::string why;
   EXPECT_FALSE(o.validate(&why));
   EXPECT_NE(why.find("max_iterations"), std::string::npos) << why;
+}
+
+// A model with a rotation block (issue #37): the strapdown INS on a short
+// simulated drive (standing, then pulling away), every method.
+TEST(Checkpoint, EveryMethodContinuesBitIdenticallyOnTheStrapdownIns) {
+  models::StrapdownIns::Params p;
+  p.T = 0.05;
+  p.anchor = {0.7, -1.8, 1600.0};
+  p.mount_rpy = Eigen::Vector3d(M_PI, 0.0, M_PI);
+  Eigen::Matrix3d R_nv;
+  double speed;
+  gssm::testing::vehicleAt(0.0, R_nv, speed);
+  p.start_rpy = so3::rollPitchYaw(R_nv * so3::fromRollPitchYaw(p.mount_rpy));
+  p.attitude_sd = 0.05, p.mount_sd = 0.05, p.gyro_bias_sd = 2e-3, p.accel_bias_sd = 0.05;
+  const models::StrapdownIns ins(p);
+  const auto drive = gssm::testing::simulateDrive(ins, 7.0, gssm::testing::normalSampler(8));
+  const auto events = eventsOf(drive.inputs, drive.measurements);
+  for (const auto& method : streamingMethods()) {
+    EstimatorOptions o;
+    o.method = method;
+    o.fixed_lag.window = o.paper_window.window = 10;
+    expectBitIdenticalContinuation(ins, o, events, {0, 60, 150});
+  }
 }

@@ -191,7 +191,9 @@ py::class_<Model, std::shared_ptr<Model>> bindModelProperties(py::module_& model
                                return out;
                              })
       .def("channel_index", &Model::channelIndex, py::arg("name"), "index of the channel called `name`")
-      .def_property_readonly("angle_states", &Model::angleStates, "stacked components that are angles");
+      .def_property_readonly("angle_states", &Model::angleStates, "stacked components that are angles")
+      .def_property_readonly("rotation_blocks", &Model::rotationBlocks,
+                             "first stacked components of the rotation vectors (each three; updated by R·Exp(δ))");
   cls.def_property_readonly("landmarks", [](const Model& m) {
         Eigen::MatrixXd out(static_cast<Eigen::Index>(m.landmarks().size()), 2);
         for (std::size_t i = 0; i < m.landmarks().size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.landmarks()[i];

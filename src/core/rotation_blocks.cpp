@@ -31,7 +31,10 @@ void retractBlocks(Eigen::Ref<Eigen::VectorXd> x, const Eigen::Ref<const Eigen::
   const Eigen::VectorXd phi = x;
   x += delta;
   forEachBlock(blocks, x.size(), offset, [&](Eigen::Index j) {
-    x.segment<3>(j) = so3::Log(so3::Exp(phi.segment<3>(j)) * so3::Exp(delta.segment<3>(j)));
+    // x ⊕ 0 = x exactly (Log(Exp(φ)) is φ only to rounding).
+    x.segment<3>(j) = delta.segment<3>(j).isZero(0.0)
+                          ? phi.segment<3>(j)
+                          : so3::Log(so3::Exp(phi.segment<3>(j)) * so3::Exp(delta.segment<3>(j)));
   });
 }
 
