@@ -130,4 +130,13 @@ TEST(RtklibPos, ReadsTheDrivesSolutionFile) {
   EXPECT_DOUBLE_EQ(s.fixes.front().t, 1436038458.499);  // the IMU's time base (imu.csv starts at 1436038461.854)
   EXPECT_EQ(io::gpstCalendar(s.fixes.back().t), "2025/07/08 19:38:52.749");
   EXPECT_EQ(s.fixes.back().line, 1099);
+  // As named columns (a data file of a model's parameters).
+  const Eigen::MatrixXd c = io::solutionColumns(s, {"t", "lat", "sdu", "vu", "q"});
+  ASSERT_EQ(c.rows(), 1098);
+  EXPECT_EQ(c(0, 0), s.fixes.front().t);
+  EXPECT_EQ(c(5, 1), s.fixes[5].lat_deg);
+  EXPECT_NEAR(c(5, 2), std::sqrt(s.fixes[5].cov_neu(2, 2)), 1e-15);
+  EXPECT_EQ(c(5, 3), (*s.fixes[5].vel_neu)[2]);
+  EXPECT_EQ(c(5, 4), 1.0);
+  expectThrowsNaming<InputError>([&] { io::solutionColumns(s, {"speed"}); }, {"gnss.pos", "'speed'", "lat"});
 }

@@ -12,6 +12,8 @@
 #include "gssm/core/so3.h"
 #include "gssm/io/config.h"
 #include "gssm/io/ini.h"
+#include "gssm/io/rtklib_pos.h"
+#include "expect_error.h"
 #include "gssm/models/strapdown_ins.h"
 #include "jacobian_check.h"
 #include "reference_kalman.h"
@@ -70,6 +72,26 @@ TEST(StrapdownIns, RoundTripsThroughItsIniForm) {
   const auto& p = dynamic_cast<const StrapdownIns&>(*again).params();
   EXPECT_NEAR(p.anchor.lat, model.params().anchor.lat, 1e-15);
   EXPECT_LT((p.mount_rpy - model.params().mount_rpy).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+// The frame's anchor from the log itself: the first fix of its .pos.
+TEST(StrapdownIns, AnchorIsTheFirstFixOfTheLog) {
+  const std::string ini =
+      "[model]\ntype = strapdown_ins\nanchor = first_fix\n[dataset]\ngnss = gnss.pos\n";
+  const auto m = io::makeModel(io::IniDocument::parse(ini, "ins.ini"), GSSM_SOURCE_DIR "/datasets/gnss-ins-drive");
+  const auto& a = dynamic_cast<const StrapdownIns&>(*m).params().anchor;
+  // gnss.pos read on its own: its first fix (40.0966268, −105.1474483, 1601.474)
+  const io::GnssSolution pos = io::readRtklibPos(GSSM_SOURCE_DIR "/datasets/gnss-ins-drive/gnss.pos");
+  EXPECT_NEAR(a.lat * 180 / M_PI, pos.fixes.front().lat_deg, 1e-12);
+  EXPECT_NEAR(a.lon * 180 / M_PI, pos.fixes.front().lon_deg, 1e-12);
+  EXPECT_NEAR(a.height, pos.fixes.front().height, 1e-12);
+  testing::expectThrowsNaming<InputError>(
+      [] {
+        io::makeModel(io::IniDocument::parse("[model]\ntype = strapdown_ins\nanchor = first_fix\n[dataset]\n"
+                                             "gnss = imu.csv\n", "ins.ini"),
+                      GSSM_SOURCE_DIR "/datasets/gnss-ins-drive");
+      },
+      {"imu.csv", "lat"});
 }
 
 // Each constant of a simulated drive within 2 reported σ of its truth, in

@@ -7,6 +7,7 @@
 #include "gssm/core/error.h"
 #include "gssm/io/config.h"
 #include "gssm/io/csv.h"
+#include "gssm/io/rtklib_pos.h"
 #include "gssm/model/registry.h"
 
 namespace gssm::io {
@@ -73,7 +74,9 @@ class IniParamSource final : public ParamSource {
 };
 
 Eigen::MatrixXd IniParamSource::dataFile(const std::string& file, const std::vector<std::string>& columns) const {
-  const CsvTable t = readCsv(io::dataFile(ini_, data_dir_, file));
+  const std::string path = io::dataFile(ini_, data_dir_, file);
+  if (std::filesystem::path(path).extension() == ".pos") return solutionColumns(readRtklibPos(path), columns);
+  const CsvTable t = readCsv(path);
   std::vector<std::size_t> at;
   for (const auto& c : columns) {
     const int i = t.column(c);

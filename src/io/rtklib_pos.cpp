@@ -253,4 +253,29 @@ void writeRtklibPos(const std::string& path, const GnssSolution& solution, const
   file.flush();
 }
 
+Eigen::MatrixXd solutionColumns(const GnssSolution& solution, const std::vector<std::string>& columns) {
+  static const char* const kKnown = "t, lat, lon, height, q, ns, sdn, sde, sdu, vn, ve, vu";
+  auto value = [&](const GnssFix& f, const std::string& c) -> double {
+    if (c == "t") return f.t;
+    if (c == "lat") return f.lat_deg;
+    if (c == "lon") return f.lon_deg;
+    if (c == "height") return f.height;
+    if (c == "q") return f.quality;
+    if (c == "ns") return f.satellites;
+    for (int i = 0; i < 3; ++i) {
+      if (c == std::string("sd") + "neu"[i]) return std::sqrt(f.cov_neu(i, i));
+      if (c == std::string("v") + "neu"[i]) {
+        if (!f.vel_neu) throw InputError(solution.source + ": column '" + c + "' asked for, but the file has no velocities");
+        return (*f.vel_neu)[i];
+      }
+    }
+    throw InputError(solution.source + ": no column '" + c + "' in an RTKLIB solution (it has " + kKnown + ")");
+  };
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(solution.fixes.size()), static_cast<Eigen::Index>(columns.size()));
+  for (std::size_t r = 0; r < solution.fixes.size(); ++r)
+    for (std::size_t c = 0; c < columns.size(); ++c)
+      out(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = value(solution.fixes[r], columns[c]);
+  return out;
+}
+
 }  // namespace gssm::io

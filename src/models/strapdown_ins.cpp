@@ -183,7 +183,9 @@ std::vector<ParamSpec> insParams() {
   using namespace param;
   std::vector<ParamSpec> p{
       real("model", "T", "nominal IMU interval (s)"),
-      required(vector("model", "anchor", "the NED frame's origin: latitude, longitude (deg), ellipsoidal height (m)")),
+      required(any("model", "anchor",
+                   "the NED frame's origin: latitude, longitude (deg), ellipsoidal height (m), or first_fix: the "
+                   "first fix of [dataset] gnss (an RTKLIB .pos, default gnss.pos)")),
       vector("model", "mount_rpy", "nominal IMU → vehicle rotation as roll, pitch, yaw (deg; vehicle axes forward, right, down)"),
       learnable(real("model", "gyro_sd", "gyro white noise, rad/s/√Hz")),
       learnable(real("model", "accel_sd", "accelerometer white noise, m/s²/√Hz")),
@@ -205,10 +207,28 @@ std::vector<ParamSpec> insParams() {
   return p;
 }
 
+// [model] anchor: "lat lon height", or first_fix (of the log's GNSS file:
+// the same scenario.ini then serves any log of the data set).
+geodesy::Geodetic readAnchor(const ParamSource& in) {
+  Eigen::VectorXd a;
+  bool first_fix = false;
+  try {  // a word, or numbers (a keyword source holding numbers has no text)
+    first_fix = in.text("model", "anchor") == "first_fix";
+  } catch (const InvalidArgument&) {
+  }
+  if (first_fix) {
+    const Eigen::MatrixXd fixes = in.dataFile(in.text("dataset", "gnss", "gnss.pos"), {"lat", "lon", "height"});
+    if (fixes.rows() == 0) throw InputError(in.where("model", "anchor") + " = first_fix: the GNSS file has no fix");
+    a = fixes.row(0).transpose();
+  } else {
+    a = in.vector("model", "anchor", 3);
+  }
+  return {a[0] * kDeg, a[1] * kDeg, a[2]};
+}
+
 StrapdownIns::Params readIns(const ParamSource& in) {
   StrapdownIns::Params p;
-  const Eigen::VectorXd a = in.vector("model", "anchor", 3);
-  p.anchor = {a[0] * kDeg, a[1] * kDeg, a[2]};
+  p.anchor = readAnchor(in);
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
   for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
                             {"gnss_sd", &p.gnss_sd}, {"nhc_sd", &p.nhc_sd}, {"zupt_sd", &p.zupt_sd}})

@@ -48,6 +48,12 @@ std::string gpstCalendar(double t);
 /// time going backwards, or a layout gssm does not read.
 GnssSolution parseRtklibPos(const std::string& text, const std::string& source);
 GnssSolution readRtklibPos(const std::string& path);
+/// The named columns of a solution, one row per fix, for readers that take
+/// a data file by its columns (ParamSource::dataFile): t (GPS s), lat, lon
+/// (deg), height (m), q, ns, sdn, sde, sdu (m), vn, ve, vu (m/s, when the
+/// file has velocities). InputError naming the source and the known columns
+/// for any other.
+Eigen::MatrixXd solutionColumns(const GnssSolution& solution, const std::vector<std::string>& columns);
 
 /// Writes a solution in the layout parseRtklibPos reads (and RTKPLOT
 /// plots): latitude/longitude/height, GPST calendar times, the velocity
