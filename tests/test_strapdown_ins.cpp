@@ -11,6 +11,7 @@
 #include "gssm/core/rotation_blocks.h"
 #include "gssm/core/so3.h"
 #include "gssm/io/config.h"
+#include "gssm/io/dataset.h"
 #include "gssm/io/ini.h"
 #include "gssm/io/rtklib_pos.h"
 #include "expect_error.h"
@@ -92,6 +93,32 @@ TEST(StrapdownIns, AnchorIsTheFirstFixOfTheLog) {
                       GSSM_SOURCE_DIR "/datasets/gnss-ins-drive");
       },
       {"imu.csv", "lat"});
+}
+
+// The drive's files as a dataset: the IMU as inputs, each RTK-fixed GNSS
+// fix a measurement in the frame with its own covariance (NEU → NED), the
+// fixes inside the outages withheld (292, the data set's README), floats
+// (all 8 inside the first outage) neither used nor counted as truth.
+TEST(StrapdownIns, ReadsTheDrivesImuAndGnssWithItsOutages) {
+  const std::string dir = GSSM_SOURCE_DIR "/datasets/gnss-ins-drive";
+  const io::IniDocument ini = io::IniDocument::parse(
+      "[model]\ntype = strapdown_ins\nanchor = first_fix\n"
+      "[dataset]\ninputs = imu.csv\ninput_columns = gx gy gz ax ay az\ngnss = gnss.pos\n"
+      "gnss_outages = outages.csv\nstart_time = 1436038461.854\n",
+      dir + "/scenario-test.ini");
+  const auto model = io::makeModel(ini, dir);
+  io::Dataset ds;
+  io::readDatasetData(dir, *model, ds, io::BadRows::Throw, &ini);
+  EXPECT_EQ(ds.inputs.size(), 27107u);
+  EXPECT_EQ(ds.withheld.size(), 292u);
+  EXPECT_EQ(ds.measurements.size(), 1090u - 292u);
+  EXPECT_EQ(ds.gnss_dropped, 0u);
+  const Measurement& first = ds.measurements.front();
+  EXPECT_EQ(first.channel, StrapdownIns::kGnss);
+  EXPECT_LT(first.y.norm(), 1e-6);  // the anchor is the first fix
+  EXPECT_NEAR(first.R(0, 0), 0.0098995 * 0.0098995, 1e-12);
+  EXPECT_NEAR(first.R(2, 2), 0.01 * 0.01, 1e-12);
+  for (std::size_t i = 1; i < ds.measurements.size(); ++i) ASSERT_GT(ds.measurements[i].t, ds.measurements[i - 1].t);
 }
 
 // Each constant of a simulated drive within 2 reported σ of its truth, in

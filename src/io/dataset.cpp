@@ -10,6 +10,7 @@
 #include "gssm/core/error.h"
 #include "gssm/core/time.h"
 #include "gssm/io/csv.h"
+#include "io/gnss_measurements.h"
 
 namespace gssm::io {
 
@@ -390,7 +391,8 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
                                   "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
                                   "truth_interpolate", "start_time", "rows", "drop_at_or_below", "out_of_order",
-                                  "constants_reference"});
+                                  "constants_reference", "gnss", "gnss_channel", "gnss_max_quality", "gnss_float_scale",
+                                  "gnss_outages"});
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   out.truth.reset();
   if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0
@@ -404,7 +406,10 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   out.row_errors.clear();
   out.late_rows = 0;
   out.max_lateness = 0;
+  out.withheld.clear();
+  out.gnss_dropped = 0;
   if (ini.has("dataset", "measurements")) readMeasurements(file("measurements"), ini, model, out, bad_rows);
+  if (ini.has("dataset", "gnss")) readGnssMeasurements(file("gnss"), dir, ini, model, out);
   if (std::isinf(out.t0))  // start_time = first
     out.t0 = out.measurements.empty() ? 0.0 : out.measurements.front().t - model.nominalStep();
   if (out.truth && ini.getBool("dataset", "truth_interpolate", false)) interpolateTruth(model, out);

@@ -39,6 +39,11 @@ struct Dataset {
   /// time order, [dataset] out_of_order = sort), and the largest lateness (s).
   std::size_t late_rows = 0;
   double max_lateness = 0;
+  /// GNSS fixes inside [dataset] gnss_outages, withheld from the estimators
+  /// (on the GNSS channel, in the model's frame): the truth to score against.
+  std::vector<Measurement> withheld;
+  /// GNSS fixes dropped for their quality ([dataset] gnss_max_quality).
+  std::size_t gnss_dropped = 0;
 };
 
 enum class BadRows {
@@ -64,6 +69,11 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
 ///     truth = FILE, truth_columns = NAMES (stacked components it gives)
 ///     start_time = truth | NUMBER (t0), rows = measurements | inputs
 ///     constants_reference = FILE (a calibration of the constants, judged against)
+///     gnss = FILE (an RTKLIB .pos: each fix a measurement on channel
+///       gnss_channel, default "gnss", mapped by Model::localPosition, with
+///       the fix's own covariance; gnss_max_quality: the worst Q used, default
+///       1 = RTK-fixed; gnss_float_scale: σ factor of float fixes, default 3;
+///       gnss_outages = FILE: rows start,end (s) whose fixes are withheld)
 void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
                      BadRows bad_rows = BadRows::Throw, const IniDocument* config = nullptr);
 

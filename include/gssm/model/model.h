@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -157,6 +158,12 @@ class Model {
   virtual std::vector<Eigen::Vector2d> bodyPoints(const Eigen::VectorXd& /*xc*/) const { return {}; }
   /// Their names (one per point), e.g. "tag 0".
   virtual std::vector<std::string> bodyPointNames() const { return {}; }
+  /// A model whose positions live in a frame anchored on the Earth maps a
+  /// WGS-84 point (latitude, longitude in rad, ellipsoidal height in m) into
+  /// it: the GNSS fixes of a log become its measurements. None by default.
+  virtual std::optional<Eigen::Vector3d> localPosition(double /*lat*/, double /*lon*/, double /*height*/) const {
+    return std::nullopt;
+  }
 
   /// A calibration reference of the constants, for judging estimates (no
   /// estimator reads it): the columns of the reference file this model

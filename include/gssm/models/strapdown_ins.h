@@ -61,6 +61,10 @@ class StrapdownIns final : public Model {
   Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
   Eigen::MatrixXd processNoise(double dt) const override;
+  /// The point in the frame (NED from the anchor, m).
+  std::optional<Eigen::Vector3d> localPosition(double lat, double lon, double height) const override {
+    return frame_.local().toNed({lat, lon, height});
+  }
 
   // Where each part of x_b starts.
   static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kConstants = 13;

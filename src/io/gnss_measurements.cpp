@@ -1,0 +1,73 @@
+#include "io/gnss_measurements.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "gssm/core/error.h"
+#include "gssm/io/csv.h"
+#include "gssm/io/rtklib_pos.h"
+
+namespace gssm::io {
+
+namespace {
+struct Outage {
+  double start, end;
+};
+
+std::vector<Outage> readOutages(const std::string& path) {
+  const CsvTable t = readCsv(path);
+  const int a = t.column("start"), b = t.column("end");
+  if (a < 0 || b < 0) throw InputError(t.source + ":1: expected columns start,end (s)");
+  std::vector<Outage> out;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    const double s = t.rows[r][static_cast<std::size_t>(a)], e = t.rows[r][static_cast<std::size_t>(b)];
+    if (!(e > s))
+      throw InputError(t.source + ":" + std::to_string(t.line_of_row[r]) + ": an outage must end after it starts");
+    out.push_back({s, e});
+  }
+  return out;
+}
+
+bool inside(const std::vector<Outage>& outages, double t) {
+  return std::any_of(outages.begin(), outages.end(), [t](const Outage& o) { return t >= o.start && t < o.end; });
+}
+}  // namespace
+
+void readGnssMeasurements(const std::string& path, const std::string& dir, const IniDocument& ini, const Model& model,
+                          Dataset& out) {
+  const int channel = model.channelIndex(ini.getString("dataset", "gnss_channel", "gnss"));
+  if (model.channel(channel).dim() != 3 || !model.localPosition(0, 0, 0))
+    throw InputError(ini.source() + ": [dataset] gnss: model '" + model.name() + "' channel '" +
+                     model.channel(channel).name + "' does not take positions in a frame anchored on the Earth");
+  const int max_quality = static_cast<int>(ini.getDouble("dataset", "gnss_max_quality", 1));
+  const double float_scale = ini.getDouble("dataset", "gnss_float_scale", 3.0);
+  std::vector<Outage> outages;
+  if (ini.has("dataset", "gnss_outages"))
+    outages = readOutages((std::filesystem::path(dir) / ini.getString("dataset", "gnss_outages")).string());
+  const GnssSolution sol = readRtklibPos(path);
+  const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
+  std::vector<Measurement> used;
+  for (const GnssFix& f : sol.fixes) {
+    const double deg = M_PI / 180;
+    Measurement m(f.t, *model.localPosition(f.lat_deg * deg, f.lon_deg * deg, f.height), channel,
+                  neu_to_ned * f.cov_neu * neu_to_ned);
+    if (inside(outages, f.t)) {
+      if (f.quality == 1) out.withheld.push_back(std::move(m));  // RTK-fixed: the truth inside
+      continue;
+    }
+    if (f.quality > max_quality) {
+      ++out.gnss_dropped;
+      continue;
+    }
+    if (f.quality != 1) m.R *= float_scale * float_scale;
+    used.push_back(std::move(m));
+  }
+  std::vector<Measurement> merged;
+  merged.reserve(out.measurements.size() + used.size());
+  std::merge(out.measurements.begin(), out.measurements.end(), used.begin(), used.end(), std::back_inserter(merged),
+             [](const Measurement& a, const Measurement& b) { return a.t < b.t; });
+  out.measurements = std::move(merged);
+}
+
+}  // namespace gssm::io
