@@ -6,6 +6,8 @@
 #include "gssm/solvers/batch_solver.h"
 #include "gssm/solvers/ekf.h"
 #include "gssm/core/error.h"
+#include "gssm/core/time.h"
+#include "gssm/estimator/estimator.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/radar2d.h"
 #include "gssm/factors/problem.h"
@@ -383,6 +385,35 @@ TEST(Problem, RejectsTimesGoingBackwardsAndGroupsEqualTimesIntoOneStep) {
   const Problem p = buildProblem(radar, ms);
   EXPECT_EQ(p.times.size(), 2u);
   EXPECT_EQ(p.graph.size(), 5u);  // 2 priors, 1 process, 2 measurements
+}
+
+// GPS-second time bases (1.4e9 s: one ulp is 2.4e-7 s): a measurement one
+// ulp after another is at its instant — one step in the batch and in a
+// streaming run, the same numbers as at exactly that time — and instants a
+// second apart are not the same (the old 1e-9 relative rule merged 1.4 s).
+TEST(Problem, InstantsAtGpsSecondsWithinRoundingShareAStep) {
+  const double t0 = 1436038461.854, t1 = t0 + 0.05;
+  EXPECT_TRUE(sameTime(t1, std::nextafter(t1, 2 * t1)));
+  EXPECT_FALSE(sameTime(t1, t1 + 1.0));
+  EXPECT_FALSE(sameTime(t1, t1 + 1e-3));
+  EXPECT_TRUE(sameTime(0.5, 0.5 + 5e-7));
+  EXPECT_FALSE(sameTime(0.5, 0.5 + 2e-6));
+  const models::Radar2D radar;
+  std::vector<Measurement> exact{{t1, Eigen::VectorXd::Constant(1, 1000)}, {t1, Eigen::VectorXd::Constant(1, 1001)},
+                                 {t1 + 0.05, Eigen::VectorXd::Constant(1, 1002)}};
+  std::vector<Measurement> ulp = exact;
+  ulp[1].t = std::nextafter(t1, 2 * t1);
+  EXPECT_EQ(buildProblem(radar, ulp, {}, t0).times, buildProblem(radar, exact, {}, t0).times);
+  EXPECT_EQ(buildProblem(radar, ulp, {}, t0).times.size(), 3u);
+  for (Method method : {Method::Ekf, Method::Incremental, Method::FixedLag}) {
+    EstimatorOptions o(method);
+    o.t0 = t0;
+    auto a = makeEstimator(radar, o), b = makeEstimator(radar, o);
+    for (std::size_t i = 0; i < exact.size(); ++i) a->addMeasurement(exact[i]), b->addMeasurement(ulp[i]);
+    EXPECT_EQ(b->step(), 2) << methodName(method);
+    EXPECT_EQ(a->current().mean, b->current().mean) << methodName(method);
+    EXPECT_EQ(a->current().covariance, b->current().covariance) << methodName(method);
+  }
 }
 
 TEST(NewtonPolish, CurvaturePlusGaussNewtonEqualsTheNumericalHessianOfEachFactor) {

@@ -142,7 +142,7 @@ void Estimator::addInput(double t, const Eigen::VectorXd& u) {
   requireVector(u, model_.dims().nu, std::string(methodName()) + ": input u at t = " + std::to_string(t));
   // A time stamp within rounding of the newest state's (k·T computed two
   // ways) means "now".
-  if (std::isfinite(t) && t < t_ && sameTime(t, t_)) t = t_;
+  if (std::isfinite(t) && sameTime(t, t_)) t = t_;
   if (!std::isfinite(t) || t < t_) {
     std::ostringstream os;
     os << methodName() << ": input at t = " << t << " must be at or after the newest state (t = " << t_ << ")";
@@ -286,7 +286,7 @@ void Estimator::addMeasurements(const Measurement* ms, std::size_t count) {
 
 // Validated measurements at time t: at the newest state, or a new one.
 void Estimator::addAt(double t, const Measurement* ms, std::size_t count) {
-  if (t == t_) {
+  if (t == t_ || (k_ > 0 && sameTime(t, t_))) {  // the newest state's instant (core/time.h)
     doMeasurements(k_, ms, count);
   } else {
     doStep(k_ + 1, t - t_, inputInForce(), ms, count);  // strong guarantee: throws before changing anything

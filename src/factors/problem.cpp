@@ -5,12 +5,13 @@
 #include <sstream>
 
 #include "gssm/core/error.h"
+#include "gssm/core/time.h"
 
 namespace gssm {
 
 Eigen::VectorXd inputAt(const Model& model, const std::vector<Input>& inputs, double t) {
-  auto it = std::upper_bound(inputs.begin(), inputs.end(), t,
-                             [](double tt, const Input& in) { return tt < in.t; });
+  auto it = std::upper_bound(inputs.begin(), inputs.end(), t,  // in force: at or before t (core/time.h)
+                             [](double tt, const Input& in) { return tt < in.t && !sameTime(tt, in.t); });
   if (it == inputs.begin()) return Eigen::VectorXd::Zero(model.dims().nu);
   return std::prev(it)->u;
 }
@@ -23,7 +24,8 @@ std::vector<ScheduledStep> stepSchedule(const std::vector<Measurement>& measurem
   while (mi < measurements.size() || ii < inputs.size()) {
     const double t = std::min(mi < measurements.size() ? measurements[mi].t : INFINITY,
                               ii < inputs.size() ? inputs[ii].t : INFINITY);
-    if (steps.empty() || t > steps.back().t) steps.push_back({t, {}});
+    // An event at the newest step's instant (core/time.h) joins it.
+    if (steps.empty() || (t > steps.back().t && !sameTime(t, steps.back().t))) steps.push_back({t, {}});
     for (; mi < measurements.size() && measurements[mi].t == t; ++mi) steps.back().measurements.push_back(mi);
     while (ii < inputs.size() && inputs[ii].t == t) ++ii;
   }

@@ -2,8 +2,12 @@
 // Time stamps: one rule for "the same instant" everywhere. State times are
 // accumulated step by step (t_k + dt) or read from another file than the
 // one they are compared with, so equal instants may differ by rounding:
-// they match when they differ by at most kTimeTolerance relative to their
-// size (absolute below 1 s).
+// they match when they differ by at most 1 µs, or by kTimeTolerance relative
+// to their size where that is more (a few hundred ulps: 0.14 ms at GPS
+// seconds, 1.4e9 s, where one ulp is 2.4e-7 s — a GNSS fix 2.4e-7 s after an
+// IMU stamp is that stamp's instant, not a state of its own whose Q(dt) is
+// singular). (It was 1e-9 relative, which at GPS seconds made instants 1.4 s
+// apart "the same".)
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -12,10 +16,11 @@
 
 namespace gssm {
 
-constexpr double kTimeTolerance = 1e-9;
+constexpr double kTimeTolerance = 1e-13;
+constexpr double kTimeToleranceAbsolute = 1e-6;  ///< s
 
 inline bool sameTime(double a, double b) {
-  return std::abs(a - b) <= kTimeTolerance * std::max({1.0, std::abs(a), std::abs(b)});
+  return std::abs(a - b) <= std::max(kTimeToleranceAbsolute, kTimeTolerance * std::max(std::abs(a), std::abs(b)));
 }
 
 /// Finds rows of increasing `times` (e.g. a truth file) at increasing query
