@@ -33,6 +33,15 @@ inline void vehicleAt(double t, Eigen::Matrix3d& R_nv, double& speed) {
   R_nv = so3::fromRollPitchYaw(Eigen::Vector3d(0.0, pitch, yaw));
 }
 
+/// The IMU's roll, pitch, yaw at the drive's start, mounted at `mount_rpy`
+/// (IMU → vehicle): a model's prior mean for it.
+inline Eigen::Vector3d driveStartRpy(const Eigen::Vector3d& mount_rpy) {
+  Eigen::Matrix3d R_nv;
+  double speed;
+  vehicleAt(0.0, R_nv, speed);
+  return so3::rollPitchYaw(R_nv * so3::fromRollPitchYaw(mount_rpy));
+}
+
 /// Drives `seconds` with `model` (its T the IMU interval); the constants
 /// drawn from the model's prior, the start its prior mean.
 inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double seconds, const NormalSampler& draw) {

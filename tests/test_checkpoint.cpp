@@ -344,10 +344,7 @@ TEST(Checkpoint, EveryMethodContinuesBitIdenticallyOnTheStrapdownIns) {
   p.T = 0.05;
   p.anchor = {0.7, -1.8, 1600.0};
   p.mount_rpy = Eigen::Vector3d(M_PI, 0.0, M_PI);
-  Eigen::Matrix3d R_nv;
-  double speed;
-  gssm::testing::vehicleAt(0.0, R_nv, speed);
-  p.start_rpy = so3::rollPitchYaw(R_nv * so3::fromRollPitchYaw(p.mount_rpy));
+  p.start_rpy = gssm::testing::driveStartRpy(p.mount_rpy);
   p.attitude_sd = 0.05, p.mount_sd = 0.05, p.gyro_bias_sd = 2e-3, p.accel_bias_sd = 0.05;
   const models::StrapdownIns ins(p);
   const auto drive = gssm::testing::simulateDrive(ins, 7.0, gssm::testing::normalSampler(8));

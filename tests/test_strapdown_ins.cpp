@@ -32,10 +32,7 @@ StrapdownIns::Params driveParams(double T) {
   p.mount_rpy = Eigen::Vector3d(M_PI, 0.0, M_PI);  // the drive's nominal: upside down, backwards
   p.gyro_sd = 1e-3, p.accel_sd = 0.02;
   p.gnss_sd = 0.02, p.nhc_sd = 0.05, p.zupt_sd = 0.01;
-  Eigen::Matrix3d R_nv;  // the drive's start, the IMU nominally mounted
-  double speed;
-  testing::vehicleAt(0.0, R_nv, speed);
-  p.start_rpy = so3::rollPitchYaw(R_nv * so3::fromRollPitchYaw(p.mount_rpy));
+  p.start_rpy = testing::driveStartRpy(p.mount_rpy);  // the IMU nominally mounted
   p.attitude_sd = 0.05, p.velocity_sd = 0.1, p.position_sd = 0.1;
   p.gyro_bias_sd = 2e-3, p.accel_bias_sd = 0.05;
   p.lever = Eigen::Vector3d(0.0, -0.05, 0.0);

@@ -69,6 +69,14 @@ void postmultiplyBlocks(Eigen::MatrixXd& J, const std::vector<Eigen::Matrix3d>& 
   });
 }
 
+std::vector<Eigen::Matrix3d> blockRightJacobians(const Eigen::Ref<const Eigen::VectorXd>& delta,
+                                                 const std::vector<int>& blocks, int offset) {
+  std::vector<Eigen::Matrix3d> out;
+  forEachBlock(blocks, delta.size(), offset,
+               [&](Eigen::Index j) { out.push_back(so3::rightJacobian(delta.segment<3>(j))); });
+  return out;
+}
+
 void normalizeBlocks(Eigen::Ref<Eigen::VectorXd> x, const std::vector<int>& blocks, int offset) {
   forEachBlock(blocks, x.size(), offset, [&](Eigen::Index j) {
     if (x.segment<3>(j).norm() > M_PI) x.segment<3>(j) = so3::Log(so3::Exp(x.segment<3>(j)));

@@ -68,11 +68,7 @@ FactorPtr readFactor(ByteReader& in, const Model& model, const std::string& what
       for (int a : angles)
         if (a < 0 || a >= g.mean.size()) in.fail(what + ": angle component " + std::to_string(a) + " out of range");
       // Its rotation blocks are the model's in its variable (every prior is on a state or on x_b).
-      std::vector<int> rotations;
-      const int nc = model.dims().nc;
-      for (int b : model.rotationBlocks())
-        if (k.isConstants() ? b >= nc : b < nc) rotations.push_back(k.isConstants() ? b - nc : b);
-      return std::make_shared<PriorFactor>(k, g, std::move(angles), std::move(rotations));
+      return std::make_shared<PriorFactor>(k, g, std::move(angles), model.rotationBlocksIn(k.isConstants()));
     }
     case FactorTag::Process: {
       const std::int64_t k = in.i64((what + " step").c_str());

@@ -195,16 +195,17 @@ void internal::processResidual(const Model& model, const Eigen::VectorXd& u, dou
   }
 }
 
-namespace {
-// The model's rotation blocks in a factor's variable: x_c from 0, x_b from n_c.
-Factor::Rotations modelRotations(const Model& model, bool constants) {
+Factor::Rotations internal::rotationsOfVariable(const Model& model, bool constants) {
   if (model.rotationBlocks().empty()) return {};
   return {&model.rotationBlocks(), constants ? model.dims().nc : 0};
 }
-}  // namespace
 
-Factor::Rotations ProcessFactor::rotationsOf(std::size_t a) const { return modelRotations(*model_, a == 2); }
-Factor::Rotations MeasurementFactor::rotationsOf(std::size_t a) const { return modelRotations(*model_, a == 1); }
+Factor::Rotations ProcessFactor::rotationsOf(std::size_t a) const {
+  return internal::rotationsOfVariable(*model_, a == 2);
+}
+Factor::Rotations MeasurementFactor::rotationsOf(std::size_t a) const {
+  return internal::rotationsOfVariable(*model_, a == 1);
+}
 
 void ProcessFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                                 std::vector<Eigen::MatrixXd>* J) const {

@@ -8,6 +8,7 @@
 
 #include "gssm/core/gaussian.h"
 #include "gssm/core/robust_loss.h"
+#include "gssm/factors/factors.h"
 #include "gssm/model/model.h"
 
 namespace gssm::internal {
@@ -23,6 +24,10 @@ void processResidual(const Model& model, const Eigen::VectorXd& u, double dt, co
 void measurementResidual(const Model& model, int channel, const Eigen::Ref<const Eigen::VectorXd>& y,
                          const GaussianNoise& noise, const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                          std::vector<Eigen::MatrixXd>* J);
+
+/// Where a variable of `model` holds rotations: its stacked blocks, from 0
+/// in x_c, from n_c in x_b (constants true); null blocks for a model without.
+Factor::Rotations rotationsOfVariable(const Model& model, bool constants);
 
 /// r and J scaled by √ρ'(s), s = ‖r‖², for a robust loss; returns ½ρ(s).
 double robustify(const RobustLoss& loss, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J);

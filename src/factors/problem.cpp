@@ -36,12 +36,13 @@ std::vector<FactorPtr> priorFactors(const Model& model, const Gaussian& state_pr
                                     const Gaussian& constants_prior, std::int64_t step) {
   // The model's angle components, split between x_c and x_b.
   const int nc = model.dims().nc;
-  std::vector<int> state_angles, constant_angles, state_rotations, constant_rotations;
+  std::vector<int> state_angles, constant_angles;
   for (int a : model.angleStates()) (a < nc ? state_angles : constant_angles).push_back(a < nc ? a : a - nc);
-  for (int b : model.rotationBlocks()) (b < nc ? state_rotations : constant_rotations).push_back(b < nc ? b : b - nc);
-  std::vector<FactorPtr> f{std::make_shared<PriorFactor>(Key::state(step), state_prior, state_angles, state_rotations)};
+  std::vector<FactorPtr> f{
+      std::make_shared<PriorFactor>(Key::state(step), state_prior, state_angles, model.rotationBlocksIn(false))};
   if (model.dims().nb > 0)
-    f.push_back(std::make_shared<PriorFactor>(Key::constants(), constants_prior, constant_angles, constant_rotations));
+    f.push_back(std::make_shared<PriorFactor>(Key::constants(), constants_prior, constant_angles,
+                                              model.rotationBlocksIn(true)));
   return f;
 }
 

@@ -409,7 +409,8 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   out.withheld.clear();
   out.gnss_dropped = 0;
   if (ini.has("dataset", "measurements")) readMeasurements(file("measurements"), ini, model, out, bad_rows);
-  if (ini.has("dataset", "gnss")) readGnssMeasurements(file("gnss"), dir, ini, model, out);
+  if (ini.has("dataset", "gnss"))
+    readGnssMeasurements(file("gnss"), ini.has("dataset", "gnss_outages") ? file("gnss_outages") : "", ini, model, out);
   if (std::isinf(out.t0))  // start_time = first
     out.t0 = out.measurements.empty() ? 0.0 : out.measurements.front().t - model.nominalStep();
   if (out.truth && ini.getBool("dataset", "truth_interpolate", false)) interpolateTruth(model, out);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 
 #include "gssm/core/error.h"
 #include "gssm/io/csv.h"
@@ -34,22 +33,20 @@ bool inside(const std::vector<Outage>& outages, double t) {
 }
 }  // namespace
 
-void readGnssMeasurements(const std::string& path, const std::string& dir, const IniDocument& ini, const Model& model,
-                          Dataset& out) {
+void readGnssMeasurements(const std::string& path, const std::string& outages_path, const IniDocument& ini,
+                          const Model& model, Dataset& out) {
   const int channel = model.channelIndex(ini.getString("dataset", "gnss_channel", "gnss"));
   if (model.channel(channel).dim() != 3 || !model.localPosition(0, 0, 0))
     throw InputError(ini.source() + ": [dataset] gnss: model '" + model.name() + "' channel '" +
                      model.channel(channel).name + "' does not take positions in a frame anchored on the Earth");
   const int max_quality = static_cast<int>(ini.getDouble("dataset", "gnss_max_quality", 1));
   const double float_scale = ini.getDouble("dataset", "gnss_float_scale", 3.0);
-  std::vector<Outage> outages;
-  if (ini.has("dataset", "gnss_outages"))
-    outages = readOutages((std::filesystem::path(dir) / ini.getString("dataset", "gnss_outages")).string());
+  const std::vector<Outage> outages = outages_path.empty() ? std::vector<Outage>{} : readOutages(outages_path);
   const GnssSolution sol = readRtklibPos(path);
   const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
+  const double deg = M_PI / 180;
   std::vector<Measurement> used;
   for (const GnssFix& f : sol.fixes) {
-    const double deg = M_PI / 180;
     Measurement m(f.t, *model.localPosition(f.lat_deg * deg, f.lon_deg * deg, f.height), channel,
                   neu_to_ned * f.cov_neu * neu_to_ned);
     if (inside(outages, f.t)) {

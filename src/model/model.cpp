@@ -150,6 +150,13 @@ void Model::setRotationBlocks(std::vector<int> first_components) {
   rotation_blocks_ = std::move(first_components);
 }
 
+std::vector<int> Model::rotationBlocksIn(bool constants) const {
+  std::vector<int> out;
+  for (int b : rotation_blocks_)
+    if (constants ? b >= dims_.nc : b < dims_.nc) out.push_back(constants ? b - dims_.nc : b);
+  return out;
+}
+
 Eigen::VectorXd Model::wrapStacked(Eigen::VectorXd z) const {
   wrapAngles(z, angle_states_);
   normalizeBlocks(z, rotation_blocks_);

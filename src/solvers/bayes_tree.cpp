@@ -14,7 +14,7 @@
 
 #include "gssm/core/error.h"
 #include "gssm/core/rotation_blocks.h"
-#include "gssm/core/so3.h"
+#include "factors/model_factors.h"
 #include "linear/dot.h"
 #include "solvers/newton.h"
 
@@ -25,13 +25,8 @@ namespace {
 // in the chart x = anchor ⊕ δ of its variable at δ̂.
 void chartJacobian(const std::vector<int>& blocks, int offset, const Eigen::Ref<const Eigen::VectorXd>& delta,
                    Eigen::MatrixXd& J) {
-  if (!hasRotationIn(blocks, delta.size(), offset)) return;
-  std::vector<Eigen::Matrix3d> Jr;
-  for (int b : blocks) {
-    const Eigen::Index j = b - offset;
-    if (j >= 0 && j + 3 <= delta.size()) Jr.push_back(so3::rightJacobian(delta.segment<3>(j)));
-  }
-  postmultiplyBlocks(J, Jr, blocks, offset);
+  if (hasRotationIn(blocks, delta.size(), offset))
+    postmultiplyBlocks(J, blockRightJacobians(delta, blocks, offset), blocks, offset);
 }
 }  // namespace
 
@@ -247,17 +242,17 @@ int BayesTreeEngine::allocSlot() {
 }
 
 Factor::Rotations BayesTreeEngine::rotationsOf(const Key& k) const {
-  if (!model_ || model_->rotationBlocks().empty()) return {};
-  return {&model_->rotationBlocks(), k.isConstants() ? model_->dims().nc : 0};
+  return model_ ? rotationsOfVariable(*model_, k.isConstants()) : Factor::Rotations{};
 }
 
 void BayesTreeEngine::estimateInto(const Key& k, const Var& v, Eigen::VectorXd& out) const {
-  out = v.anchor() + v.delta();
   const Factor::Rotations r = rotationsOf(k);
-  if (r.blocks && hasRotationIn(*r.blocks, out.size(), r.offset)) {  // anchor ⊕ δ (docs/DESIGN.md §12)
-    out = v.anchor();
-    retractBlocks(out, v.delta(), *r.blocks, r.offset);
+  if (!r.blocks) {
+    out = v.anchor() + v.delta();
+    return;
   }
+  out = v.anchor();  // anchor ⊕ δ (docs/DESIGN.md §12)
+  retractBlocks(out, v.delta(), *r.blocks, r.offset);
 }
 
 Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {

@@ -32,6 +32,10 @@ void premultiplyBlocks(Eigen::MatrixXd& J, const std::vector<Eigen::Matrix3d>& M
 void postmultiplyBlocks(Eigen::MatrixXd& J, const std::vector<Eigen::Matrix3d>& M, const std::vector<int>& blocks,
                         int offset = 0);
 
+/// Jr(δ_φ) of each block of δ, in order (the Jacobian of x ⊕ δ in δ there).
+std::vector<Eigen::Matrix3d> blockRightJacobians(const Eigen::Ref<const Eigen::VectorXd>& delta,
+                                                 const std::vector<int>& blocks, int offset = 0);
+
 /// Each block's φ brought to |φ| ≤ π (the same rotation): for reported means.
 void normalizeBlocks(Eigen::Ref<Eigen::VectorXd> x, const std::vector<int>& blocks, int offset = 0);
 

@@ -120,6 +120,9 @@ class Model {
   /// with respect to that body-frame tangent δ, its covariances of δ. Empty
   /// for a model of vectors and angles only (every model before #37).
   const std::vector<int>& rotationBlocks() const { return rotation_blocks_; }
+  /// The rotation blocks in x_c (constants false) or x_b (true), indexed
+  /// within that vector.
+  std::vector<int> rotationBlocksIn(bool constants) const;
   /// The stacked state with its angle components wrapped to (−π, π] and its
   /// rotation vectors to |φ| ≤ π.
   Eigen::VectorXd wrapStacked(Eigen::VectorXd z) const;
