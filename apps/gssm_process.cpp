@@ -69,6 +69,10 @@ gssm::io::ProcessCallbacks consoleCallbacks() {
                                                static_cast<Eigen::Index>(i));
       line << "  " << m.constant_names[i] << " = " << last.mean[j] << " ± " << std::sqrt(last.covariance(j, j));
     }
+    if (m.withheld.count)
+      line << "\n        withheld fixes (" << m.withheld.count << "): horizontal RMS " << m.withheld.horizontal_rms
+           << " m, max " << m.withheld.horizontal_max << " m; used fixes (" << m.used.count << "): horizontal RMS "
+           << m.used.horizontal_rms << " m";
     std::cout << line.str() << "\n        " << run.summary << "\n";
   };
   return cb;

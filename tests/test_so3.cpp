@@ -120,6 +120,22 @@ TEST(So3, EulerAnglesJacobianMatchesDifferencesAwayFromGimbalLock) {
   EXPECT_GE(checked, 15);
 }
 
+TEST(So3, RotationOfEulerAnglesJacobianMatchesDifferences) {
+  // J_out_rpy everywhere, gimbal lock included (the map itself is smooth).
+  int i = 0;
+  for (const Matrix3& R : attitudes()) {
+    const Vector3 rpy = so3::rollPitchYaw(R) + Vector3(0.1, 0.0, -0.2);
+    Matrix3 J;
+    so3::fromRollPitchYaw(rpy, &J);
+    expectJacobian<Vector3, Matrix3>("J_R_rpy" + at(i++), [](const Vector3& a) { return so3::fromRollPitchYaw(a); },
+                                     rpy, J, vectors3(), rotations(), 1e-7);
+  }
+  // and its inverse is rollPitchYaw's (Euler rates ↔ body rates)
+  Matrix3 J_rpy_R, J_R_rpy;
+  so3::fromRollPitchYaw(so3::rollPitchYaw(so3::Exp(Vector3(0.3, -0.4, 2.0)), &J_rpy_R), &J_R_rpy);
+  EXPECT_LT((J_rpy_R * J_R_rpy - Matrix3::Identity()).norm(), 1e-12);
+}
+
 TEST(So3, MapsRoundTrip) {
   for (const Vector3& phi : tangents()) {
     const Vector3 back = so3::Log(so3::Exp(phi));

@@ -31,7 +31,7 @@ StrapdownIns::Params driveParams(double T) {
   p.anchor = {40.0 * M_PI / 180, -105.0 * M_PI / 180, 1600.0};
   p.mount_rpy = Eigen::Vector3d(M_PI, 0.0, M_PI);  // the drive's nominal: upside down, backwards
   p.gyro_sd = 1e-3, p.accel_sd = 0.02;
-  p.gnss_sd = 0.02, p.nhc_sd = 0.05, p.zupt_sd = 0.01;
+  p.gnss_sd = 0.02, p.nhc_sd = 0.05, p.nhc_down_sd = 0.05, p.zupt_sd = 0.01;
   p.start_rpy = testing::driveStartRpy(p.mount_rpy);  // the IMU nominally mounted
   p.attitude_sd = 0.05, p.velocity_sd = 0.1, p.position_sd = 0.1;
   p.gyro_bias_sd = 2e-3, p.accel_bias_sd = 0.05;
@@ -108,11 +108,17 @@ TEST(StrapdownIns, ReadsTheDrivesImuAndGnssWithItsOutages) {
   io::readDatasetData(dir, *model, ds, io::BadRows::Throw, &ini);
   EXPECT_EQ(ds.inputs.size(), 27107u);
   EXPECT_EQ(ds.withheld.size(), 292u);
-  EXPECT_EQ(ds.measurements.size(), 1090u - 292u);
+  // The 14 fixes before the first IMU row are dropped, each named by its line.
+  ASSERT_EQ(ds.dropped.size(), 14u);
+  EXPECT_NE(ds.dropped.front().find("gnss.pos:2:1: time 1436038458.499 is not after the start"), std::string::npos)
+      << ds.dropped.front();
+  EXPECT_NE(ds.dropped.back().find("gnss.pos:15:1:"), std::string::npos) << ds.dropped.back();
+  EXPECT_EQ(ds.measurements.size(), 1090u - 292u - 14u);
   EXPECT_EQ(ds.gnss_dropped, 0u);
   const Measurement& first = ds.measurements.front();
   EXPECT_EQ(first.channel, StrapdownIns::kGnss);
-  EXPECT_LT(first.y.norm(), 1e-6);  // the anchor is the first fix
+  EXPECT_GT(first.t, 1436038461.854);
+  EXPECT_LT(first.y.norm(), 0.01);  // the car stands at the anchor, the first fix
   EXPECT_NEAR(first.R(0, 0), 0.0098995 * 0.0098995, 1e-12);
   EXPECT_NEAR(first.R(2, 2), 0.01 * 0.01, 1e-12);
   for (std::size_t i = 1; i < ds.measurements.size(); ++i) ASSERT_GT(ds.measurements[i].t, ds.measurements[i - 1].t);

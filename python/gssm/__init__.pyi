@@ -45,6 +45,7 @@ class BatchOptions:
     relative_cost_tolerance: float
     step_tolerance: float
     gradient_tolerance: float
+    decrease_tolerance: float
     initial_lambda: float
     max_lambda: float
     newton_polish_steps: int

@@ -47,7 +47,7 @@ void fillFromSimulation(PyDataset& d) {
   d.data.truth = run.truth();
   d.data.t0 = run.times.empty() ? 0.0 : run.times.front();
   const std::string rows = d.data.scenario.getString("dataset", "rows", "measurements");
-  d.data.rows = rows == "inputs" ? RowTimes::Inputs : rows == "epochs" ? RowTimes::Epochs : RowTimes::Measurements;
+  d.data.rows = rowTimesNamed(rows).value_or(RowTimes::Measurements);
 }
 
 PyDataset datasetFromArrays(const VectorXd& t, const MatrixXd& y, const std::optional<Eigen::VectorXi>& channel,

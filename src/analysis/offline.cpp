@@ -145,7 +145,8 @@ class StreamingRun {
                const std::vector<Input>& inputs, const StreamingCheckpoints& checkpoints, RowTimes rows)
       : model_(model), options_(options), measurements_(measurements), inputs_(inputs), checkpoints_(checkpoints),
         inline_recorder_(out_), recorder_(checkpoints.recorder ? *checkpoints.recorder : inline_recorder_),
-        at_inputs_(rows == RowTimes::Inputs), at_epochs_(rows == RowTimes::Epochs),
+        at_inputs_(rows == RowTimes::Inputs || rows == RowTimes::States),
+        at_epochs_(rows == RowTimes::Epochs || rows == RowTimes::States),
         group_epochs_(at_epochs_ && !options.compute_nis) {
     out_.method = options.method;
     at_.data_fingerprint = internal::kFnv1a64Basis;
@@ -189,7 +190,7 @@ class StreamingRun {
   void feedInputsBefore(double t) {
     for (; at_.next_input < inputs_.size() && inputs_[at_.next_input].t < t; ++at_.next_input) {
       const double ti = std::max(inputs_[at_.next_input].t, est_->time());
-      if ((at_inputs_ || at_epochs_) && at_.row_due && ti > est_->time()) addRow(est_->current()), at_.row_due = at_inputs_;
+      if ((at_inputs_ || at_epochs_) && at_.row_due && ti > est_->time()) addRow(est_->current()), at_.row_due = false;
       const bool advances = ti > est_->time();
       est_->addInput(ti, inputs_[at_.next_input].u);
       if (at_inputs_ && advances) at_.row_due = true;
@@ -313,6 +314,14 @@ OfflineRun runStreaming(const Model& model, const EstimatorOptions& options,
   return StreamingRun(model, options, measurements, inputs, checkpoints, rows).run(progress);
 }
 
+std::optional<RowTimes> rowTimesNamed(const std::string& name) {
+  if (name == "measurements") return RowTimes::Measurements;
+  if (name == "inputs") return RowTimes::Inputs;
+  if (name == "epochs") return RowTimes::Epochs;
+  if (name == "states") return RowTimes::States;
+  return std::nullopt;
+}
+
 OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
                     const std::vector<Measurement>& measurements,
                     const std::vector<Input>& inputs, RowTimes rows, const Values* from) {
@@ -334,7 +343,9 @@ OfflineRun runBatch(const Model& model, const EstimatorOptions& options,
   // inputs, have no row), as the streaming runs report; or one per input time.
   std::size_t mi = 0, ii = 0;
   for (std::size_t k = 1; k < p.times.size(); ++k) {
-    if (rows == RowTimes::Inputs) {
+    if (rows == RowTimes::States) {
+      // every state
+    } else if (rows == RowTimes::Inputs) {
       while (ii < inputs.size() && inputs[ii].t < p.times[k]) ++ii;
       if (ii >= inputs.size() || inputs[ii].t != p.times[k]) continue;
     } else {

@@ -113,9 +113,10 @@ Vector3 act(const Matrix3& R, const Vector3& v, Matrix3* J_out_R, Matrix3* J_out
   return R * v;
 }
 
-Matrix3 fromRollPitchYaw(const Vector3& rpy) {
+Matrix3 fromRollPitchYaw(const Vector3& rpy, Matrix3* J_out_rpy) {
   const double cr = std::cos(rpy.x()), sr = std::sin(rpy.x()), cp = std::cos(rpy.y()), sp = std::sin(rpy.y());
   const double cy = std::cos(rpy.z()), sy = std::sin(rpy.z());
+  if (J_out_rpy) *J_out_rpy << 1, 0, -sp, 0, cr, sr * cp, 0, -sr, cr * cp;
   Matrix3 R;
   R << cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,  //
       sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,   //

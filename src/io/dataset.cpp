@@ -168,12 +168,17 @@ void interpolateTruth(const Model& model, Dataset& out) {
   out.truth = std::move(at);
 }
 
-// [dataset] start_time (a number, the truth's first time, or "first": one
-// nominal step before the first measurement, set once they are read) and rows.
+// [dataset] start_time (a number, the truth's first time, "first": one
+// nominal step before the first measurement, set once they are read, or
+// "first_input": the first input's time, set as they are read) and rows.
 void readStartAndRows(const IniDocument& ini, Dataset& out) {
   const std::string start = ini.getString("dataset", "start_time", "0");
   if (start == "first") {
     out.t0 = -std::numeric_limits<double>::infinity();
+  } else if (start == "first_input") {
+    if (!ini.has("dataset", "inputs"))
+      throw InputError(ini.source() + ": [dataset] start_time = first_input, but there is no [dataset] inputs file");
+    out.t0 = std::numeric_limits<double>::quiet_NaN();
   } else if (start == "truth") {
     if (!out.truth || out.truth->times.empty())
       throw InputError(ini.source() + ": [dataset] start_time = truth, but there is no truth file with rows");
@@ -182,9 +187,11 @@ void readStartAndRows(const IniDocument& ini, Dataset& out) {
     out.t0 = ini.getDouble("dataset", "start_time", 0.0);
   }
   const std::string rows = ini.getString("dataset", "rows", "measurements");
-  if (rows != "measurements" && rows != "inputs" && rows != "epochs")
-    throw InputError(ini.source() + ": [dataset] rows = '" + rows + "': expected measurements, inputs or epochs");
-  out.rows = rows == "inputs" ? RowTimes::Inputs : rows == "epochs" ? RowTimes::Epochs : RowTimes::Measurements;
+  const std::optional<RowTimes> named = rowTimesNamed(rows);
+  if (!named)
+    throw InputError(ini.source() + ": [dataset] rows = '" + rows +
+                     "': expected measurements, inputs, epochs or states");
+  out.rows = *named;
 }
 
 // Inputs: rates held from each row's time, or increments over the interval
@@ -201,6 +208,10 @@ void readInputs(const std::string& path, const IniDocument& ini, const Model& mo
   const std::string kind = ini.getString("dataset", "input_kind", "rates");
   if (kind != "rates" && kind != "increments")
     throw InputError(ini.source() + ": [dataset] input_kind = '" + kind + "': expected rates or increments");
+  if (std::isnan(out.t0)) {  // start_time = first_input
+    if (in.rows.empty()) throw InputError(in.source + ": no rows: [dataset] start_time = first_input needs one");
+    out.t0 = in.rows[0][static_cast<std::size_t>(tc)];
+  }
   double prev = out.t0;
   // Rows before the start describe motion before the run: dropped, listed
   // (increments ending at t0 too; a rate may start at t0).
@@ -386,13 +397,40 @@ void readConstantsReference(const std::string& path, const IniDocument& ini, con
   }
 }
 
+// [dataset] zero_channels = NAMES, zero_rate = Hz: a zero measurement on
+// each of those channels every 1/rate s after t0 until the last input or
+// measurement (a constraint the model states as a channel: a car's
+// non-holonomic velocity), merged in time order with the data.
+void addZeroMeasurements(const IniDocument& ini, const Model& model, Dataset& out) {
+  const double rate = ini.getDouble("dataset", "zero_rate", 0.0);
+  if (!(rate > 0) || !std::isfinite(rate))
+    throw InputError(ini.source() + ": [dataset] zero_channels needs zero_rate, a positive rate (Hz)");
+  std::vector<int> channels;
+  for (const auto& name : words(ini.getString("dataset", "zero_channels"))) channels.push_back(model.channelIndex(name));
+  double end = out.t0;
+  if (!out.inputs.empty()) end = std::max(end, out.inputs.back().t);
+  if (!out.measurements.empty()) end = std::max(end, out.measurements.back().t);
+  std::vector<Measurement> zeros;
+  for (std::int64_t k = 1;; ++k) {
+    const double t = out.t0 + static_cast<double>(k) / rate;  // no drift over a long log
+    if (t > end) break;
+    for (int c : channels) zeros.emplace_back(t, Eigen::VectorXd::Zero(model.channel(c).dim()), c);
+  }
+  std::vector<Measurement> merged;
+  merged.reserve(out.measurements.size() + zeros.size());
+  std::merge(out.measurements.begin(), out.measurements.end(), zeros.begin(), zeros.end(), std::back_inserter(merged),
+             [](const Measurement& a, const Measurement& b) { return a.t < b.t; });
+  out.measurements = std::move(merged);
+}
+
 // One CSV per sensor stream, as the config's [dataset] describes.
 void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
   ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
                                   "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
                                   "truth_interpolate", "start_time", "rows", "drop_at_or_below", "out_of_order",
                                   "constants_reference", "gnss", "gnss_channel", "gnss_max_quality", "gnss_float_scale",
-                                  "gnss_outages"});
+                                  "gnss_outages", "gnss_still_channel", "gnss_still_speed", "zero_channels",
+                                  "zero_rate"});
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   out.truth.reset();
   if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0
@@ -413,6 +451,7 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
     readGnssMeasurements(file("gnss"), ini.has("dataset", "gnss_outages") ? file("gnss_outages") : "", ini, model, out);
   if (std::isinf(out.t0))  // start_time = first
     out.t0 = out.measurements.empty() ? 0.0 : out.measurements.front().t - model.nominalStep();
+  if (ini.has("dataset", "zero_channels")) addZeroMeasurements(ini, model, out);
   if (out.truth && ini.getBool("dataset", "truth_interpolate", false)) interpolateTruth(model, out);
 }
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "gssm/core/error.h"
 #include "gssm/io/csv.h"
+#include "gssm/io/number_text.h"
 #include "gssm/io/rtklib_pos.h"
 
 namespace gssm::io {
@@ -31,6 +32,26 @@ std::vector<Outage> readOutages(const std::string& path) {
 bool inside(const std::vector<Outage>& outages, double t) {
   return std::any_of(outages.begin(), outages.end(), [t](const Outage& o) { return t >= o.start && t < o.end; });
 }
+
+// [dataset] gnss_still_channel: the channel of a zero-velocity measurement
+// at every used fix whose own velocity is under gnss_still_speed (m/s).
+struct StillFixes {
+  int channel = -1;  // none
+  double speed = 0;
+};
+
+StillFixes stillFixes(const IniDocument& ini, const Model& model, const GnssSolution& sol) {
+  StillFixes s;
+  if (!ini.has("dataset", "gnss_still_channel")) return s;
+  s.channel = model.channelIndex(ini.getString("dataset", "gnss_still_channel"));
+  s.speed = ini.getDouble("dataset", "gnss_still_speed", 0.05);
+  if (!(s.speed > 0))
+    throw InputError(ini.source() + ": [dataset] gnss_still_speed must be positive (m/s)");
+  if (!sol.has_velocity)
+    throw InputError(sol.source + ": no velocity columns (vn ve vu), which [dataset] gnss_still_channel needs "
+                     "(RTKLIB: output the velocity, or remove the key)");
+  return s;
+}
 }  // namespace
 
 void readGnssMeasurements(const std::string& path, const std::string& outages_path, const IniDocument& ini,
@@ -43,10 +64,16 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
   const double float_scale = ini.getDouble("dataset", "gnss_float_scale", 3.0);
   const std::vector<Outage> outages = outages_path.empty() ? std::vector<Outage>{} : readOutages(outages_path);
   const GnssSolution sol = readRtklibPos(path);
+  const StillFixes still = stillFixes(ini, model, sol);
   const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
   const double deg = M_PI / 180;
   std::vector<Measurement> used;
   for (const GnssFix& f : sol.fixes) {
+    if (!(f.t > out.t0)) {  // before the first IMU row, or the start the INI sets
+      out.dropped.push_back(sol.source + ":" + std::to_string(f.line) + ":1: time " + formatDouble(f.t) +
+                            " is not after the start " + formatDouble(out.t0) + " (dropped: before the run)");
+      continue;
+    }
     Measurement m(f.t, *model.localPosition(f.lat_deg * deg, f.lon_deg * deg, f.height), channel,
                   neu_to_ned * f.cov_neu * neu_to_ned);
     if (inside(outages, f.t)) {
@@ -59,6 +86,8 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
     }
     if (f.quality != 1) m.R *= float_scale * float_scale;
     used.push_back(std::move(m));
+    if (still.channel >= 0 && f.vel_neu->norm() < still.speed)  // standing: its zero-velocity measurement too
+      used.emplace_back(f.t, Eigen::VectorXd::Zero(model.channel(still.channel).dim()), still.channel);
   }
   std::vector<Measurement> merged;
   merged.reserve(out.measurements.size() + used.size());

@@ -51,6 +51,12 @@ std::string metricsJson(const std::vector<RunMetrics>& runs, const std::string& 
            << ",\n      \"constants_reference_rms\": " << num(m.constants_reference_rms)
            << ",\n      \"constants_referenced\": " << m.constants_referenced << ",\n";
     }
+    const auto points = [&](const char* name, const PointErrors& e) {
+      os << "      \"" << name << "\": {\"count\": " << e.count << ", \"horizontal_rms_m\": " << num(e.horizontal_rms)
+         << ", \"horizontal_max_m\": " << num(e.horizontal_max) << ", \"rms_3d_m\": " << num(e.rms)
+         << ", \"max_3d_m\": " << num(e.max) << "},\n";
+    };
+    if (m.withheld.count) points("withheld", m.withheld), points("used", m.used);
     os << "      \"downweighted\": " << m.downweighted << ",\n";
     os << "      \"rejected\": " << m.rejected << ",\n";
     os << "      \"latency_median_s\": " << num(m.latency_median) << ",\n";

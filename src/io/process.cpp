@@ -117,6 +117,17 @@ void compareToReference(const Model& model, const ProcessResult& r, const Offlin
   compareConstants(m, *r.dataset.constants_reference, &compared);
 }
 
+// Errors at the withheld measurements (inside a log's GNSS outages) and at
+// the used ones of their channel (outside).
+void scoreWithheld(const Model& model, const Dataset& d, const OfflineRun& run, RunMetrics& m) {
+  const int channel = d.withheld.front().channel;
+  std::vector<Measurement> used;
+  for (const Measurement& x : d.measurements)
+    if (x.channel == channel) used.push_back(x);
+  m.withheld = predictionErrors(model, run, d.inputs, d.withheld);
+  m.used = predictionErrors(model, run, d.inputs, used);
+}
+
 // A method's run and its metrics (against the reference too, if any).
 struct MeasuredRun {
   OfflineRun run;
@@ -127,6 +138,7 @@ MeasuredRun runAndMeasure(const ProcessOptions& o, const Model& model, const Pro
   MeasuredRun m{runMethod(o, model, r, options, method, cb), {}};
   m.metrics = computeMetrics(model, m.run, r.dataset.truth ? &*r.dataset.truth : nullptr);
   if (r.dataset.constants_reference) compareToReference(model, r, m.run, m.metrics);
+  if (!r.dataset.withheld.empty()) scoreWithheld(model, r.dataset, m.run, m.metrics);
   return m;
 }
 

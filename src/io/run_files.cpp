@@ -21,9 +21,10 @@ std::string RunFiles::recordsName(Method method) { return std::string("run-") + 
 RunFiles::RunFiles(const std::string& dir, const Model& model, Method method, bool records)
     : estimates_path_((fs::path(dir) / estimatesName(method)).string()),
       records_path_((fs::path(dir) / recordsName(method)).string()),
-      records_(records) {
+      records_(records),
+      model_(model) {
   header_.push_back("t");
-  const auto names = model.stackedStateNames();
+  const auto names = model.reportNames();
   for (const auto& n : names) header_.push_back(n);
   for (const auto& n : names) header_.push_back("sd_" + n);
 }
@@ -35,10 +36,10 @@ void RunFiles::open() {
 
 void RunFiles::row(const EstimateRow& r) {
   if (!csv_) open();
-  const Eigen::Index n = r.mean.size();
+  model_.report(r.mean, r.covariance, value_, sd_);
   line_.assign(1, r.t);
-  for (Eigen::Index i = 0; i < n; ++i) line_.push_back(r.mean[i]);
-  for (Eigen::Index i = 0; i < n; ++i) line_.push_back(std::sqrt(r.covariance(i, i)));
+  line_.insert(line_.end(), value_.data(), value_.data() + value_.size());
+  line_.insert(line_.end(), sd_.data(), sd_.data() + sd_.size());
   csv_->row(line_);
   if (!records_) return;
   internal::ByteWriter w;

@@ -144,6 +144,27 @@ class ColoredNoiseModel final : public Model {
     return inner_->bodyPoints(xc.head(a_.inner_nc));
   }
   std::vector<std::string> bodyPointNames() const override { return inner_->bodyPointNames(); }
+  std::optional<Eigen::Vector3d> localPosition(double lat, double lon, double height) const override {
+    return inner_->localPosition(lat, lon, height);
+  }
+  // The inner model's report, then the error states as they are.
+  std::vector<std::string> reportNames() const override {
+    std::vector<std::string> names = inner_->reportNames();
+    const auto& state = this->names().state;
+    names.insert(names.end(), state.begin() + a_.inner_nc, state.end());
+    return names;
+  }
+  void report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance, Eigen::VectorXd& value,
+              Eigen::VectorXd& sd) const override {
+    const int n = a_.inner_nc, nb = dims().nb, m = a_.count;
+    std::vector<int> inner(static_cast<std::size_t>(n + nb));
+    for (int i = 0; i < n + nb; ++i) inner[static_cast<std::size_t>(i)] = i < n ? i : i + m;
+    Eigen::VectorXd v, s;
+    inner_->report(mean(inner), covariance(inner, inner), v, s);
+    value.resize(v.size() + m), sd.resize(s.size() + m);
+    value << v, mean.segment(n, m);
+    sd << s, covariance.diagonal().segment(n, m).cwiseSqrt();
+  }
   std::vector<std::string> referenceColumns() const override { return inner_->referenceColumns(); }
   Eigen::VectorXd referenceConstants(const Eigen::MatrixXd& rows, const Truth& truth) const override {
     return inner_->referenceConstants(rows, innerTruth(truth));

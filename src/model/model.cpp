@@ -184,6 +184,12 @@ GaussianNoise Model::processNoiseModel(double dt, std::int64_t step) const {
   return q;
 }
 
+void Model::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance, Eigen::VectorXd& value,
+                   Eigen::VectorXd& sd) const {
+  value = mean;
+  sd = covariance.diagonal().cwiseSqrt();
+}
+
 std::vector<std::string> Model::stackedStateNames() const {
   std::vector<std::string> out = names_.state;
   out.insert(out.end(), names_.constants.begin(), names_.constants.end());

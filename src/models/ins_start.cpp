@@ -78,12 +78,15 @@ InsStart insStart(double t0, const std::vector<Input>& imu, const std::vector<do
   auto fixesIn = [&](double from, double until) {
     return std::count_if(fix_t.begin(), fix_t.end(), [&](double t) { return t >= from && t <= until; });
   };
-  auto velocity = [&](double t) {
+  auto trackAt = [&](double t) {
     double to = t + 1.0;
     while (fixesIn(t - 1.0, to) < 6 && to < t + 3.0) to += 0.25;
-    return fitTrack(t, t - 1.0, to, fix_t, fix_ned).velocity(t);
+    return fitTrack(t, t - 1.0, to, fix_t, fix_ned);
   };
-  s.velocity = velocity(t0);
+  auto velocity = [&](double t) { return trackAt(t).velocity(t); };
+  const Track start = trackAt(t0);
+  s.velocity = start.velocity(t0);
+  s.position = start.c.row(0).transpose();
   Eigen::Vector3d track = s.velocity;
   s.moving = std::hypot(track.x(), track.y()) > o.moving_speed;
   // The window's mean acceleration; none for a car at rest (a fit's

@@ -1,10 +1,13 @@
 #include "gssm/models/strapdown_ins.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
+#include <sstream>
 
 #include "gssm/core/error.h"
 #include "gssm/core/so3.h"
 #include "gssm/model/registry.h"
+#include "gssm/models/ins_start.h"
 
 namespace gssm::models {
 
@@ -14,8 +17,8 @@ using so3::hat;
 ModelNames insNames() {
   ModelNames n;
   n.state = {"att_x", "att_y", "att_z", "vn", "ve", "vd", "pn", "pe", "pd"};
-  n.constants = {"bg_x", "bg_y", "bg_z", "ba_x", "ba_y", "ba_z", "lever_f", "lever_r", "lever_d",
-                 "mount_x", "mount_y", "mount_z", "imu_delay"};
+  n.constants = {"bg_x", "bg_y", "bg_z", "ba_x", "ba_y", "ba_z", "lever_x", "lever_y", "lever_z",
+                 "mount_roll", "mount_pitch", "mount_yaw", "imu_delay"};
   n.input = {"gx", "gy", "gz", "ax", "ay", "az"};
   n.measurement = {"gnss_n", "gnss_e", "gnss_d"};
   return n;
@@ -36,7 +39,7 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
 }
 
 ModelNoise insNoise(const StrapdownIns::Params& p) {
-  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.nhc_sd, p.zupt_sd, p.attitude_sd, p.velocity_sd,
+  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.attitude_sd, p.velocity_sd,
                    p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
   ModelNoise n;
@@ -49,19 +52,18 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
       Eigen::Vector3d::Constant(p.position_sd);
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
-  bmean.segment<3>(StrapdownIns::kLever) = p.lever;
+  bmean.segment<3>(StrapdownIns::kLever) = so3::fromRollPitchYaw(p.mount_rpy).transpose() * p.lever;  // IMU axes
   bsd << Eigen::Vector3d::Constant(p.gyro_bias_sd), Eigen::Vector3d::Constant(p.accel_bias_sd),
       Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd;
   n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
   return n;
 }
 
-MeasurementChannel channelOf(const std::string& name, std::vector<std::string> components, double sd,
-                             std::vector<int> constants) {
+MeasurementChannel channelOf(const std::string& name, std::vector<std::string> components,
+                             const Eigen::VectorXd& sd, std::vector<int> constants) {
   MeasurementChannel c;
   c.name = name;
-  c.R = Eigen::MatrixXd::Identity(static_cast<Eigen::Index>(components.size()),
-                                  static_cast<Eigen::Index>(components.size())) * sd * sd;
+  c.R = sd.cwiseAbs2().asDiagonal();
   c.components = std::move(components);
   c.constants = std::move(constants);
   return c;
@@ -73,14 +75,27 @@ StrapdownIns::StrapdownIns(const Params& p)
       p_(p),
       frame_(p.anchor),
       mount0_(so3::fromRollPitchYaw(p.mount_rpy)) {
-  setChannels({channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, p.gnss_sd, {6, 7, 8, 9, 10, 11, kDelay}),
-               channelOf("nhc", {"nhc_right", "nhc_down"}, p.nhc_sd, {9, 10, 11}),
-               channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, p.zupt_sd, {})});
+  setChannels({channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay}),
+               channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11}),
+               channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, Eigen::Vector3d::Constant(p.zupt_sd), {})});
   setRotationBlocks({0});
 }
 
-Eigen::Matrix3d StrapdownIns::mounting(const Eigen::VectorXd& xb) const {
-  return so3::Exp(xb.segment<3>(kMount)) * mount0_;
+// R_vb = Rx(μ_r)·Ry(μ_p)·Rz(μ_y)·R_vb0: the vehicle's forward axis in the
+// IMU's axes, R_vbᵀ·e_x = R_vb0ᵀ·Rz(−μ_y)·Ry(−μ_p)·e_x, does not depend on
+// the roll μ_r. Right Jacobian: Mᵀ∂M = [(Ry·Rz)ᵀe_x, Rzᵀe_y, e_z] (M the
+// misalignment), moved to R_vb's tangent by R_vb0ᵀ.
+Eigen::Matrix3d StrapdownIns::mounting(const Eigen::VectorXd& xb, Eigen::Matrix3d* J_out_mu) const {
+  const Eigen::Vector3d mu = xb.segment<3>(kMount);
+  const Eigen::Matrix3d Rx = Eigen::AngleAxisd(mu.x(), Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Matrix3d Ry = Eigen::AngleAxisd(mu.y(), Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(mu.z(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  if (J_out_mu) {
+    Eigen::Matrix3d J;
+    J << (Ry * Rz).transpose().col(0), Rz.transpose().col(1), Eigen::Vector3d::UnitZ();
+    *J_out_mu = mount0_.transpose() * J;
+  }
+  return Rx * Ry * Rz * mount0_;
 }
 
 Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u,
@@ -124,16 +139,13 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
 
 // The antenna at the GNSS time of the fix: the state at IMU time t is the
 // true time t + d (d = imu_delay, added to the IMU's stamps), so to first
-// order y = p + R·w − d·v, w = R_vbᵀ·ℓ = R_vb0ᵀ·Exp(−μ)·ℓ: ∂y/∂δθ = −R·[w]×,
-// ∂y/∂v = −d·I, ∂y/∂ℓ = R·R_vbᵀ, ∂y/∂μ = R·R_vb0ᵀ·Exp(−μ)·[ℓ]×·Jr(−μ) (from
-// ∂(Exp(φ)ℓ)/∂φ = −Exp(φ)[ℓ]×Jr(φ)), ∂y/∂d = −v.
+// order y = p + R·ℓ − d·v (ℓ in the IMU's axes): ∂y/∂δθ = −R·[ℓ]×,
+// ∂y/∂v = −d·I, ∂y/∂ℓ = R, ∂y/∂d = −v.
 Eigen::VectorXd StrapdownIns::antenna(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                                       Eigen::MatrixXd* J_h_xb) const {
   const Eigen::Matrix3d R = so3::Exp(xc.head<3>());
-  const Eigen::Vector3d v = xc.segment<3>(3), mu = xb.segment<3>(kMount), lever = xb.segment<3>(kLever);
+  const Eigen::Vector3d v = xc.segment<3>(3), w = xb.segment<3>(kLever);
   const double delay = xb[kDelay];
-  const Eigen::Matrix3d Emu_t = so3::Exp(-mu);
-  const Eigen::Vector3d w = mount0_.transpose() * (Emu_t * lever);
   if (J_h_xc) {
     J_h_xc->setZero(3, 9);
     J_h_xc->leftCols<3>() = -R * hat(w);
@@ -142,20 +154,19 @@ Eigen::VectorXd StrapdownIns::antenna(const Eigen::VectorXd& xc, const Eigen::Ve
   }
   if (J_h_xb) {
     J_h_xb->setZero(3, kConstants);
-    J_h_xb->middleCols<3>(kLever) = R * mount0_.transpose() * Emu_t;
-    J_h_xb->middleCols<3>(kMount) = R * mount0_.transpose() * Emu_t * hat(lever) * so3::rightJacobian(-mu);
+    J_h_xb->middleCols<3>(kLever) = R;
     J_h_xb->col(kDelay) = -v;
   }
   return xc.segment<3>(6) + R * w - delay * v;
 }
 
 // The vehicle's velocity w = R_vb·Rᵀ·v, its right and down parts: with
-// u = Rᵀv, ∂/∂δθ = R_vb·[u]×, ∂/∂v = R_vb·Rᵀ, ∂/∂μ = −Exp(μ)·[R_vb0·u]×·Jr(μ).
+// u = Rᵀv, ∂/∂δθ = R_vb·[u]×, ∂/∂v = R_vb·Rᵀ, ∂/∂μ = −R_vb·[u]×·E.
 Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                                               Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
   const Eigen::Matrix3d R = so3::Exp(xc.head<3>());
-  const Eigen::Vector3d mu = xb.segment<3>(kMount);
-  const Eigen::Matrix3d Emu = so3::Exp(mu), M = Emu * mount0_;
+  Eigen::Matrix3d E;
+  const Eigen::Matrix3d M = mounting(xb, &E);
   const Eigen::Vector3d u = R.transpose() * xc.segment<3>(3);
   const Eigen::Vector3d w = M * u;
   if (J_h_xc) {
@@ -165,7 +176,7 @@ Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const E
   }
   if (J_h_xb) {
     J_h_xb->setZero(2, kConstants);
-    J_h_xb->middleCols<3>(kMount) = (-Emu * hat(mount0_ * u) * so3::rightJacobian(mu)).bottomRows<2>();
+    J_h_xb->middleCols<3>(kMount) = (-M * hat(u) * E).bottomRows<2>();
   }
   return w.tail<2>();
 }
@@ -190,8 +201,15 @@ std::vector<ParamSpec> insParams() {
       learnable(real("model", "gyro_sd", "gyro white noise, rad/s/√Hz")),
       learnable(real("model", "accel_sd", "accelerometer white noise, m/s²/√Hz")),
       learnable(real("model", "gnss_sd", "σ of each GNSS coordinate when a fix gives none (m)")),
-      learnable(real("model", "nhc_sd", "σ of the vehicle's sideways and vertical velocity (m/s)")),
+      learnable(real("model", "nhc_sd", "σ of the vehicle's sideways velocity at the IMU (m/s)")),
+      learnable(real("model", "nhc_down_sd",
+                     "σ of its vertical velocity (m/s; with one σ for both the constraint is blind to the mounting's "
+                     "roll, which turns one into the other)")),
       learnable(real("model", "zupt_sd", "σ of the velocity while standing (m/s)")),
+      any("prior", "start",
+          "data: the start's attitude, velocity and position from the log (roll and pitch from the specific "
+          "force, yaw from the GNSS track; [dataset] inputs, input_columns, gnss, start_time), instead of "
+          "start_rpy, start_velocity and start_position"),
       vector("prior", "start_rpy", "prior mean of the IMU's roll, pitch, yaw (deg)"),
       vector("prior", "start_velocity", "prior mean of v(0), NED (m/s)"),
       vector("prior", "start_position", "prior mean of p(0), NED (m)"),
@@ -226,17 +244,76 @@ geodesy::Geodetic readAnchor(const ParamSource& in) {
   return {a[0] * kDeg, a[1] * kDeg, a[2]};
 }
 
+std::vector<std::string> splitWords(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<std::string> out;
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+// The IMU rows of [dataset] inputs from t0 on, and t0 ([dataset] start_time:
+// a number or first_input).
+std::vector<Input> startImu(const ParamSource& in, double& t0) {
+  std::vector<std::string> cols{"t"};
+  for (const auto& c : splitWords(in.text("dataset", "input_columns"))) cols.push_back(c);
+  if (cols.size() != 7)
+    throw InputError(in.where("dataset", "input_columns") + ": expected 6 columns (gyro x y z, accelerometer x y z)");
+  const Eigen::MatrixXd imu = in.dataFile(in.text("dataset", "inputs"), cols);
+  if (imu.rows() == 0) throw InputError(in.where("prior", "start") + " = data: the IMU file has no row");
+  t0 = in.text("dataset", "start_time", "0") == "first_input" ? imu(0, 0) : in.real("dataset", "start_time");
+  std::vector<Input> out;
+  for (Eigen::Index r = 0; r < imu.rows(); ++r)
+    if (imu(r, 0) >= t0) out.push_back({imu(r, 0), imu.row(r).tail<6>().transpose()});
+  return out;
+}
+
+// [prior] start = data: the start from the log (ins_start.h), from the
+// fixes the estimators see (after t0, of an accepted quality, outside the
+// outages), the position that of the IMU (the antenna's less the prior lever).
+void startFromData(const ParamSource& in, StrapdownIns::Params& p) {
+  double t0 = 0;
+  const std::vector<Input> imu = startImu(in, t0);
+  const Eigen::MatrixXd fixes = in.dataFile(in.text("dataset", "gnss", "gnss.pos"), {"t", "lat", "lon", "height", "q"});
+  Eigen::MatrixXd outages(0, 2);
+  if (in.has("dataset", "gnss_outages")) outages = in.dataFile(in.text("dataset", "gnss_outages"), {"start", "end"});
+  const double max_quality = in.real("dataset", "gnss_max_quality", 1);
+  const strapdown::NavFrame frame(p.anchor);
+  std::vector<double> ft;
+  std::vector<Eigen::Vector3d> fp;
+  for (Eigen::Index r = 0; r < fixes.rows(); ++r) {
+    const double t = fixes(r, 0);
+    bool withheld = false;
+    for (Eigen::Index o = 0; o < outages.rows(); ++o) withheld |= t >= outages(o, 0) && t < outages(o, 1);
+    if (t <= t0 || withheld || fixes(r, 4) > max_quality) continue;
+    ft.push_back(t);
+    fp.push_back(frame.local().toNed({fixes(r, 1) * kDeg, fixes(r, 2) * kDeg, fixes(r, 3)}));
+  }
+  const Eigen::Matrix3d R_vb0 = so3::fromRollPitchYaw(p.mount_rpy);
+  const InsStart s = insStart(t0, imu, ft, fp, R_vb0, frame);
+  p.start_rpy = so3::rollPitchYaw(s.R_nb);
+  p.start_velocity = s.velocity;
+  p.start_position = s.position - s.R_nb * R_vb0.transpose() * p.lever;
+}
+
 StrapdownIns::Params readIns(const ParamSource& in) {
   StrapdownIns::Params p;
   p.anchor = readAnchor(in);
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
   for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
-                            {"gnss_sd", &p.gnss_sd}, {"nhc_sd", &p.nhc_sd}, {"zupt_sd", &p.zupt_sd}})
+                            {"gnss_sd", &p.gnss_sd}, {"nhc_sd", &p.nhc_sd}, {"nhc_down_sd", &p.nhc_down_sd},
+                            {"zupt_sd", &p.zupt_sd}})
     *value = in.real("model", key, *value);
+  if (in.has("prior", "lever")) p.lever = in.vector("prior", "lever", 3);
+  const bool from_data = in.has("prior", "start") && in.text("prior", "start") == "data";
+  if (in.has("prior", "start") && !from_data)
+    throw InputError(in.where("prior", "start") + " = '" + in.text("prior", "start") + "': expected data");
+  for (const char* key : {"start_rpy", "start_velocity", "start_position"})
+    if (from_data && in.has("prior", key))
+      throw InputError(in.where("prior", key) + ": given with start = data (one or the other)");
+  if (from_data) startFromData(in, p);
   if (in.has("prior", "start_rpy")) p.start_rpy = in.vector("prior", "start_rpy", 3) * kDeg;
   if (in.has("prior", "start_velocity")) p.start_velocity = in.vector("prior", "start_velocity", 3);
   if (in.has("prior", "start_position")) p.start_position = in.vector("prior", "start_position", 3);
-  if (in.has("prior", "lever")) p.lever = in.vector("prior", "lever", 3);
   p.attitude_sd = in.real("prior", "attitude_sd", p.attitude_sd / kDeg) * kDeg;
   p.mount_sd = in.real("prior", "mount_sd", p.mount_sd / kDeg) * kDeg;
   for (auto [key, value] : {std::pair{"velocity_sd", &p.velocity_sd}, {"position_sd", &p.position_sd},
@@ -251,7 +328,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("model", "anchor", Eigen::Vector3d(p.anchor.lat / kDeg, p.anchor.lon / kDeg, p.anchor.height));
   out.vector("model", "mount_rpy", p.mount_rpy / kDeg);
   for (auto [key, value] : {std::pair{"gyro_sd", p.gyro_sd}, {"accel_sd", p.accel_sd}, {"gnss_sd", p.gnss_sd},
-                            {"nhc_sd", p.nhc_sd}, {"zupt_sd", p.zupt_sd}})
+                            {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
+                            {"zupt_sd", p.zupt_sd}})
     out.real("model", key, value);
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);
   out.vector("prior", "start_velocity", p.start_velocity);

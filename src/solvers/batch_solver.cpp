@@ -47,6 +47,7 @@ bool BatchSolverOptions::validate(std::string* why) const {
   if (!(relative_cost_tolerance >= 0)) return fail("relative_cost_tolerance must be >= 0");
   if (!(step_tolerance >= 0)) return fail("step_tolerance must be >= 0");
   if (!(gradient_tolerance >= 0)) return fail("gradient_tolerance must be >= 0");
+  if (!(decrease_tolerance >= 0)) return fail("decrease_tolerance must be >= 0");
   if (!(initial_lambda > 0)) return fail("initial_lambda must be > 0");
   if (!(max_lambda > initial_lambda)) return fail("max_lambda must exceed initial_lambda");
   if (newton_polish_steps < 0) return fail("newton_polish_steps must be >= 0");
@@ -580,7 +581,7 @@ struct BatchSolver::Impl::Iteration {
       sum.termination = Termination::CostConverged;
       return false;
     }
-    if (stepConverged(delta, x)) {
+    if (stepConverged(delta, x) || (policy.lambda() == 0 && predicted <= options.decrease_tolerance)) {
       if (policy.undamped()) {  // a tiny undamped step is still the exact correction: take it
         internal::addStep(x, delta, x, &retraction);
         cost = s.linearize(graph, x, g, diag);

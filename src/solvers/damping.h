@@ -37,14 +37,18 @@ class LevenbergMarquardtPolicy {
     return undamped_ ? acceptUndamped(new_cost, cost) : new_cost < cost;
   }
   static bool acceptUndamped(double new_cost, double cost) { return new_cost <= cost * (1 + kUndampedSlack); }
-  /// After a kept step: less damping.
+  /// After a kept step: less damping, none below kMinLambda. λ·diag(JᵀJ)
+  /// damps a long chain of stiff states (an INS's, 10⁹–10¹¹ on the
+  /// diagonal) by ~λ·10¹¹ per state; kept at 1e-12 it held the GNSS/INS
+  /// drive's outages 0.19 m from the minimum after 100 iterations, where
+  /// undamped steps reach 0.12 m in 10.
   void accepted() {
-    if (!undamped_) lambda_ = std::max(lambda_ / 10, kMinLambda);
+    if (!undamped_) lambda_ = lambda_ / 10 < kMinLambda ? 0.0 : lambda_ / 10;
   }
   /// After a step that raised the cost (or could not be formed): more
   /// damping; false when λ passed its maximum (no progress possible).
   bool rejected() {
-    lambda_ *= 10;
+    lambda_ = lambda_ > 0 ? lambda_ * 10 : kMinLambda;
     return lambda_ <= max_lambda_;
   }
   /// The damped system could not be factored: more damping, damped again.

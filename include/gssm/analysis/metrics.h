@@ -10,6 +10,15 @@
 
 namespace gssm {
 
+/// A run's errors at measurements of a point-like channel (a GNSS antenna's
+/// NED position): the model's prediction h against each measurement, the
+/// first two components horizontal.
+struct PointErrors {
+  std::size_t count = 0;  ///< measurements scored
+  double horizontal_rms = NAN, horizontal_max = NAN;
+  double rms = NAN, max = NAN;  ///< of the whole vector (3-D)
+};
+
 struct RunMetrics {
   Method method = Method::Ekf;
   std::vector<std::string> names;  ///< the compared components' names (the truth's; all stacked states by default)
@@ -38,6 +47,10 @@ struct RunMetrics {
   double total_seconds = 0;
   int iterations = 0;
   bool has_truth = false;
+  /// Against the measurements withheld from the estimators (a log's GNSS
+  /// outages: the truth inside them) and against those on the same channel
+  /// that were used (outside them); count 0 when the dataset withholds none.
+  PointErrors withheld, used;
 };
 
 /// Matches rows to truth by time (runErrors); throws InvalidArgument if an
@@ -49,6 +62,14 @@ RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth
 /// terms, Model::comparableConstants; null: m.constants as they are);
 /// InvalidArgument on a size mismatch.
 void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference, const Gaussian* compared = nullptr);
+
+/// The run's errors at `at` (all on one channel, in time order): at each
+/// measurement's time t, the newest row at or before t (causal for a
+/// streaming run's rows) carried to t by the model's f under the input in
+/// force (a step of at most one input interval), then h on that channel,
+/// minus the measurement. Measurements before the first row are not scored.
+PointErrors predictionErrors(const Model& model, const OfflineRun& run, const std::vector<Input>& inputs,
+                             const std::vector<Measurement>& at);
 
 /// Percentile (0..100) of a sample, by linear interpolation; 0 for empty.
 double percentile(std::vector<double> v, double p);

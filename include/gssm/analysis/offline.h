@@ -42,8 +42,13 @@ struct OfflineRun {
 /// When a streaming run records an estimate row: after every measurement;
 /// at every input time (a state an input made, before the next later event);
 /// or once per epoch, a distinct measurement time (after its last
-/// measurement), as the batch run reports (several sensors sharing a time).
-enum class RowTimes { Measurements, Inputs, Epochs };
+/// measurement), as the batch run reports (several sensors sharing a time);
+/// or at every state, an input's or an epoch's (after every event at its
+/// time: an IMU's samples and each GNSS fix after its update).
+enum class RowTimes { Measurements, Inputs, Epochs, States };
+/// The RowTimes named "measurements", "inputs", "epochs" or "states" (an
+/// INI's [dataset] rows); none for any other name.
+std::optional<RowTimes> rowTimesNamed(const std::string& name);
 
 /// Where a streaming run's records go, and what its checkpoints remember of
 /// them (docs/DESIGN.md §7). The run keeps them in OfflineRun and hands the

@@ -45,7 +45,9 @@ Vector3 act(const Matrix3& R, const Vector3& v, Matrix3* J_out_R = nullptr, Matr
 
 /// The rotation body → navigation frame of roll, pitch and yaw (rad; ZYX:
 /// R = Rz(yaw)·Ry(pitch)·Rx(roll), the aerospace convention in NED).
-Matrix3 fromRollPitchYaw(const Vector3& rpy);
+/// J_out_rpy: R(rpy + d) = R·Exp(J·d) to first order, the Euler rates → body
+/// rates matrix [[1, 0, −sin p], [0, cos r, sin r cos p], [0, −sin r, cos r cos p]].
+Matrix3 fromRollPitchYaw(const Vector3& rpy, Matrix3* J_out_rpy = nullptr);
 /// Roll, pitch, yaw of R, pitch in [−π/2, π/2], roll and yaw in (−π, π].
 /// At pitch ±π/2 (gimbal lock) only yaw ∓ roll is defined: roll is 0
 /// there. J_rpy_R (the body rates → Euler rates matrix) is singular at

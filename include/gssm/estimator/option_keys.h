@@ -55,6 +55,7 @@ void optionKeys(Visitor& v, BatchSolverOptions& o) {
   v("relative_cost_tolerance", o.relative_cost_tolerance);
   v("step_tolerance", o.step_tolerance);
   v("gradient_tolerance", o.gradient_tolerance);
+  v("decrease_tolerance", o.decrease_tolerance);
   v("initial_lambda", o.initial_lambda);
   v("max_lambda", o.max_lambda);
   v("newton_polish_steps", o.newton_polish_steps);

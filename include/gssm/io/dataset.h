@@ -67,13 +67,23 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
 ///       value; channel_by = index: the column holds the channel's index;
 ///       without channel_column the default channel)
 ///     truth = FILE, truth_columns = NAMES (stacked components it gives)
-///     start_time = truth | NUMBER (t0), rows = measurements | inputs
+///     start_time = truth | first | first_input | NUMBER (t0; first: a
+///       nominal step before the first measurement; first_input: the first
+///       input row's time), rows = measurements | inputs | epochs | states
 ///     constants_reference = FILE (a calibration of the constants, judged against)
 ///     gnss = FILE (an RTKLIB .pos: each fix a measurement on channel
 ///       gnss_channel, default "gnss", mapped by Model::localPosition, with
 ///       the fix's own covariance; gnss_max_quality: the worst Q used, default
 ///       1 = RTK-fixed; gnss_float_scale: σ factor of float fixes, default 3;
-///       gnss_outages = FILE: rows start,end (s) whose fixes are withheld)
+///       gnss_outages = FILE: rows start,end (s) whose fixes are withheld;
+///       fixes at or before t0 are dropped and listed in `dropped`;
+///       gnss_still_channel = NAME: a zero measurement on that channel at
+///       every used fix whose own velocity is under gnss_still_speed, m/s,
+///       default 0.05: a zero-velocity update where the receiver saw the
+///       vehicle stand)
+///     zero_channels = NAMES, zero_rate = HZ: a zero measurement on each of
+///       those channels every 1/rate s after t0 (a vehicle's non-holonomic
+///       constraint stated as a channel of the model)
 void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
                      BadRows bad_rows = BadRows::Throw, const IniDocument* config = nullptr);
 

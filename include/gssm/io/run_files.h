@@ -1,7 +1,7 @@
 #pragma once
 // The output files of one streaming run, written as the run goes (a
-// RunRecorder): estimates-<method>.csv (t, the stacked mean, its standard
-// deviations) and, when the run takes checkpoints, run-<method>.bin with
+// RunRecorder): estimates-<method>.csv (t, what the model reports of each
+// estimate and its standard deviations: Model::report) and, when the run takes checkpoints, run-<method>.bin with
 // what the metrics need exactly (each row's full covariance, each update's
 // latency and NIS). A checkpoint then stores only the two files' lengths:
 // its size does not grow with the run, and resuming cuts the files there
@@ -36,6 +36,8 @@ class RunFiles final : public RunRecorder {
   std::string estimates_path_, records_path_;
   std::vector<std::string> header_;
   bool records_;
+  const Model& model_;
+  Eigen::VectorXd value_, sd_;  // a row's report
   std::unique_ptr<CsvWriter> csv_;
   std::unique_ptr<AppendFile> bin_;  // the records (when records_)
   std::vector<double> line_;

@@ -184,6 +184,16 @@ class Model {
   /// All state names in the stacked order [x_c; x_b].
   std::vector<std::string> stackedStateNames() const;
 
+  /// What a user reads of an estimate (estimates-<method>.csv's columns,
+  /// each with an sd_ column): by default the stacked state itself. A model
+  /// whose states are not the quantities its users judge (an INS: the
+  /// antenna's latitude and longitude, the vehicle's Euler angles in
+  /// degrees) names its own, and maps a stacked mean and covariance to
+  /// their values and standard deviations (first order).
+  virtual std::vector<std::string> reportNames() const { return stackedStateNames(); }
+  virtual void report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance, Eigen::VectorXd& value,
+                      Eigen::VectorXd& sd) const;
+
  protected:
   /// Validates every dimension, name and covariance; throws InvalidArgument
   /// or NumericalError naming the offending field.

@@ -29,6 +29,7 @@ struct InsStartOptions {
 struct InsStart {
   Eigen::Matrix3d R_nb = Eigen::Matrix3d::Identity();  ///< the IMU's attitude at t0
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< of the GNSS antenna at t0, NED (m/s)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< of the GNSS antenna at t0, NED (m), from the same fit
   bool moving = false;                                 ///< the track came from the velocity
   double track_yaw = 0;                                ///< the vehicle's heading used (rad)
 };

@@ -6,13 +6,20 @@
 // constants are single nodes, each only in the factors that involve it:
 //
 //   x_c = [θ (IMU → NED, rotation block), v (m/s, NED), p (m, NED)]
-//   x_b = [b_g (rad/s), b_a (m/s²), ℓ (IMU → antenna in vehicle axes, m),
-//          μ (mounting misalignment, rad: R_vb = Exp(μ)·R_vb0),
+//   x_b = [b_g (rad/s), b_a (m/s²), ℓ (IMU → antenna in the IMU's axes, m:
+//            GNSS sees it so, whatever the mounting; in vehicle axes,
+//            R_vb·ℓ, it would bend with the weakly seen mounting roll and
+//            make a curved valley that Gauss–Newton crawls along),
+//          μ (mounting misalignment about the vehicle's axes, rad:
+//            R_vb = Rx(μ_r)·Ry(μ_p)·Rz(μ_y)·R_vb0, roll outermost: the
+//            vehicle's forward axis in the IMU's axes then depends on μ_p
+//            and μ_y alone, so the weakly seen roll does not bend the two
+//            that the non-holonomic constraint sees well),
 //          d (the IMU's time delay, s: added to its stamps gives GNSS time)]
 //   u   = [ω̃ (rad/s), f̃ (m/s²)] in the IMU's axes
 //
 // Channels: `gnss` (the antenna's NED position at the fix's time,
-// p + R_nb·R_vbᵀ·ℓ − d·v), `nhc`
+// p + R_nb·ℓ − d·v), `nhc`
 // (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z),
 // `zupt` (the velocity, zero while standing). R_vb maps the IMU's axes to
 // the vehicle's (forward, right, down); R_vb0 is its nominal value.
@@ -33,7 +40,8 @@ class StrapdownIns final : public Model {
     double gyro_sd = 1e-3;                     ///< gyro white noise, rad/s/√Hz
     double accel_sd = 1e-2;                    ///< accelerometer white noise, m/s²/√Hz
     double gnss_sd = 0.02;                     ///< σ of each GNSS coordinate (m) unless a fix gives its own
-    double nhc_sd = 0.1;                       ///< σ of the vehicle's sideways and vertical velocity (m/s)
+    double nhc_sd = 0.1;                       ///< σ of the vehicle's sideways velocity at the IMU (m/s)
+    double nhc_down_sd = 0.1;                  ///< σ of its vertical velocity (m/s)
     double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)
     Eigen::Vector3d start_rpy{0, 0, 0};        ///< prior mean of the IMU's attitude, roll, pitch, yaw (rad)
     Eigen::Vector3d start_velocity{0, 0, 0};   ///< prior mean of v(0) (m/s, NED)
@@ -41,7 +49,7 @@ class StrapdownIns final : public Model {
     double attitude_sd = 0.1, velocity_sd = 1.0, position_sd = 1.0;  ///< their σ (rad, m/s, m)
     double gyro_bias_sd = 0.01;                ///< prior σ of b_g (rad/s), mean 0
     double accel_bias_sd = 0.1;                ///< prior σ of b_a (m/s²), mean 0
-    Eigen::Vector3d lever{0, 0, 0};            ///< prior mean of ℓ (m)
+    Eigen::Vector3d lever{0, 0, 0};            ///< prior mean of the lever arm in vehicle axes (m; x_b holds R_vb0ᵀ·it)
     double lever_sd = 0.1;                     ///< its σ (m)
     double mount_sd = 0.1;                     ///< prior σ of μ (rad), mean 0
     double delay_sd = 0.1;                     ///< prior σ of d (s), mean 0
@@ -51,8 +59,9 @@ class StrapdownIns final : public Model {
   std::string name() const override { return "strapdown_ins"; }
   const Params& params() const { return p_; }
   const strapdown::NavFrame& frame() const { return frame_; }
-  /// R_vb = Exp(μ)·R_vb0 at the constants x_b.
-  Eigen::Matrix3d mounting(const Eigen::VectorXd& xb) const;
+  /// R_vb = Rx(μ_r)·Ry(μ_p)·Rz(μ_y)·R_vb0 at the constants x_b; J_out_mu:
+  /// R_vb(μ + δ) = R_vb·Exp(J·δ) to first order.
+  Eigen::Matrix3d mounting(const Eigen::VectorXd& xb, Eigen::Matrix3d* J_out_mu = nullptr) const;
 
   Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u, double dt,
                     Eigen::MatrixXd* J_f_xc = nullptr, Eigen::MatrixXd* J_f_xb = nullptr) const override;
@@ -61,6 +70,13 @@ class StrapdownIns final : public Model {
   Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
   Eigen::MatrixXd processNoise(double dt) const override;
+  /// lat, lon (deg), height (m) of the antenna; vn, ve, vd (m/s); the
+  /// vehicle's roll, pitch, yaw w.r.t. NED (deg); the biases; the lever arm
+  /// in vehicle axes (m); imu_delay (s); the mounting R_vb as roll, pitch,
+  /// yaw (deg, ZYX, IMU → vehicle). Standard deviations to first order.
+  std::vector<std::string> reportNames() const override;
+  void report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance, Eigen::VectorXd& value,
+              Eigen::VectorXd& sd) const override;
   /// The point in the frame (NED from the anchor, m).
   std::optional<Eigen::Vector3d> localPosition(double lat, double lon, double height) const override {
     return frame_.local().toNed({lat, lon, height});

@@ -1,0 +1,64 @@
+// What a navigation user reads of a StrapdownIns estimate (issue #37,
+// point 6): the antenna's latitude, longitude and height, the velocity, the
+// vehicle's roll, pitch and yaw, and the constants in the vehicle's terms,
+// each with its standard deviation to first order (J·Σ·Jᵀ on the stacked
+// tangent: the attitude's block is a right perturbation).
+#include <cmath>
+
+#include "gssm/core/so3.h"
+#include "gssm/models/strapdown_ins.h"
+
+namespace gssm::models {
+
+namespace {
+constexpr double kDeg = 180.0 / M_PI;  // rad → deg
+constexpr int kNc = 9, kTheta = 0, kVel = 3;
+}  // namespace
+
+std::vector<std::string> StrapdownIns::reportNames() const {
+  return {"lat",     "lon",     "height",  "vn",      "ve",      "vd",        "roll",       "pitch",
+          "yaw",     "bg_x",    "bg_y",    "bg_z",    "ba_x",    "ba_y",      "ba_z",       "lever_f",
+          "lever_r", "lever_d", "imu_delay", "mount_roll", "mount_pitch", "mount_yaw"};
+}
+
+// Rows of J (outputs × stacked tangent) and values, in reportNames' order.
+void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance, Eigen::VectorXd& value,
+                          Eigen::VectorXd& sd) const {
+  const Eigen::VectorXd xc = mean.head(kNc), xb = mean.tail(kConstants);
+  const int n = kNc + kConstants, b = kNc;  // b: where x_b starts in the stacked state
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(22, n);
+  value.resize(22);
+  // The antenna in the frame, then geodetic (deg, deg, m).
+  Eigen::MatrixXd J_xc, J_xb;
+  const Eigen::Vector3d ned = antenna(xc, xb, &J_xc, &J_xb);
+  const geodesy::Geodetic g = frame_.local().toGeodetic(ned);
+  const Eigen::Vector3d to_geo(kDeg / (geodesy::meridianRadius(g.lat) + g.height),
+                               kDeg / ((geodesy::transverseRadius(g.lat) + g.height) * std::cos(g.lat)), -1.0);
+  value.head<3>() << g.lat * kDeg, g.lon * kDeg, g.height;
+  J.block(0, 0, 3, kNc) = to_geo.asDiagonal() * J_xc;
+  J.block(0, b, 3, kConstants) = to_geo.asDiagonal() * J_xb;
+  value.segment<3>(3) = xc.segment<3>(kVel);
+  J.block<3, 3>(3, kVel).setIdentity();
+  // The vehicle: R_nv = R·R_vbᵀ, perturbed R_nv·Exp(R_vb·(δθ − E·δμ)).
+  Eigen::Matrix3d E, J_rpy = Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d R = so3::Exp(xc.head<3>()), R_vb = mounting(xb, &E);
+  value.segment<3>(6) = so3::rollPitchYaw(R * R_vb.transpose(), &J_rpy) * kDeg;
+  J.block<3, 3>(6, kTheta) = kDeg * J_rpy * R_vb;
+  J.block<3, 3>(6, b + kMount) = -kDeg * J_rpy * R_vb * E;
+  value.segment<6>(9) = xb.segment<6>(kGyroBias);
+  J.block<6, 6>(9, b + kGyroBias).setIdentity();
+  // The lever arm in vehicle axes, R_vb·ℓ.
+  const Eigen::Vector3d lever = xb.segment<3>(kLever);
+  value.segment<3>(15) = R_vb * lever;
+  J.block<3, 3>(15, b + kLever) = R_vb;
+  J.block<3, 3>(15, b + kMount) = -R_vb * so3::hat(lever) * E;
+  value[18] = xb[kDelay];
+  J(18, b + kDelay) = 1;
+  // The mounting as the ZYX angles of R_vb (IMU → vehicle), as the source's.
+  J_rpy.setZero();
+  value.tail<3>() = so3::rollPitchYaw(R_vb, &J_rpy) * kDeg;
+  J.block<3, 3>(19, b + kMount) = kDeg * J_rpy * E;
+  sd = (J * covariance).cwiseProduct(J).rowwise().sum().cwiseSqrt();
+}
+
+}  // namespace gssm::models
