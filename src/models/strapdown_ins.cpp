@@ -18,7 +18,7 @@ ModelNames insNames() {
   ModelNames n;
   n.state = {"att_x", "att_y", "att_z", "vn", "ve", "vd", "pn", "pe", "pd"};
   n.constants = {"bg_x", "bg_y", "bg_z", "ba_x", "ba_y", "ba_z", "lever_x", "lever_y", "lever_z",
-                 "mount_roll", "mount_pitch", "mount_yaw", "imu_delay"};
+                 "mount_roll", "mount_pitch", "mount_yaw", "imu_delay", "sg_x", "sg_y", "sg_z", "sa_x", "sa_y", "sa_z"};
   n.input = {"gx", "gy", "gz", "ax", "ay", "az"};
   n.measurement = {"gnss_n", "gnss_e", "gnss_d"};
   return n;
@@ -40,7 +40,8 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
 
 ModelNoise insNoise(const StrapdownIns::Params& p) {
   for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.attitude_sd, p.velocity_sd,
-                   p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd})
+                   p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd,
+                   p.gyro_scale_sd, p.accel_scale_sd})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
   ModelNoise n;
   n.T = p.T;
@@ -54,7 +55,8 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
   bmean.segment<3>(StrapdownIns::kLever) = so3::fromRollPitchYaw(p.mount_rpy).transpose() * p.lever;  // IMU axes
   bsd << Eigen::Vector3d::Constant(p.gyro_bias_sd), Eigen::Vector3d::Constant(p.accel_bias_sd),
-      Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd;
+      Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd,
+      Eigen::Vector3d::Constant(p.gyro_scale_sd), Eigen::Vector3d::Constant(p.accel_scale_sd);
   n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
   return n;
 }
@@ -105,7 +107,11 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
   x.v = xc.segment<3>(3);
   x.p = xc.segment<3>(6);
   strapdown::StepJacobians J;
-  const strapdown::NavState next = strapdown::step(x, u.head<3>(), u.tail<3>(), xb.segment<3>(kGyroBias),
+  // A reading is (1 + s)∘(true) + b: to first order true = reading − b − s∘reading.
+  const Eigen::Vector3d gyro = u.head<3>(), accel = u.tail<3>();
+  const Eigen::Vector3d gyro_c = gyro - xb.segment<3>(kGyroScale).cwiseProduct(gyro);
+  const Eigen::Vector3d accel_c = accel - xb.segment<3>(kAccelScale).cwiseProduct(accel);
+  const strapdown::NavState next = strapdown::step(x, gyro_c, accel_c, xb.segment<3>(kGyroBias),
                                                    xb.segment<3>(kAccelBias), dt, frame_,
                                                    J_f_xc || J_f_xb ? &J : nullptr);
   if (J_f_xc) *J_f_xc = J.J_next_x;
@@ -113,6 +119,8 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
     J_f_xb->setZero(9, kConstants);
     J_f_xb->middleCols<3>(kGyroBias) = J.J_next_bg;
     J_f_xb->middleCols<3>(kAccelBias) = J.J_next_ba;
+    J_f_xb->middleCols<3>(kGyroScale) = J.J_next_bg * gyro.asDiagonal();
+    J_f_xb->middleCols<3>(kAccelScale) = J.J_next_ba * accel.asDiagonal();
   }
   Eigen::VectorXd out(9);
   out << so3::Log(next.R), next.v, next.p;
@@ -221,7 +229,9 @@ std::vector<ParamSpec> insParams() {
       vector("prior", "lever", "prior mean of the lever arm IMU → antenna, vehicle axes (m)"),
       real("prior", "lever_sd", "its σ (m)"),
       real("prior", "mount_sd", "prior σ of the mounting misalignment (deg), mean 0"),
-      real("prior", "delay_sd", "prior σ of the IMU's time delay (s, added to its stamps), mean 0")};
+      real("prior", "delay_sd", "prior σ of the IMU's time delay (s, added to its stamps), mean 0"),
+      real("prior", "gyro_scale_sd", "prior σ of each gyro axis's scale factor error (1 = 100 %), mean 0"),
+      real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error, mean 0")};
   return p;
 }
 
@@ -318,7 +328,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   p.mount_sd = in.real("prior", "mount_sd", p.mount_sd / kDeg) * kDeg;
   for (auto [key, value] : {std::pair{"velocity_sd", &p.velocity_sd}, {"position_sd", &p.position_sd},
                             {"gyro_bias_sd", &p.gyro_bias_sd}, {"accel_bias_sd", &p.accel_bias_sd},
-                            {"lever_sd", &p.lever_sd}, {"delay_sd", &p.delay_sd}})
+                            {"lever_sd", &p.lever_sd}, {"delay_sd", &p.delay_sd},
+                            {"gyro_scale_sd", &p.gyro_scale_sd}, {"accel_scale_sd", &p.accel_scale_sd}})
     *value = in.real("prior", key, *value);
   return p;
 }
@@ -338,7 +349,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   for (auto [key, value] : {std::pair{"attitude_sd", p.attitude_sd / kDeg}, {"velocity_sd", p.velocity_sd},
                             {"position_sd", p.position_sd}, {"gyro_bias_sd", p.gyro_bias_sd},
                             {"accel_bias_sd", p.accel_bias_sd}, {"lever_sd", p.lever_sd}, {"mount_sd", p.mount_sd / kDeg},
-                            {"delay_sd", p.delay_sd}})
+                            {"delay_sd", p.delay_sd}, {"gyro_scale_sd", p.gyro_scale_sd},
+                            {"accel_scale_sd", p.accel_scale_sd}})
     out.real("prior", key, value);
 }
 

@@ -18,7 +18,8 @@ constexpr int kNc = 9, kTheta = 0, kVel = 3;
 std::vector<std::string> StrapdownIns::reportNames() const {
   return {"lat",     "lon",     "height",  "vn",      "ve",      "vd",        "roll",       "pitch",
           "yaw",     "bg_x",    "bg_y",    "bg_z",    "ba_x",    "ba_y",      "ba_z",       "lever_f",
-          "lever_r", "lever_d", "imu_delay", "mount_roll", "mount_pitch", "mount_yaw"};
+          "lever_r", "lever_d", "imu_delay", "mount_roll", "mount_pitch", "mount_yaw", "sg_x", "sg_y", "sg_z",
+          "sa_x", "sa_y", "sa_z"};
 }
 
 // Rows of J (outputs × stacked tangent) and values, in reportNames' order.
@@ -26,8 +27,8 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
                           Eigen::VectorXd& sd) const {
   const Eigen::VectorXd xc = mean.head(kNc), xb = mean.tail(kConstants);
   const int n = kNc + kConstants, b = kNc;  // b: where x_b starts in the stacked state
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(22, n);
-  value.resize(22);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n, n);
+  value.resize(n);
   // The antenna in the frame, then geodetic (deg, deg, m).
   Eigen::MatrixXd J_xc, J_xb;
   const Eigen::Vector3d ned = antenna(xc, xb, &J_xc, &J_xb);
@@ -56,8 +57,10 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   J(18, b + kDelay) = 1;
   // The mounting as the ZYX angles of R_vb (IMU → vehicle), as the source's.
   J_rpy.setZero();
-  value.tail<3>() = so3::rollPitchYaw(R_vb, &J_rpy) * kDeg;
+  value.segment<3>(19) = so3::rollPitchYaw(R_vb, &J_rpy) * kDeg;
   J.block<3, 3>(19, b + kMount) = kDeg * J_rpy * E;
+  value.tail<6>() = xb.segment<6>(kGyroScale);
+  J.block<6, 6>(22, b + kGyroScale).setIdentity();
   sd = (J * covariance).cwiseProduct(J).rowwise().sum().cwiseSqrt();
 }
 

@@ -15,7 +15,9 @@
 //            vehicle's forward axis in the IMU's axes then depends on μ_p
 //            and μ_y alone, so the weakly seen roll does not bend the two
 //            that the non-holonomic constraint sees well),
-//          d (the IMU's time delay, s: added to its stamps gives GNSS time)]
+//          d (the IMU's time delay, s: added to its stamps gives GNSS time),
+//          s_g, s_a (the gyro's and accelerometer's scale factor errors per
+//            axis: a reading is (1 + s)∘true + b)]
 //   u   = [ω̃ (rad/s), f̃ (m/s²)] in the IMU's axes
 //
 // Channels: `gnss` (the antenna's NED position at the fix's time,
@@ -53,6 +55,8 @@ class StrapdownIns final : public Model {
     double lever_sd = 0.1;                     ///< its σ (m)
     double mount_sd = 0.1;                     ///< prior σ of μ (rad), mean 0
     double delay_sd = 0.1;                     ///< prior σ of d (s), mean 0
+    double gyro_scale_sd = 0.01;               ///< prior σ of the gyro's scale factor errors, mean 0
+    double accel_scale_sd = 0.01;              ///< prior σ of the accelerometer's scale factor errors, mean 0
   };
 
   explicit StrapdownIns(const Params& p);
@@ -83,7 +87,8 @@ class StrapdownIns final : public Model {
   }
 
   // Where each part of x_b starts.
-  static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kConstants = 13;
+  static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kGyroScale = 13,
+                       kAccelScale = 16, kConstants = 19;
   enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2 };
 
  private:
