@@ -52,8 +52,8 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
   Eigen::Matrix3d R_nv;
   double speed;
   vehicleAt(0, R_nv, speed);
-  Eigen::VectorXd x(9);
-  x << so3::Log(R_nv * R_vb), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero();
+  Eigen::VectorXd x(models::StrapdownIns::kStates);
+  x << so3::Log(R_nv * R_vb), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0;
   d.states.push_back(x);
   const Eigen::VectorXd bias = d.constants.head<6>();
   const int steps = static_cast<int>(std::lround(seconds / T));
@@ -74,7 +74,7 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
     u += bias;  // what the IMU reads
     d.inputs.push_back({t, u});
     x = model.f(x, d.constants, u, T);
-    retractBlocks(x, sampleGaussian(Eigen::VectorXd::Zero(9), model.processNoise(T), draw), model.rotationBlocks());
+    retractBlocks(x, sampleGaussian(Eigen::VectorXd::Zero(x.size()), model.processNoise(T), draw), model.rotationBlocks());
     d.states.push_back(x);
     const double tn = (k + 1) * T;
     const int n = k + 1;

@@ -46,7 +46,7 @@ TEST(StrapdownIns, JacobiansMatchTangentDifferencesAtEveryAttitude) {
                                          {0.0, 0.0, -M_PI + 1e-6}, {M_PI - 1e-3, 0.2, 2.0}};
   testing::expectJacobiansMatchDifferences(model, [&](std::mt19937& rng) {
     testing::JacobianPoint p;
-    p.xc = testing::uniformVector(rng, 9, -20, 20);
+    p.xc = testing::uniformVector(rng, StrapdownIns::kStates, -20, 20);
     p.xc.head<3>() = so3::Log(so3::fromRollPitchYaw(rpy[std::uniform_int_distribution<std::size_t>(0, rpy.size() - 1)(rng)]));
     p.xb = testing::uniformVector(rng, StrapdownIns::kConstants, -0.1, 0.1);
     p.xb.segment<3>(StrapdownIns::kLever) = testing::uniformVector(rng, 3, -1, 1);
@@ -61,19 +61,20 @@ TEST(StrapdownIns, JacobiansMatchTangentDifferencesAtEveryAttitude) {
 // sds: J·Σ·Jᵀ) and against the model's own pieces (its values).
 TEST(StrapdownIns, ReportsAntennaVehicleAttitudeAndConstantsWithFirstOrderSds) {
   const StrapdownIns model(driveParams(0.01));
-  const int n = 9 + StrapdownIns::kConstants;
+  const int n = StrapdownIns::kStates + StrapdownIns::kConstants;
   const std::vector<int> angles{6, 7, 8, 19, 20, 21};  // degrees: differences wrap
   std::mt19937 rng(11);
   for (int trial = 0; trial < 6; ++trial) {
     Eigen::VectorXd x(n);
     x << so3::Log(so3::fromRollPitchYaw(testing::uniformVector(rng, 3, -1.2, 1.2))), testing::uniformVector(rng, 6, -50, 50),
-        testing::uniformVector(rng, StrapdownIns::kConstants, -0.05, 0.05);
+        100.0, testing::uniformVector(rng, StrapdownIns::kConstants, -0.05, 0.05);
     const Eigen::MatrixXd A = testing::uniformVector(rng, n * n, -0.03, 0.03).reshaped(n, n);
     const Eigen::MatrixXd cov = A * A.transpose();
     Eigen::VectorXd value, sd;
     model.report(x, cov, value, sd);
-    ASSERT_EQ(value.size(), static_cast<Eigen::Index>(model.reportNames().size()));
-    Eigen::MatrixXd J(n, n);
+    const auto m = static_cast<Eigen::Index>(model.reportNames().size());
+    ASSERT_EQ(value.size(), m);
+    Eigen::MatrixXd J(m, n);
     for (int j = 0; j < n; ++j) {
       Eigen::VectorXd up = x, down = x, vu, vd, s;
       Eigen::VectorXd d = Eigen::VectorXd::Zero(n);
@@ -89,10 +90,10 @@ TEST(StrapdownIns, ReportsAntennaVehicleAttitudeAndConstantsWithFirstOrderSds) {
     const Eigen::VectorXd numeric = (J * cov * J.transpose()).diagonal().cwiseSqrt();
     // lat, lon, height: NED → geodetic differentiated with the point's radii,
     // not the frame's tilt over the distance from the anchor (50 m / R_E)
-    for (int i = 0; i < n; ++i)
+    for (int i = 0; i < m; ++i)
       EXPECT_NEAR(sd[i], numeric[i], (i < 3 ? 1e-3 : 1e-6) * numeric[i] + 1e-12)
           << model.reportNames()[static_cast<std::size_t>(i)];
-    const Eigen::VectorXd xc = x.head(9), xb = x.tail(StrapdownIns::kConstants);
+    const Eigen::VectorXd xc = x.head(StrapdownIns::kStates), xb = x.tail(StrapdownIns::kConstants);
     const geodesy::Geodetic g = model.frame().local().toGeodetic(model.h(StrapdownIns::kGnss, xc, xb));
     EXPECT_NEAR(value[0], g.lat * 180 / M_PI, 1e-12);
     EXPECT_NEAR(value[1], g.lon * 180 / M_PI, 1e-12);
@@ -181,11 +182,12 @@ TEST(StrapdownIns, BatchRecoversTheConstantsOfASimulatedDrive) {
     const OfflineRun r = runOffline(model, {Method::Batch}, d.measurements, d.inputs);
     const EstimateRow& end = r.rows.back();
     for (int i = 0; i < StrapdownIns::kConstants; ++i, ++total) {
-      const double err = end.mean[9 + i] - d.constants[i], sd = std::sqrt(end.covariance(9 + i, 9 + i));
+      const int j = StrapdownIns::kStates + i;
+      const double err = end.mean[j] - d.constants[i], sd = std::sqrt(end.covariance(j, j));
       const bool ok = std::abs(err) <= 2 * sd;
       inside += ok;
       if (!ok) std::cout << "seed " << seed << " " << model.names().constants[static_cast<std::size_t>(i)] << ": "
-                         << end.mean[9 + i] << " vs " << d.constants[i] << " (σ " << sd << ")\n";
+                         << end.mean[j] << " vs " << d.constants[i] << " (σ " << sd << ")\n";
     }
   }
   std::cout << inside << " of " << total << " constants within 2σ\n";
@@ -193,7 +195,7 @@ TEST(StrapdownIns, BatchRecoversTheConstantsOfASimulatedDrive) {
 }
 
 // The online methods on one drive: the incremental smoother ends near the
-// batch as it runs (iSAM2's relinearization threshold: measured 0.09σ) and
+// batch as it runs (iSAM2's relinearization threshold: measured 0.37σ, at the clock rate) and
 // at it when every update is iterated to the fixed point (an 8 s drive: the
 // constants are in every process factor, so each iteration relinearizes the
 // whole chain); the EKF and the fixed lag hold the truth of every constant
@@ -210,7 +212,7 @@ TEST(StrapdownIns, OnlineMethodsOnASimulatedDrive) {
     const OfflineRun r = runOffline(model, inc, d.measurements, d.inputs);
     Eigen::VectorXd diff;
     localBlocks(r.rows.back().mean, batch.mean, diff, model.rotationBlocks());
-    EXPECT_LT(diff.cwiseQuotient(batch.covariance.diagonal().cwiseSqrt()).cwiseAbs().maxCoeff(), iterated ? 1e-4 : 0.25)
+    EXPECT_LT(diff.cwiseQuotient(batch.covariance.diagonal().cwiseSqrt()).cwiseAbs().maxCoeff(), iterated ? 1e-4 : 0.5)
         << "incremental − batch, in batch σ: " << diff.transpose();
   }
   const testing::SimulatedDrive d = testing::simulateDrive(model, 12.0, testing::normalSampler(77));
@@ -219,7 +221,8 @@ TEST(StrapdownIns, OnlineMethodsOnASimulatedDrive) {
     const EstimateRow& end = o.rows.back();
     int beyond3 = 0;  // of 19 consistent estimates, one beyond 3σ happens in 5 % of drives
     for (int i = 0; i < StrapdownIns::kConstants; ++i) {
-      const double z = std::abs(end.mean[9 + i] - d.constants[i]) / std::sqrt(end.covariance(9 + i, 9 + i));
+      const int j = StrapdownIns::kStates + i;
+      const double z = std::abs(end.mean[j] - d.constants[i]) / std::sqrt(end.covariance(j, j));
       beyond3 += z > 3;
       EXPECT_LE(z, 4) << methodName(method) << " " << model.names().constants[static_cast<std::size_t>(i)];
     }

@@ -1,5 +1,6 @@
 #include "gssm/plot/run_figures.h"
 #include "gssm/plot/learn_figure.h"
+#include "gssm/plot/withheld_figures.h"
 
 #include <algorithm>
 #include <cmath>
@@ -249,6 +250,7 @@ std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const s
   std::vector<FigureJob> jobs =
       runFigureJobs(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan);
   if (r.learnt) jobs.push_back(learningFigureJob(*r.learnt, dir, r.label));
+  for (auto& job : withheldFigureJobs(r, dir)) jobs.push_back(std::move(job));
   if (r.dataset.constants_reference && !r.runs.empty() && model.dims().nb > 0) {
     const auto batch = std::find_if(r.runs.begin(), r.runs.end(), [](const OfflineRun& x) { return x.method == Method::Batch; });
     const OfflineRun& run = batch != r.runs.end() ? *batch : r.runs.back();

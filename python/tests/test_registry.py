@@ -110,12 +110,13 @@ def test_strapdown_ins_from_its_registration():
     block, its constants and channels, its INI form and Jacobians' shapes."""
     m = gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], prior_start_rpy=[0.0, 0.0, 30.0], prior_delay_sd=0.2)
     assert isinstance(m, gssm.models.StrapdownIns) and m.name == "strapdown_ins"
-    assert (m.nc, m.nb) == (9, 13) and m.rotation_blocks == [0] and m.angle_states == []
-    assert m.constant_names[-1] == "imu_delay" and [c.name for c in m.channels] == ["gnss", "nhc", "zupt"]
+    assert (m.nc, m.nb) == (10, 20) and m.rotation_blocks == [0] and m.angle_states == []
+    assert m.constant_names[12] == "imu_delay" and m.constant_names[-1] == "clock_rate"
+    assert [c.name for c in m.channels] == ["gnss", "nhc", "zupt"]
     assert m.params["prior_delay_sd"] == 0.2
     assert gssm.models.from_ini(m.to_ini()).to_ini() == m.to_ini()
     x, b = m.prior_state[0], m.prior_constants[0]
     np.testing.assert_allclose(np.linalg.norm(x[:3]), np.radians(30.0), atol=1e-12)  # yaw 30° as a rotation vector
     nxt, J_x, J_b = m.f(x, b, u=[0, 0, 0, 0, 0, -9.797], dt=0.01, jacobians=True)
-    assert J_x.shape == (9, 9) and J_b.shape == (9, 13)
+    assert J_x.shape == (10, 10) and J_b.shape == (10, 20)
     assert abs(nxt[5]) < 1e-3  # at rest on the ground: no vertical acceleration to speak of

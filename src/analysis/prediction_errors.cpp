@@ -23,11 +23,10 @@ Eigen::VectorXd carried(const Model& model, Eigen::VectorXd xc, const Eigen::Vec
 }
 }  // namespace
 
-PointErrors predictionErrors(const Model& model, const OfflineRun& run, const std::vector<Input>& inputs,
-                             const std::vector<Measurement>& at) {
-  PointErrors e;
+std::vector<PointError> predictionErrorSeries(const Model& model, const OfflineRun& run,
+                                              const std::vector<Input>& inputs, const std::vector<Measurement>& at) {
+  std::vector<PointError> out;
   const int nc = model.dims().nc, nb = model.dims().nb;
-  double sum_h = 0, sum = 0, max_h = 0, max = 0;
   std::size_t row = 0, input = 0;
   for (const Measurement& m : at) {
     while (row + 1 < run.rows.size() && run.rows[row + 1].t <= m.t) ++row;
@@ -36,7 +35,17 @@ PointErrors predictionErrors(const Model& model, const OfflineRun& run, const st
     while (input + 1 < inputs.size() && inputs[input + 1].t <= r.t) ++input;
     const Eigen::VectorXd xb = r.mean.tail(nb);
     const Eigen::VectorXd xc = carried(model, r.mean.head(nc), xb, inputs, input, r.t, m.t);
-    const Eigen::VectorXd d = model.h(m.channel, xc, xb) - m.y;
+    out.push_back({m.t, model.h(m.channel, xc, xb) - m.y});
+  }
+  return out;
+}
+
+PointErrors predictionErrors(const Model& model, const OfflineRun& run, const std::vector<Input>& inputs,
+                             const std::vector<Measurement>& at) {
+  PointErrors e;
+  double sum_h = 0, sum = 0, max_h = 0, max = 0;
+  for (const PointError& p : predictionErrorSeries(model, run, inputs, at)) {
+    const Eigen::VectorXd& d = p.error;
     const double h = d.head(std::min<Eigen::Index>(2, d.size())).norm(), n = d.norm();
     sum_h += h * h, sum += n * n, max_h = std::max(max_h, h), max = std::max(max, n);
     ++e.count;

@@ -445,6 +445,7 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   out.late_rows = 0;
   out.max_lateness = 0;
   out.withheld.clear();
+  out.outages.clear();
   out.gnss_dropped = 0;
   if (ini.has("dataset", "measurements")) readMeasurements(file("measurements"), ini, model, out, bad_rows);
   if (ini.has("dataset", "gnss"))

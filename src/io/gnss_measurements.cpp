@@ -63,6 +63,7 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
   const int max_quality = static_cast<int>(ini.getDouble("dataset", "gnss_max_quality", 1));
   const double float_scale = ini.getDouble("dataset", "gnss_float_scale", 3.0);
   const std::vector<Outage> outages = outages_path.empty() ? std::vector<Outage>{} : readOutages(outages_path);
+  for (const Outage& o : outages) out.outages.emplace_back(o.start, o.end);
   const GnssSolution sol = readRtklibPos(path);
   const StillFixes still = stillFixes(ini, model, sol);
   const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <mutex>
 #include <numeric>
+#include <sstream>
 
 #include "gssm/checkpoint/checkpoint.h"
 #include "gssm/core/error.h"
@@ -48,10 +49,28 @@ void continueOutputsIn(const std::string& out, const std::string& checkpoint, Me
 
 // The methods to run: as asked, or every one; with resume, the checkpoint's
 // one streaming method.
-std::vector<Method> methodsToRun(const ProcessOptions& o, const Model& model) {
-  std::vector<Method> methods = o.methods;
-  if (methods.empty() && o.resume.empty())
+// Every method, or those [scenario] methods names (a scenario whose model a
+// method cannot run says so there, with why).
+std::vector<Method> allMethods(const IniDocument& config) {
+  std::vector<Method> methods;
+  if (!config.has("scenario", "methods")) {
     for (const auto& info : gssm::methods()) methods.push_back(info.method);
+    return methods;
+  }
+  std::istringstream words(config.getString("scenario", "methods"));
+  for (std::string w; words >> w;) {
+    const std::optional<Method> m = methodNamed(w);
+    if (!m)
+      throw InputError(config.where("scenario", "methods") + ": '" + w + "' is not a method (" + methodNameList() + ")");
+    methods.push_back(*m);
+  }
+  if (methods.empty()) throw InputError(config.where("scenario", "methods") + ": names no method");
+  return methods;
+}
+
+std::vector<Method> methodsToRun(const ProcessOptions& o, const Model& model, const IniDocument& config) {
+  std::vector<Method> methods = o.methods;
+  if (methods.empty() && o.resume.empty()) methods = allMethods(config);
   if (o.resume.empty()) return methods;
   CheckpointInfo info;
   restoreCheckpoint(model, o.resume, &info);  // throws a clear error if unusable
@@ -189,7 +208,7 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   r.config = readScenario(o.data_dir, o.config);
   std::shared_ptr<const Model> model(makeModel(r.config, o.data_dir));
   r.model = model;
-  const std::vector<Method> methods = methodsToRun(o, *model);
+  const std::vector<Method> methods = methodsToRun(o, *model, r.config);
   readData(o, *model, r, cb);
   if (LearnSettings learn = learnSettings(r.config); o.learn.value_or(learn.enabled)) {
     learn.options.batch.threads = static_cast<int>(o.threads);  // learning runs alone: its batch solves may use them all

@@ -16,18 +16,20 @@ using so3::hat;
 
 ModelNames insNames() {
   ModelNames n;
-  n.state = {"att_x", "att_y", "att_z", "vn", "ve", "vd", "pn", "pe", "pd"};
+  n.state = {"att_x", "att_y", "att_z", "vn", "ve", "vd", "pn", "pe", "pd", "clock"};
   n.constants = {"bg_x", "bg_y", "bg_z", "ba_x", "ba_y", "ba_z", "lever_x", "lever_y", "lever_z",
-                 "mount_roll", "mount_pitch", "mount_yaw", "imu_delay", "sg_x", "sg_y", "sg_z", "sa_x", "sa_y", "sa_z"};
+                 "mount_roll", "mount_pitch", "mount_yaw", "imu_delay", "sg_x", "sg_y", "sg_z", "sa_x", "sa_y", "sa_z", "clock_rate"};
   n.input = {"gx", "gy", "gz", "ax", "ay", "az"};
   n.measurement = {"gnss_n", "gnss_e", "gnss_d"};
   return n;
 }
 
 // θ: the gyro's white noise in the body tangent; (v, p): white acceleration,
-// σ_a²·[[dt, dt²/2], [dt²/2, dt³/3]] on each axis (isotropic: R·σ²I·Rᵀ = σ²I).
+// σ_a²·[[dt, dt²/2], [dt²/2, dt³/3]] on each axis (isotropic: R·σ²I·Rᵀ = σ²I);
+// the clock: its wander beyond the constant rate.
 Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
-  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(9, 9);
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(10, 10);
+  Q(9, 9) = p.clock_wander_sd * p.clock_wander_sd * dt;
   const double g = p.gyro_sd * p.gyro_sd, a = p.accel_sd * p.accel_sd;
   for (int i = 0; i < 3; ++i) {
     Q(i, i) = g * dt;
@@ -41,22 +43,22 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
 ModelNoise insNoise(const StrapdownIns::Params& p) {
   for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.attitude_sd, p.velocity_sd,
                    p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd,
-                   p.gyro_scale_sd, p.accel_scale_sd})
+                   p.gyro_scale_sd, p.accel_scale_sd, p.clock_rate_sd, p.clock_wander_sd})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
   ModelNoise n;
   n.T = p.T;
   n.Q = insProcessNoise(p, p.T);
   n.R = Eigen::Matrix3d::Identity() * p.gnss_sd * p.gnss_sd;
-  Eigen::VectorXd mean(9), sd(9);
-  mean << so3::Log(so3::fromRollPitchYaw(p.start_rpy)), p.start_velocity, p.start_position;
+  Eigen::VectorXd mean(10), sd(10);
+  mean << so3::Log(so3::fromRollPitchYaw(p.start_rpy)), p.start_velocity, p.start_position, 0.0;
   sd << Eigen::Vector3d::Constant(p.attitude_sd), Eigen::Vector3d::Constant(p.velocity_sd),
-      Eigen::Vector3d::Constant(p.position_sd);
+      Eigen::Vector3d::Constant(p.position_sd), p.clock_wander_sd * std::sqrt(p.T);  // the clock starts at 0
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
   bmean.segment<3>(StrapdownIns::kLever) = so3::fromRollPitchYaw(p.mount_rpy).transpose() * p.lever;  // IMU axes
   bsd << Eigen::Vector3d::Constant(p.gyro_bias_sd), Eigen::Vector3d::Constant(p.accel_bias_sd),
       Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd,
-      Eigen::Vector3d::Constant(p.gyro_scale_sd), Eigen::Vector3d::Constant(p.accel_scale_sd);
+      Eigen::Vector3d::Constant(p.gyro_scale_sd), Eigen::Vector3d::Constant(p.accel_scale_sd), p.clock_rate_sd;
   n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
   return n;
 }
@@ -73,11 +75,11 @@ MeasurementChannel channelOf(const std::string& name, std::vector<std::string> c
 }  // namespace
 
 StrapdownIns::StrapdownIns(const Params& p)
-    : Model({9, kConstants, 6, 3}, insNames(), insNoise(p)),
+    : Model({kStates, kConstants, 6, 3}, insNames(), insNoise(p)),
       p_(p),
       frame_(p.anchor),
       mount0_(so3::fromRollPitchYaw(p.mount_rpy)) {
-  setChannels({channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay}),
+  setChannels({channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay, kClockRate}),
                channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11}),
                channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, Eigen::Vector3d::Constant(p.zupt_sd), {})});
   setRotationBlocks({0});
@@ -114,16 +116,20 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
   const strapdown::NavState next = strapdown::step(x, gyro_c, accel_c, xb.segment<3>(kGyroBias),
                                                    xb.segment<3>(kAccelBias), dt, frame_,
                                                    J_f_xc || J_f_xb ? &J : nullptr);
-  if (J_f_xc) *J_f_xc = J.J_next_x;
-  if (J_f_xb) {
-    J_f_xb->setZero(9, kConstants);
-    J_f_xb->middleCols<3>(kGyroBias) = J.J_next_bg;
-    J_f_xb->middleCols<3>(kAccelBias) = J.J_next_ba;
-    J_f_xb->middleCols<3>(kGyroScale) = J.J_next_bg * gyro.asDiagonal();
-    J_f_xb->middleCols<3>(kAccelScale) = J.J_next_ba * accel.asDiagonal();
+  if (J_f_xc) {
+    J_f_xc->setZero(kStates, kStates);
+    J_f_xc->topLeftCorner<9, 9>() = J.J_next_x;
+    (*J_f_xc)(kClock, kClock) = 1;
   }
-  Eigen::VectorXd out(9);
-  out << so3::Log(next.R), next.v, next.p;
+  if (J_f_xb) {
+    J_f_xb->setZero(kStates, kConstants);
+    J_f_xb->block<9, 3>(0, kGyroBias) = J.J_next_bg;
+    J_f_xb->block<9, 3>(0, kAccelBias) = J.J_next_ba;
+    J_f_xb->block<9, 3>(0, kGyroScale) = J.J_next_bg * gyro.asDiagonal();
+    J_f_xb->block<9, 3>(0, kAccelScale) = J.J_next_ba * accel.asDiagonal();
+  }
+  Eigen::VectorXd out(kStates);
+  out << so3::Log(next.R), next.v, next.p, xc[kClock] + dt;
   return out;
 }
 
@@ -138,7 +144,7 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
   if (channel == kGnss) return antenna(xc, xb, J_h_xc, J_h_xb);
   if (channel == kNhc) return vehicleVelocity(xc, xb, J_h_xc, J_h_xb);
   if (J_h_xc) {
-    J_h_xc->setZero(3, 9);
+    J_h_xc->setZero(3, kStates);
     J_h_xc->middleCols<3>(3).setIdentity();
   }
   if (J_h_xb) J_h_xb->setZero(3, kConstants);
@@ -146,24 +152,28 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
 }
 
 // The antenna at the GNSS time of the fix: the state at IMU time t is the
-// true time t + d (d = imu_delay, added to the IMU's stamps), so to first
-// order y = p + R·ℓ − d·v (ℓ in the IMU's axes): ∂y/∂δθ = −R·[ℓ]×,
-// ∂y/∂v = −d·I, ∂y/∂ℓ = R, ∂y/∂d = −v.
+// true time t + δ, δ = d + ρ·c the IMU's delay then (d = imu_delay at the
+// start, ρ = clock_rate, c = the state's clock, the time since the start),
+// so to first order y = p + R·ℓ − δ·v (ℓ in the IMU's axes):
+// ∂y/∂δθ = −R·[ℓ]×, ∂y/∂v = −δ·I, ∂y/∂c = −ρ·v, ∂y/∂ℓ = R, ∂y/∂d = −v,
+// ∂y/∂ρ = −c·v.
 Eigen::VectorXd StrapdownIns::antenna(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                                       Eigen::MatrixXd* J_h_xb) const {
   const Eigen::Matrix3d R = so3::Exp(xc.head<3>());
   const Eigen::Vector3d v = xc.segment<3>(3), w = xb.segment<3>(kLever);
-  const double delay = xb[kDelay];
+  const double delay = xb[kDelay] + xb[kClockRate] * xc[kClock];
   if (J_h_xc) {
-    J_h_xc->setZero(3, 9);
+    J_h_xc->setZero(3, kStates);
     J_h_xc->leftCols<3>() = -R * hat(w);
     J_h_xc->middleCols<3>(3).diagonal().setConstant(-delay);
-    J_h_xc->rightCols<3>().setIdentity();
+    J_h_xc->middleCols<3>(6).setIdentity();
+    J_h_xc->col(kClock) = -xb[kClockRate] * v;
   }
   if (J_h_xb) {
     J_h_xb->setZero(3, kConstants);
     J_h_xb->middleCols<3>(kLever) = R;
     J_h_xb->col(kDelay) = -v;
+    J_h_xb->col(kClockRate) = -xc[kClock] * v;
   }
   return xc.segment<3>(6) + R * w - delay * v;
 }
@@ -178,7 +188,7 @@ Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const E
   const Eigen::Vector3d u = R.transpose() * xc.segment<3>(3);
   const Eigen::Vector3d w = M * u;
   if (J_h_xc) {
-    J_h_xc->setZero(2, 9);
+    J_h_xc->setZero(2, kStates);
     J_h_xc->leftCols<3>() = (M * hat(u)).bottomRows<2>();
     J_h_xc->middleCols<3>(3) = (M * R.transpose()).bottomRows<2>();
   }
@@ -229,7 +239,9 @@ std::vector<ParamSpec> insParams() {
       vector("prior", "lever", "prior mean of the lever arm IMU → antenna, vehicle axes (m)"),
       real("prior", "lever_sd", "its σ (m)"),
       real("prior", "mount_sd", "prior σ of the mounting misalignment (deg), mean 0"),
-      real("prior", "delay_sd", "prior σ of the IMU's time delay (s, added to its stamps), mean 0"),
+      real("prior", "delay_sd", "prior σ of the IMU's time delay at the start (s, added to its stamps), mean 0"),
+      real("prior", "clock_rate_sd", "prior σ of the IMU clock's rate error (s/s: the delay grows by it), mean 0"),
+      real("model", "clock_wander_sd", "the IMU clock's wander beyond its constant rate (s/√s)"),
       real("prior", "gyro_scale_sd", "prior σ of each gyro axis's scale factor error (1 = 100 %), mean 0"),
       real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error, mean 0")};
   return p;
@@ -311,7 +323,7 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
   for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
                             {"gnss_sd", &p.gnss_sd}, {"nhc_sd", &p.nhc_sd}, {"nhc_down_sd", &p.nhc_down_sd},
-                            {"zupt_sd", &p.zupt_sd}})
+                            {"zupt_sd", &p.zupt_sd}, {"clock_wander_sd", &p.clock_wander_sd}})
     *value = in.real("model", key, *value);
   if (in.has("prior", "lever")) p.lever = in.vector("prior", "lever", 3);
   const bool from_data = in.has("prior", "start") && in.text("prior", "start") == "data";
@@ -329,7 +341,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   for (auto [key, value] : {std::pair{"velocity_sd", &p.velocity_sd}, {"position_sd", &p.position_sd},
                             {"gyro_bias_sd", &p.gyro_bias_sd}, {"accel_bias_sd", &p.accel_bias_sd},
                             {"lever_sd", &p.lever_sd}, {"delay_sd", &p.delay_sd},
-                            {"gyro_scale_sd", &p.gyro_scale_sd}, {"accel_scale_sd", &p.accel_scale_sd}})
+                            {"gyro_scale_sd", &p.gyro_scale_sd}, {"accel_scale_sd", &p.accel_scale_sd},
+                            {"clock_rate_sd", &p.clock_rate_sd}})
     *value = in.real("prior", key, *value);
   return p;
 }
@@ -340,7 +353,7 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("model", "mount_rpy", p.mount_rpy / kDeg);
   for (auto [key, value] : {std::pair{"gyro_sd", p.gyro_sd}, {"accel_sd", p.accel_sd}, {"gnss_sd", p.gnss_sd},
                             {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
-                            {"zupt_sd", p.zupt_sd}})
+                            {"zupt_sd", p.zupt_sd}, {"clock_wander_sd", p.clock_wander_sd}})
     out.real("model", key, value);
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);
   out.vector("prior", "start_velocity", p.start_velocity);
@@ -350,7 +363,7 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
                             {"position_sd", p.position_sd}, {"gyro_bias_sd", p.gyro_bias_sd},
                             {"accel_bias_sd", p.accel_bias_sd}, {"lever_sd", p.lever_sd}, {"mount_sd", p.mount_sd / kDeg},
                             {"delay_sd", p.delay_sd}, {"gyro_scale_sd", p.gyro_scale_sd},
-                            {"accel_scale_sd", p.accel_scale_sd}})
+                            {"accel_scale_sd", p.accel_scale_sd}, {"clock_rate_sd", p.clock_rate_sd}})
     out.real("prior", key, value);
 }
 

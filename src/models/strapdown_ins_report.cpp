@@ -12,14 +12,14 @@ namespace gssm::models {
 
 namespace {
 constexpr double kDeg = 180.0 / M_PI;  // rad → deg
-constexpr int kNc = 9, kTheta = 0, kVel = 3;
+constexpr int kNc = StrapdownIns::kStates, kTheta = 0, kVel = 3;
 }  // namespace
 
 std::vector<std::string> StrapdownIns::reportNames() const {
   return {"lat",     "lon",     "height",  "vn",      "ve",      "vd",        "roll",       "pitch",
           "yaw",     "bg_x",    "bg_y",    "bg_z",    "ba_x",    "ba_y",      "ba_z",       "lever_f",
           "lever_r", "lever_d", "imu_delay", "mount_roll", "mount_pitch", "mount_yaw", "sg_x", "sg_y", "sg_z",
-          "sa_x", "sa_y", "sa_z"};
+          "sa_x", "sa_y", "sa_z", "clock_rate"};
 }
 
 // Rows of J (outputs × stacked tangent) and values, in reportNames' order.
@@ -27,8 +27,9 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
                           Eigen::VectorXd& sd) const {
   const Eigen::VectorXd xc = mean.head(kNc), xb = mean.tail(kConstants);
   const int n = kNc + kConstants, b = kNc;  // b: where x_b starts in the stacked state
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n, n);
-  value.resize(n);
+  constexpr int kOut = 29;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(kOut, n);
+  value.resize(kOut);
   // The antenna in the frame, then geodetic (deg, deg, m).
   Eigen::MatrixXd J_xc, J_xb;
   const Eigen::Vector3d ned = antenna(xc, xb, &J_xc, &J_xb);
@@ -59,8 +60,10 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   J_rpy.setZero();
   value.segment<3>(19) = so3::rollPitchYaw(R_vb, &J_rpy) * kDeg;
   J.block<3, 3>(19, b + kMount) = kDeg * J_rpy * E;
-  value.tail<6>() = xb.segment<6>(kGyroScale);
+  value.segment<6>(22) = xb.segment<6>(kGyroScale);
   J.block<6, 6>(22, b + kGyroScale).setIdentity();
+  value[28] = xb[kClockRate];
+  J(28, b + kClockRate) = 1;
   sd = (J * covariance).cwiseProduct(J).rowwise().sum().cwiseSqrt();
 }
 

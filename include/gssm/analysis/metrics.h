@@ -63,11 +63,20 @@ RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth
 /// InvalidArgument on a size mismatch.
 void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference, const Gaussian* compared = nullptr);
 
+/// One measurement's error: prediction − measurement at its time.
+struct PointError {
+  double t = 0;
+  Eigen::VectorXd error;
+};
+
 /// The run's errors at `at` (all on one channel, in time order): at each
 /// measurement's time t, the newest row at or before t (causal for a
 /// streaming run's rows) carried to t by the model's f under the input in
 /// force (a step of at most one input interval), then h on that channel,
 /// minus the measurement. Measurements before the first row are not scored.
+std::vector<PointError> predictionErrorSeries(const Model& model, const OfflineRun& run,
+                                              const std::vector<Input>& inputs, const std::vector<Measurement>& at);
+/// Their RMS and largest values, horizontal and whole.
 PointErrors predictionErrors(const Model& model, const OfflineRun& run, const std::vector<Input>& inputs,
                              const std::vector<Measurement>& at);
 

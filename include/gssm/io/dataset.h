@@ -42,6 +42,8 @@ struct Dataset {
   /// GNSS fixes inside [dataset] gnss_outages, withheld from the estimators
   /// (on the GNSS channel, in the model's frame): the truth to score against.
   std::vector<Measurement> withheld;
+  /// Those outages' (start, end) times (s), as the file gives them.
+  std::vector<std::pair<double, double>> outages;
   /// GNSS fixes dropped for their quality ([dataset] gnss_max_quality).
   std::size_t gnss_dropped = 0;
 };

@@ -5,7 +5,8 @@
 // a NED frame fixed to the Earth at an anchor (strapdown.h). The sensor's
 // constants are single nodes, each only in the factors that involve it:
 //
-//   x_c = [θ (IMU → NED, rotation block), v (m/s, NED), p (m, NED)]
+//   x_c = [θ (IMU → NED, rotation block), v (m/s, NED), p (m, NED),
+//          c (the IMU clock's time since the start, s: f adds dt)]
 //   x_b = [b_g (rad/s), b_a (m/s²), ℓ (IMU → antenna in the IMU's axes, m:
 //            GNSS sees it so, whatever the mounting; in vehicle axes,
 //            R_vb·ℓ, it would bend with the weakly seen mounting roll and
@@ -17,11 +18,14 @@
 //            that the non-holonomic constraint sees well),
 //          d (the IMU's time delay, s: added to its stamps gives GNSS time),
 //          s_g, s_a (the gyro's and accelerometer's scale factor errors per
-//            axis: a reading is (1 + s)∘true + b)]
+//            axis: a reading is (1 + s)∘true + b),
+//          ρ (the IMU clock's rate error: its delay at clock time c is
+//            d + ρ·c; a logger mapping a millisecond counter linearly onto
+//            GPS time leaves one of order 1e-4)]
 //   u   = [ω̃ (rad/s), f̃ (m/s²)] in the IMU's axes
 //
 // Channels: `gnss` (the antenna's NED position at the fix's time,
-// p + R_nb·ℓ − d·v), `nhc`
+// p + R_nb·ℓ − (d + ρ·c)·v), `nhc`
 // (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z),
 // `zupt` (the velocity, zero while standing). R_vb maps the IMU's axes to
 // the vehicle's (forward, right, down); R_vb0 is its nominal value.
@@ -57,6 +61,8 @@ class StrapdownIns final : public Model {
     double delay_sd = 0.1;                     ///< prior σ of d (s), mean 0
     double gyro_scale_sd = 0.01;               ///< prior σ of the gyro's scale factor errors, mean 0
     double accel_scale_sd = 0.01;              ///< prior σ of the accelerometer's scale factor errors, mean 0
+    double clock_rate_sd = 1e-3;               ///< prior σ of ρ (s/s), mean 0
+    double clock_wander_sd = 1e-4;             ///< the clock's random walk beyond ρ (s/√s)
   };
 
   explicit StrapdownIns(const Params& p);
@@ -88,7 +94,8 @@ class StrapdownIns final : public Model {
 
   // Where each part of x_b starts.
   static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kGyroScale = 13,
-                       kAccelScale = 16, kConstants = 19;
+                       kAccelScale = 16, kClockRate = 19, kConstants = 20;
+  static constexpr int kClock = 9, kStates = 10;  // in x_c
   enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2 };
 
  private:

@@ -1,0 +1,69 @@
+#!/usr/bin/python3
+"""gssm-process on the real GNSS/INS car drive (datasets/gnss-ins-drive, issue
+#37) with its own scenario.ini, noise learnt from the log first: the antenna's
+horizontal error at the RTK-fixed fixes withheld inside the five outages and
+at the fixes used outside them, per method, against the issue's targets where
+they are met and against today's level where they are not (said below); the
+lever arm against the hand-measured one; the columns of estimates-<method>.csv.
+
+    process_gnss_ins.py BIN_DIR SOURCE_DIR WORK_DIR
+"""
+import csv
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+bin_dir, src, work = sys.argv[1:4]
+data = os.path.join(src, "datasets", "gnss-ins-drive")
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+
+
+def check(cond, what):
+    if not cond:
+        sys.exit("FAIL: " + what)
+    print("ok:", what)
+
+
+out = os.path.join(work, "drive")
+r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--out", out],
+                   capture_output=True, text=True)
+check(r.returncode == 0, "gssm-process runs on the drive" + ("" if r.returncode == 0 else ": " + r.stderr.strip()[-400:]))
+check(os.path.exists(os.path.join(out, "scenario.ini")) and os.path.exists(os.path.join(out, "learn.json")),
+      "the noise learnt from the log first (scenario.ini, learn.json)")
+doc = json.load(open(os.path.join(out, "metrics.json")))
+methods = doc["methods"]
+check(sorted(methods) == ["batch", "ekf", "fixed-lag", "incremental"], "the scenario's four methods ran")
+check(sum("is not after the start" in s for s in doc["skipped"]) == 14,
+      "the 14 fixes before the first IMU row dropped, each named")
+for name, m in methods.items():
+    check(m["withheld"]["count"] == 292, "%s scored at the 292 withheld RTK-fixed fixes" % name)
+    outside = m["used"]["horizontal_rms_m"]
+    check(outside <= 0.02, "%s outside the outages %.4f m RMS <= 0.02 m (target)" % (name, outside))
+# Not met yet (issue #37): smoothed 0.13 m, online 1.3 m. Guarded at today's
+# level (batch 0.136 m, online 2.1-3.1 m) so that a change for the worse fails.
+batch = methods["batch"]["withheld"]["horizontal_rms_m"]
+check(batch <= 0.15, "batch inside the outages %.3f m RMS (target 0.13 m; today's level <= 0.15 m)" % batch)
+for name in ("incremental", "fixed-lag", "ekf"):
+    e = methods[name]["withheld"]["horizontal_rms_m"]
+    check(e <= 3.4, "%s inside the outages %.2f m RMS (target 1.3 m not met; today's level <= 3.4 m)" % (name, e))
+
+with open(os.path.join(out, "estimates-batch.csv"), newline="") as f:
+    rows = list(csv.DictReader(f))
+want = ["t", "lat", "lon", "height", "vn", "ve", "vd", "roll", "pitch", "yaw", "bg_x", "bg_y", "bg_z", "ba_x", "ba_y",
+        "ba_z", "lever_f", "lever_r", "lever_d", "imu_delay", "mount_roll", "mount_pitch", "mount_yaw"]
+check(list(rows[0].keys())[:len(want)] == want and "sd_lat" in rows[0] and "sd_mount_yaw" in rows[0],
+      "estimates columns: t, antenna lat/lon/height, velocity, vehicle roll/pitch/yaw, constants, sd_ columns")
+check(len(rows) >= 27107, "a row at every IMU sample (%d rows)" % len(rows))
+last = rows[-1]
+lever = [float(last[k]) for k in ("lever_f", "lever_r", "lever_d")]
+hand = [0.0, -0.05, 0.0]
+off = [abs(a - b) for a, b in zip(lever, hand)]
+check(max(off) <= 0.10, "lever arm (%.3f, %.3f, %.3f) m within 0.10 m of the hand-measured (0, -0.05, 0) per axis "
+      "(%.3f m apart)" % (lever[0], lever[1], lever[2], math.sqrt(sum(d * d for d in off))))
+pitch, yaw = float(last["mount_pitch"]), float(last["mount_yaw"]) % 360
+check(abs(abs(pitch) - 6.79) < 1.5 and abs(yaw - 185.35) < 1.5,
+      "mounting pitch %.2f deg, yaw %.2f deg beside the source's hand values 6.79 and 185.35" % (pitch, yaw))
