@@ -14,6 +14,7 @@
 #include "gssm/io/dataset.h"
 #include "gssm/io/ini.h"
 #include "gssm/io/rtklib_pos.h"
+#include "gssm/io/track_pos.h"
 #include "expect_error.h"
 #include "gssm/models/strapdown_ins.h"
 #include "jacobian_check.h"
@@ -102,6 +103,38 @@ TEST(StrapdownIns, ReportsAntennaVehicleAttitudeAndConstantsWithFirstOrderSds) {
     EXPECT_LT((value.segment<3>(15) - R_vb * xb.segment<3>(StrapdownIns::kLever)).norm(), 1e-12);
     EXPECT_LT((so3::fromRollPitchYaw(value.segment<3>(6) * M_PI / 180) - so3::Exp(xc.head<3>()) * R_vb.transpose()).norm(),
               1e-12);
+  }
+}
+
+// The smoothed track as an RTKLIB .pos reads back as the rows' report.
+TEST(StrapdownIns, TrackPosReadsBackAsTheReportedAntenna) {
+  const StrapdownIns model(driveParams(0.01));
+  ASSERT_TRUE(io::reportsGeodeticTrack(model));
+  OfflineRun run;
+  run.method = Method::Batch;
+  const int n = StrapdownIns::kStates + StrapdownIns::kConstants;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+    x.segment<3>(3) << 3.0 * k, -1.0, 0.2;  // v
+    x.segment<3>(6) << 10.0 * k, 5.0, -1.0;  // p
+    run.rows.push_back({1436038461.854 + 0.25 * k, x, Eigen::MatrixXd::Identity(n, n) * (k == 2 ? 1.0 : 1e-4)});
+  }
+  const std::string path = ::testing::TempDir() + "/track-batch.pos";
+  io::writeTrackPos(path, model, run);
+  const io::GnssSolution back = io::readRtklibPos(path);
+  ASSERT_EQ(back.fixes.size(), 3u);
+  ASSERT_TRUE(back.has_velocity);
+  for (int k = 0; k < 3; ++k) {
+    Eigen::VectorXd value, sd;
+    model.report(run.rows[static_cast<std::size_t>(k)].mean, run.rows[static_cast<std::size_t>(k)].covariance, value, sd);
+    const io::GnssFix& f = back.fixes[static_cast<std::size_t>(k)];
+    EXPECT_NEAR(f.t, run.rows[static_cast<std::size_t>(k)].t, 1e-3);
+    EXPECT_NEAR(f.lat_deg, value[0], 1e-9);
+    EXPECT_NEAR(f.lon_deg, value[1], 1e-9);
+    EXPECT_NEAR(f.height, value[2], 1e-4);
+    EXPECT_NEAR((*f.vel_neu)[2], -value[5], 1e-5);  // up = −down
+    EXPECT_NEAR(std::sqrt(f.cov_neu(2, 2)), sd[2], 1e-4);
+    EXPECT_EQ(f.quality, k == 2 ? 2 : 1);  // sd over 5 cm: not a fix-quality estimate
   }
 }
 

@@ -14,6 +14,7 @@
 #include "gssm/io/config.h"
 #include "gssm/io/learn_config.h"
 #include "gssm/io/run_files.h"
+#include "gssm/io/track_pos.h"
 
 namespace gssm::io {
 
@@ -232,6 +233,10 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
     r.runs.push_back(std::move(m.run));
     r.metrics.push_back(std::move(m.metrics));
     r.files.push_back((fs::path(o.out_dir) / RunFiles::estimatesName(method)).string());
+    if (method == Method::Batch && reportsGeodeticTrack(*model)) {  // the smoothed track, for RTKPLOT
+      r.files.push_back((fs::path(o.out_dir) / "track-batch.pos").string());
+      writeTrackPos(r.files.back(), *model, r.runs.back());
+    }
     if (cb.finished) cb.finished(r.runs.back(), r.metrics.back());
   }
   const std::string json = (fs::path(o.out_dir) / "metrics.json").string();

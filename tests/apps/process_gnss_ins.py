@@ -67,3 +67,6 @@ check(max(off) <= 0.10, "lever arm (%.3f, %.3f, %.3f) m within 0.10 m of the han
 pitch, yaw = float(last["mount_pitch"]), float(last["mount_yaw"]) % 360
 check(abs(abs(pitch) - 6.79) < 1.5 and abs(yaw - 185.35) < 1.5,
       "mounting pitch %.2f deg, yaw %.2f deg beside the source's hand values 6.79 and 185.35" % (pitch, yaw))
+pos = os.path.join(out, "track-batch.pos")
+check(os.path.exists(pos) and sum(1 for line in open(pos) if not line.startswith("%")) == len(rows),
+      "the smoothed track as an RTKLIB .pos, an epoch per row")
