@@ -4,6 +4,7 @@
 // anything is estimated.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -74,6 +75,24 @@ TEST(DriveBadInput, PosInAnotherLayoutIsRefusedWithTheOptionToChange) {
     l[0].replace(l[0].find(from), from.size(), "x-ecef(m)      y-ecef(m)      z-ecef(m)");
   });
   testing::expectThrowsNaming<InputError>([&] { readDrive(dir); }, {"gnss.pos:2", "x-ecef(m)", "Lat/Lon/Height"});
+}
+
+// A log whose outage rows were taken out of its .pos before gssm sees it
+// may come without outages.csv: nothing is withheld, and the run says so.
+TEST(DriveBadInput, WithoutItsOutagesFileNothingIsWithheldAndItSaysSo) {
+  const fs::path dir = corrupted("no-outages", "outages.csv", [](auto&) {});
+  fs::remove(dir / "outages.csv");
+  const io::IniDocument ini = io::readScenario(dir.string());
+  const auto model = io::makeModel(ini, dir.string());
+  io::Dataset d;
+  io::readDatasetData(dir.string(), *model, d, io::BadRows::Throw, &ini);
+  EXPECT_TRUE(d.withheld.empty());
+  const auto fixes = std::count_if(d.measurements.begin(), d.measurements.end(),
+                                   [&](const Measurement& m) { return m.channel == model->channelIndex("gnss"); });
+  EXPECT_EQ(fixes, 1090 - 14);  // every RTK-fixed fix after the start is used
+  EXPECT_EQ(d.gnss_dropped, 8u);  // the float ones, by gnss_max_quality
+  EXPECT_TRUE(std::any_of(d.dropped.begin(), d.dropped.end(),
+                          [](const std::string& m) { return m.find("outages.csv: no such file") != std::string::npos; }));
 }
 
 TEST(DriveBadInput, GnssBeforeTheFirstImuRowIsDroppedAndNamed) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "gssm/core/error.h"
 #include "gssm/io/csv.h"
@@ -62,7 +63,12 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
                      model.channel(channel).name + "' does not take positions in a frame anchored on the Earth");
   const int max_quality = static_cast<int>(ini.getDouble("dataset", "gnss_max_quality", 1));
   const double float_scale = ini.getDouble("dataset", "gnss_float_scale", 3.0);
-  const std::vector<Outage> outages = outages_path.empty() ? std::vector<Outage>{} : readOutages(outages_path);
+  // A log without its outages file (a log whose outage rows were taken out
+  // of the .pos before gssm sees it) withholds nothing, and says so.
+  const bool listed = !outages_path.empty() && std::filesystem::exists(outages_path);
+  if (!outages_path.empty() && !listed)
+    out.dropped.push_back(outages_path + ": no such file ([dataset] gnss_outages): no fixes withheld");
+  const std::vector<Outage> outages = listed ? readOutages(outages_path) : std::vector<Outage>{};
   for (const Outage& o : outages) out.outages.emplace_back(o.start, o.end);
   const GnssSolution sol = readRtklibPos(path);
   const StillFixes still = stillFixes(ini, model, sol);

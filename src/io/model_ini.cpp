@@ -66,6 +66,9 @@ class IniParamSource final : public ParamSource {
     return dataFile(value, columns);
   }
   Eigen::MatrixXd dataFile(const std::string& file, const std::vector<std::string>& columns) const override;
+  bool hasDataFile(const std::string& file) const override {
+    return std::filesystem::exists(io::dataFile(ini_, data_dir_, file));
+  }
   std::string where(const std::string& s, const std::string& k) const override { return ini_.where(s, k); }
 
  private:

@@ -297,7 +297,8 @@ void startFromData(const ParamSource& in, StrapdownIns::Params& p) {
   const std::vector<Input> imu = startImu(in, t0);
   const Eigen::MatrixXd fixes = in.dataFile(in.text("dataset", "gnss", "gnss.pos"), {"t", "lat", "lon", "height", "q"});
   Eigen::MatrixXd outages(0, 2);
-  if (in.has("dataset", "gnss_outages")) outages = in.dataFile(in.text("dataset", "gnss_outages"), {"start", "end"});
+  if (in.has("dataset", "gnss_outages") && in.hasDataFile(in.text("dataset", "gnss_outages")))  // none: none withheld
+    outages = in.dataFile(in.text("dataset", "gnss_outages"), {"start", "end"});
   const double max_quality = in.real("dataset", "gnss_max_quality", 1);
   const strapdown::NavFrame frame(p.anchor);
   std::vector<double> ft;

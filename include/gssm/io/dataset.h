@@ -77,7 +77,8 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
 ///       gnss_channel, default "gnss", mapped by Model::localPosition, with
 ///       the fix's own covariance; gnss_max_quality: the worst Q used, default
 ///       1 = RTK-fixed; gnss_float_scale: σ factor of float fixes, default 3;
-///       gnss_outages = FILE: rows start,end (s) whose fixes are withheld;
+///       gnss_outages = FILE: rows start,end (s) whose fixes are withheld
+///       (a missing file withholds nothing, noted in `dropped`);
 ///       fixes at or before t0 are dropped and listed in `dropped`;
 ///       gnss_still_channel = NAME: a zero measurement on that channel at
 ///       every used fix whose own velocity is under gnss_still_speed, m/s,

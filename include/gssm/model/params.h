@@ -114,6 +114,8 @@ class ParamSource {
   /// The named columns of a data file (`file` relative to the dataset
   /// folder); InvalidArgument where the source has no files (Python).
   virtual Eigen::MatrixXd dataFile(const std::string& file, const std::vector<std::string>& columns) const = 0;
+  /// Whether such a file is there (an optional file of a data set).
+  virtual bool hasDataFile(const std::string& /*file*/) const { return true; }
   /// "scenario.ini: [model] T" or "RangeBeacon2D(range_sd=...)": for messages.
   virtual std::string where(const std::string& section, const std::string& key) const = 0;
 
