@@ -205,6 +205,39 @@ TEST(StrapdownIns, ReadsTheDrivesImuAndGnssWithItsOutages) {
   for (std::size_t i = 1; i < ds.measurements.size(); ++i) ASSERT_GT(ds.measurements[i].t, ds.measurements[i - 1].t);
 }
 
+// The shipped scenario: where the receiver's Doppler speed says the car
+// stands, a zero velocity and the gyro's mean reading since the previous
+// fix (checked against the IMU rows themselves); non-holonomic zeros at 10 Hz.
+TEST(StrapdownIns, StandingFixesGiveZeroVelocityAndTheGyrosMeanReading) {
+  const std::string dir = GSSM_SOURCE_DIR "/datasets/gnss-ins-drive";
+  const io::IniDocument ini = io::readScenario(dir);
+  const auto model = io::makeModel(ini, dir);
+  io::Dataset ds;
+  io::readDatasetData(dir, *model, ds, io::BadRows::Throw, &ini);
+  std::size_t zupt = 0, zaru = 0, nhc = 0;
+  double previous_fix = ds.t0, this_fix = ds.t0;
+  for (const Measurement& m : ds.measurements) {
+    if (m.channel == StrapdownIns::kGnss) previous_fix = this_fix, this_fix = m.t;
+    if (m.channel == StrapdownIns::kNhc) ++nhc;
+    if (m.channel == StrapdownIns::kZupt) {
+      ++zupt;
+      EXPECT_EQ(m.y.norm(), 0.0);
+    }
+    if (m.channel == StrapdownIns::kZaru) {
+      ++zaru;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int n = 0;
+      for (const Input& u : ds.inputs)
+        if (u.t > previous_fix && u.t <= m.t) sum += u.u.head<3>(), ++n;
+      ASSERT_GT(n, 0);
+      EXPECT_LT((m.y - sum / n).norm(), 1e-12) << "at t = " << m.t;
+    }
+  }
+  EXPECT_GT(zupt, 150u);  // the first ~38 s standing, and two stops later
+  EXPECT_EQ(zaru, zupt);
+  EXPECT_NEAR(static_cast<double>(nhc), 271.1 * 10, 2);
+}
+
 // Each constant of a simulated drive within 2 reported σ of its truth, in
 // at least 90 % of the (seed, constant) pairs.
 TEST(StrapdownIns, BatchRecoversTheConstantsOfASimulatedDrive) {

@@ -112,7 +112,7 @@ def test_strapdown_ins_from_its_registration():
     assert isinstance(m, gssm.models.StrapdownIns) and m.name == "strapdown_ins"
     assert (m.nc, m.nb) == (10, 20) and m.rotation_blocks == [0] and m.angle_states == []
     assert m.constant_names[12] == "imu_delay" and m.constant_names[-1] == "clock_rate"
-    assert [c.name for c in m.channels] == ["gnss", "nhc", "zupt"]
+    assert [c.name for c in m.channels] == ["gnss", "nhc", "zupt", "zaru"]
     assert m.params["prior_delay_sd"] == 0.2
     assert gssm.models.from_ini(m.to_ini()).to_ini() == m.to_ini()
     x, b = m.prior_state[0], m.prior_constants[0]

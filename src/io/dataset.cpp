@@ -429,7 +429,7 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
                                   "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
                                   "truth_interpolate", "start_time", "rows", "drop_at_or_below", "out_of_order",
                                   "constants_reference", "gnss", "gnss_channel", "gnss_max_quality", "gnss_float_scale",
-                                  "gnss_outages", "gnss_still_channel", "gnss_still_speed", "zero_channels",
+                                  "gnss_outages", "gnss_still_channel", "gnss_still_speed", "gnss_still_rates", "zero_channels",
                                   "zero_rate"});
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   out.truth.reset();

@@ -39,7 +39,20 @@ bool inside(const std::vector<Outage>& outages, double t) {
 struct StillFixes {
   int channel = -1;  // none
   double speed = 0;
+  int rates_channel = -1;  // gnss_still_rates: none
 };
+
+// The mean of the inputs' first dim(channel) components over (from, to]
+// (the gyro's reading while the car stands still), as a measurement at `to`.
+void addMeanInput(const std::vector<Input>& inputs, const Model& model, int channel, double from, double to,
+                  std::vector<Measurement>& out) {
+  const int dim = model.channel(channel).dim();
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(dim);
+  int n = 0;
+  auto it = std::upper_bound(inputs.begin(), inputs.end(), from, [](double t, const Input& u) { return t < u.t; });
+  for (; it != inputs.end() && it->t <= to; ++it, ++n) sum += it->u.head(dim);
+  if (n > 0) out.emplace_back(to, sum / n, channel);
+}
 
 StillFixes stillFixes(const IniDocument& ini, const Model& model, const GnssSolution& sol) {
   StillFixes s;
@@ -48,6 +61,7 @@ StillFixes stillFixes(const IniDocument& ini, const Model& model, const GnssSolu
   s.speed = ini.getDouble("dataset", "gnss_still_speed", 0.05);
   if (!(s.speed > 0))
     throw InputError(ini.source() + ": [dataset] gnss_still_speed must be positive (m/s)");
+  if (ini.has("dataset", "gnss_still_rates")) s.rates_channel = model.channelIndex(ini.getString("dataset", "gnss_still_rates"));
   if (!sol.has_velocity)
     throw InputError(sol.source + ": no velocity columns (vn ve vu), which [dataset] gnss_still_channel needs "
                      "(RTKLIB: output the velocity, or remove the key)");
@@ -75,6 +89,7 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
   const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
   const double deg = M_PI / 180;
   std::vector<Measurement> used;
+  double previous = out.t0;
   for (const GnssFix& f : sol.fixes) {
     if (!(f.t > out.t0)) {  // before the first IMU row, or the start the INI sets
       out.dropped.push_back(sol.source + ":" + std::to_string(f.line) + ":1: time " + formatDouble(f.t) +
@@ -93,8 +108,11 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
     }
     if (f.quality != 1) m.R *= float_scale * float_scale;
     used.push_back(std::move(m));
-    if (still.channel >= 0 && f.vel_neu->norm() < still.speed)  // standing: its zero-velocity measurement too
+    if (still.channel >= 0 && f.vel_neu->norm() < still.speed) {  // standing: its zero-velocity measurement too
       used.emplace_back(f.t, Eigen::VectorXd::Zero(model.channel(still.channel).dim()), still.channel);
+      if (still.rates_channel >= 0) addMeanInput(out.inputs, model, still.rates_channel, previous, f.t, used);
+    }
+    previous = f.t;
   }
   std::vector<Measurement> merged;
   merged.reserve(out.measurements.size() + used.size());

@@ -41,7 +41,7 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
 }
 
 ModelNoise insNoise(const StrapdownIns::Params& p) {
-  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.attitude_sd, p.velocity_sd,
+  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.zaru_sd, p.attitude_sd, p.velocity_sd,
                    p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd,
                    p.gyro_scale_sd, p.accel_scale_sd, p.clock_rate_sd, p.clock_wander_sd})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
@@ -81,7 +81,8 @@ StrapdownIns::StrapdownIns(const Params& p)
       mount0_(so3::fromRollPitchYaw(p.mount_rpy)) {
   setChannels({channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay, kClockRate}),
                channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11}),
-               channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, Eigen::Vector3d::Constant(p.zupt_sd), {})});
+               channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, Eigen::Vector3d::Constant(p.zupt_sd), {}),
+               channelOf("zaru", {"zaru_x", "zaru_y", "zaru_z"}, Eigen::Vector3d::Constant(p.zaru_sd), {0, 1, 2})});
   setRotationBlocks({0});
 }
 
@@ -143,6 +144,7 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
   this->channel(channel);  // range check: throws, naming the channels
   if (channel == kGnss) return antenna(xc, xb, J_h_xc, J_h_xb);
   if (channel == kNhc) return vehicleVelocity(xc, xb, J_h_xc, J_h_xb);
+  if (channel == kZaru) return restingGyro(xc, xb, J_h_xc, J_h_xb);
   if (J_h_xc) {
     J_h_xc->setZero(3, kStates);
     J_h_xc->middleCols<3>(3).setIdentity();
@@ -199,6 +201,23 @@ Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const E
   return w.tail<2>();
 }
 
+// What the gyro reads while the car stands: its bias and the Earth's rate in
+// the IMU's axes (the scale factor's part of it, 1e-7 rad/s, left out):
+// y = b_g + Rᵀ·ω_ie; ∂y/∂δθ = [Rᵀ·ω_ie]×, ∂y/∂b_g = I.
+Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
+                                          Eigen::MatrixXd* J_h_xb) const {
+  const Eigen::Vector3d w = so3::Exp(xc.head<3>()).transpose() * frame_.earthRate();
+  if (J_h_xc) {
+    J_h_xc->setZero(3, kStates);
+    J_h_xc->leftCols<3>() = hat(w);
+  }
+  if (J_h_xb) {
+    J_h_xb->setZero(3, kConstants);
+    J_h_xb->middleCols<3>(kGyroBias).setIdentity();
+  }
+  return xb.segment<3>(kGyroBias) + w;
+}
+
 Eigen::MatrixXd StrapdownIns::processNoise(double dt) const { return insProcessNoise(p_, dt); }
 
 }  // namespace gssm::models
@@ -224,6 +243,7 @@ std::vector<ParamSpec> insParams() {
                      "σ of its vertical velocity (m/s; with one σ for both the constraint is blind to the mounting's "
                      "roll, which turns one into the other)")),
       learnable(real("model", "zupt_sd", "σ of the velocity while standing (m/s)")),
+      learnable(real("model", "zaru_sd", "σ of the gyro's mean reading while standing (rad/s)")),
       any("prior", "start",
           "data: the start's attitude, velocity and position from the log (roll and pitch from the specific "
           "force, yaw from the GNSS track; [dataset] inputs, input_columns, gnss, start_time), instead of "
@@ -324,7 +344,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
   for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
                             {"gnss_sd", &p.gnss_sd}, {"nhc_sd", &p.nhc_sd}, {"nhc_down_sd", &p.nhc_down_sd},
-                            {"zupt_sd", &p.zupt_sd}, {"clock_wander_sd", &p.clock_wander_sd}})
+                            {"zupt_sd", &p.zupt_sd}, {"zaru_sd", &p.zaru_sd},
+                            {"clock_wander_sd", &p.clock_wander_sd}})
     *value = in.real("model", key, *value);
   if (in.has("prior", "lever")) p.lever = in.vector("prior", "lever", 3);
   const bool from_data = in.has("prior", "start") && in.text("prior", "start") == "data";
@@ -354,7 +375,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("model", "mount_rpy", p.mount_rpy / kDeg);
   for (auto [key, value] : {std::pair{"gyro_sd", p.gyro_sd}, {"accel_sd", p.accel_sd}, {"gnss_sd", p.gnss_sd},
                             {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
-                            {"zupt_sd", p.zupt_sd}, {"clock_wander_sd", p.clock_wander_sd}})
+                            {"zupt_sd", p.zupt_sd}, {"zaru_sd", p.zaru_sd},
+                            {"clock_wander_sd", p.clock_wander_sd}})
     out.real("model", key, value);
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);
   out.vector("prior", "start_velocity", p.start_velocity);

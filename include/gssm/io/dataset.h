@@ -83,7 +83,10 @@ IniDocument readScenario(const std::string& dir, const std::string& config_overr
 ///       gnss_still_channel = NAME: a zero measurement on that channel at
 ///       every used fix whose own velocity is under gnss_still_speed, m/s,
 ///       default 0.05: a zero-velocity update where the receiver saw the
-///       vehicle stand)
+///       vehicle stand; gnss_still_rates = NAME: there too, a measurement
+///       on that channel of the inputs' mean over the interval since the
+///       previous fix, their first components, as many as it has: the
+///       gyro's reading while standing)
 ///     zero_channels = NAMES, zero_rate = HZ: a zero measurement on each of
 ///       those channels every 1/rate s after t0 (a vehicle's non-holonomic
 ///       constraint stated as a channel of the model)

@@ -27,7 +27,8 @@
 // Channels: `gnss` (the antenna's NED position at the fix's time,
 // p + R_nb·ℓ − (d + ρ·c)·v), `nhc`
 // (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z),
-// `zupt` (the velocity, zero while standing). R_vb maps the IMU's axes to
+// `zupt` (the velocity, zero while standing), `zaru` (the gyro's mean
+// reading while standing: b_g + R_nbᵀ·ω_ie). R_vb maps the IMU's axes to
 // the vehicle's (forward, right, down); R_vb0 is its nominal value.
 #include <Eigen/Core>
 
@@ -49,6 +50,7 @@ class StrapdownIns final : public Model {
     double nhc_sd = 0.1;                       ///< σ of the vehicle's sideways velocity at the IMU (m/s)
     double nhc_down_sd = 0.1;                  ///< σ of its vertical velocity (m/s)
     double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)
+    double zaru_sd = 0.005;                    ///< σ of the gyro's mean reading while standing (rad/s)
     Eigen::Vector3d start_rpy{0, 0, 0};        ///< prior mean of the IMU's attitude, roll, pitch, yaw (rad)
     Eigen::Vector3d start_velocity{0, 0, 0};   ///< prior mean of v(0) (m/s, NED)
     Eigen::Vector3d start_position{0, 0, 0};   ///< prior mean of p(0) (m, NED)
@@ -96,11 +98,13 @@ class StrapdownIns final : public Model {
   static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kGyroScale = 13,
                        kAccelScale = 16, kClockRate = 19, kConstants = 20;
   static constexpr int kClock = 9, kStates = 10;  // in x_c
-  enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2 };
+  enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2, kZaru = 3 };
 
  private:
   Eigen::VectorXd antenna(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                           Eigen::MatrixXd* J_h_xb) const;
+  Eigen::VectorXd restingGyro(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
+                              Eigen::MatrixXd* J_h_xb) const;
   Eigen::VectorXd vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                                   Eigen::MatrixXd* J_h_xb) const;
   Params p_;
