@@ -51,6 +51,31 @@ Figure trackFigure(const io::ProcessResult& r) {
   return f;
 }
 
+// One outage up close: each method's antenna error north (solid) and east
+// (dashed) at the withheld fixes, against the time since the outage began.
+Figure outageFigure(const io::ProcessResult& r, std::size_t k) {
+  const auto [from, to] = r.dataset.outages[k];
+  std::vector<Measurement> inside;
+  for (const Measurement& m : r.dataset.withheld)
+    if (m.t >= from && m.t < to) inside.push_back(m);
+  Figure f;
+  f.robust_quantile = 0.0;
+  f.title = "outage " + std::to_string(k + 1) + ": antenna error north (solid), east (dashed) (" + r.label + ")";
+  f.xlabel = "time since the outage began (s)";
+  f.ylabel = "error (m)";
+  for (std::size_t j = 0; j < r.runs.size(); ++j) {
+    const std::string label = methodInfo(r.runs[j].method).label;
+    Series north{label, {}, {}, paletteColor(j), 2, false}, east{"", {}, {}, paletteColor(j), 2, true};
+    for (const PointError& p : predictionErrorSeries(*r.model, r.runs[j], r.dataset.inputs, inside)) {
+      north.x.push_back(p.t - from), north.y.push_back(p.error[0]);
+      east.x.push_back(p.t - from), east.y.push_back(p.error[1]);
+    }
+    f.series.push_back(std::move(north));
+    f.series.push_back(std::move(east));
+  }
+  return f;
+}
+
 Figure errorFigure(const io::ProcessResult& r) {
   const double t0 = r.dataset.t0;
   Figure f;
@@ -80,8 +105,12 @@ Figure errorFigure(const io::ProcessResult& r) {
 std::vector<FigureJob> withheldFigureJobs(const io::ProcessResult& r, const std::string& dir) {
   if (r.dataset.withheld.empty() || r.runs.empty() || r.dataset.withheld.front().y.size() < 2) return {};
   const auto path = [&](const char* name) { return (std::filesystem::path(dir) / name).string(); };
-  return {{[&r] { return trackFigure(r); }, path("fig-track.png")},
-          {[&r] { return errorFigure(r); }, path("fig-horizontal-error.png")}};
+  std::vector<FigureJob> jobs{{[&r] { return trackFigure(r); }, path("fig-track.png")},
+                              {[&r] { return errorFigure(r); }, path("fig-horizontal-error.png")}};
+  for (std::size_t k = 0; k < r.dataset.outages.size(); ++k)
+    jobs.push_back({[&r, k] { return outageFigure(r, k); },
+                    path(("fig-outage-" + std::to_string(k + 1) + ".png").c_str())});
+  return jobs;
 }
 
 }  // namespace gssm::plot

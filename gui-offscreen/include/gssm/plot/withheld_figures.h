@@ -11,8 +11,9 @@
 
 namespace gssm::plot {
 
-/// fig-track.png and fig-horizontal-error.png, to draw; none when the
-/// dataset withholds nothing. `r` must outlive them.
+/// fig-track.png, fig-horizontal-error.png and fig-outage-<k>.png (each
+/// outage up close), to draw; none when the dataset withholds nothing. `r`
+/// must outlive them.
 std::vector<FigureJob> withheldFigureJobs(const io::ProcessResult& r, const std::string& dir);
 
 }  // namespace gssm::plot
