@@ -8,14 +8,6 @@
 namespace gssm::plot {
 
 namespace {
-// The measurements of the withheld ones' channel that the estimators used.
-std::vector<Measurement> usedOnChannel(const io::Dataset& d) {
-  std::vector<Measurement> used;
-  for (const Measurement& m : d.measurements)
-    if (m.channel == d.withheld.front().channel) used.push_back(m);
-  return used;
-}
-
 // Fixes as east/north markers: a short cross each.
 Series markers(const std::string& label, const std::vector<Measurement>& ms, Color c, double h) {
   Series s{label, {}, {}, c, 1, false};
@@ -36,7 +28,7 @@ Figure trackFigure(const io::ProcessResult& r) {
   f.title = "antenna track, outages withheld (" + r.label + ")";
   f.xlabel = "east (m)";
   f.ylabel = "north (m)";
-  f.series.push_back(markers("fixes used", usedOnChannel(r.dataset), Color{170, 170, 170}, 0.6));
+  f.series.push_back(markers("fixes used", io::usedOnWithheldChannel(r.dataset), Color{170, 170, 170}, 0.6));
   Series truth = markers("fixes withheld (truth)", r.dataset.withheld, Color{0, 0, 0}, 0.6);
   truth.width = 3;
   f.series.push_back(std::move(truth));
@@ -83,7 +75,7 @@ Figure errorFigure(const io::ProcessResult& r) {
   f.xlabel = "time since the start (s)";
   f.ylabel = "horizontal error (m)";
   f.robust_quantile = 0.0;
-  std::vector<Measurement> all = usedOnChannel(r.dataset);
+  std::vector<Measurement> all = io::usedOnWithheldChannel(r.dataset);
   all.insert(all.end(), r.dataset.withheld.begin(), r.dataset.withheld.end());
   std::sort(all.begin(), all.end(), [](const Measurement& a, const Measurement& b) { return a.t < b.t; });
   double top = 0;

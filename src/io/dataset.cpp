@@ -457,6 +457,14 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
 }
 }  // namespace
 
+std::vector<Measurement> usedOnWithheldChannel(const Dataset& d) {
+  std::vector<Measurement> used;
+  if (d.withheld.empty()) return used;
+  for (const Measurement& m : d.measurements)
+    if (m.channel == d.withheld.front().channel) used.push_back(m);
+  return used;
+}
+
 void readDatasetData(const std::string& dir, const Model& model, Dataset& out, BadRows bad_rows,
                      const IniDocument* config) {
   out.dir = dir;

@@ -140,12 +140,8 @@ void compareToReference(const Model& model, const ProcessResult& r, const Offlin
 // Errors at the withheld measurements (inside a log's GNSS outages) and at
 // the used ones of their channel (outside).
 void scoreWithheld(const Model& model, const Dataset& d, const OfflineRun& run, RunMetrics& m) {
-  const int channel = d.withheld.front().channel;
-  std::vector<Measurement> used;
-  for (const Measurement& x : d.measurements)
-    if (x.channel == channel) used.push_back(x);
   m.withheld = predictionErrors(model, run, d.inputs, d.withheld);
-  m.used = predictionErrors(model, run, d.inputs, used);
+  m.used = predictionErrors(model, run, d.inputs, usedOnWithheldChannel(d));
 }
 
 // A method's run and its metrics (against the reference too, if any).

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "gssm/io/rtklib_pos.h"
+#include "gssm/models/geodesy.h"
 
 namespace gssm::io {
 
@@ -32,9 +33,10 @@ void writeTrackPos(const std::string& path, const Model& model, const OfflineRun
     GnssFix f;
     f.t = row.t;
     f.lat_deg = value[lat], f.lon_deg = value[lon], f.height = value[height];
-    // lat/lon sds back to metres north and east
-    const double m_per_deg = 6378137.0 * M_PI / 180;
-    const double sn = sd[lat] * m_per_deg, se = sd[lon] * m_per_deg * std::cos(value[lat] * M_PI / 180);
+    // lat/lon sds back to metres north and east (the point's radii of curvature)
+    const double phi = value[lat] * M_PI / 180, to_rad = M_PI / 180;
+    const double sn = sd[lat] * to_rad * (geodesy::meridianRadius(phi) + value[height]);
+    const double se = sd[lon] * to_rad * (geodesy::transverseRadius(phi) + value[height]) * std::cos(phi);
     f.cov_neu.diagonal() << sn * sn, se * se, sd[height] * sd[height];
     f.quality = std::hypot(sn, se) < 0.05 ? 1 : 2;
     if (s.has_velocity) {

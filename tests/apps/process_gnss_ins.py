@@ -12,20 +12,12 @@ import csv
 import json
 import math
 import os
-import shutil
 import subprocess
-import sys
 
-bin_dir, src, work = sys.argv[1:4]
+from app_checks import check, setup
+
+bin_dir, src, work = setup()
 data = os.path.join(src, "datasets", "gnss-ins-drive")
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
-
-
-def check(cond, what):
-    if not cond:
-        sys.exit("FAIL: " + what)
-    print("ok:", what)
 
 
 out = os.path.join(work, "drive")

@@ -54,6 +54,11 @@ enum class BadRows {
   Skip,   ///< keep every good row, record each bad one
 };
 
+/// The measurements used on the channel of `d.withheld` (the fixes outside
+/// the outages, to score and draw beside the withheld ones); none when
+/// nothing is withheld.
+std::vector<Measurement> usedOnWithheldChannel(const Dataset& d);
+
 /// Reads scenario.ini (or `config_override` when non-empty).
 IniDocument readScenario(const std::string& dir, const std::string& config_override = "");
 /// Reads a dataset of a model's shape, naming file, line and column in
