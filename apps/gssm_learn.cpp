@@ -5,7 +5,7 @@
 
 #include "cli.h"
 #include "gssm/io/learn_config.h"
-#include "gssm/plot/learn_figure.h"
+#include "plot_library.h"
 
 int main(int argc, char** argv) {
   return gssm::apps::runApp("gssm-learn", [&] {
@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     cli.option("config", "FILE", "INI file to use instead of DIR/scenario.ini ([learn] gives the options)");
     cli.option("start", "SIGMA", "every σ starts here (overrides [learn] start; 0: the [model] values)");
     cli.parse(argc, argv);
+    gssm::apps::PlotLibrary plot;  // loads while the noise is learnt
     const std::string data = cli.require("data"), out = cli.require("out");
     std::optional<gssm::NoiseLearningOptions> options;
     if (cli.given("start")) {
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
     const gssm::io::LearnResult r = gssm::io::learnDataset(data, out, cli.get("config"), options);
     std::cout << r.report.toString();
     const std::string label = r.config.getString("scenario", "name", data);
-    std::cout << "figure: " << gssm::plot::writeLearningFigure(r.report, out, label) << "\n";
+    std::cout << "figure: " << plot.functions().write_learning_figure(r.report, out, label) << "\n";
     for (const auto& f : r.files) std::cout << "gssm-learn: wrote " << f << "\n";
     return r.report.converged ? 0 : 4;
   });

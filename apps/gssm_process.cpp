@@ -15,7 +15,7 @@
 #include "cli.h"
 #include "gssm/io/config.h"
 #include "gssm/io/process.h"
-#include "gssm/plot/run_figures.h"
+#include "plot_library.h"
 
 namespace {
 
@@ -100,12 +100,13 @@ int main(int argc, char** argv) {
     cli.flag("skip-bad-rows", "skip malformed measurement rows (listed in metrics.json) instead of stopping at the first");
     cli.option("threads", "N", "methods run at the same time (default: one per core; 1: one after another)");
     cli.parse(argc, argv);
+    gssm::apps::PlotLibrary plot;  // loads while the dataset is read and run
     const gssm::io::ProcessOptions options = processOptions(cli);
     const gssm::io::ProcessResult r = gssm::io::processDataset(options, consoleCallbacks());
     if (r.status.late_rows > 0)
       std::cout << "gssm-process: " << r.status.late_rows << " measurement rows came after later ones (up to "
                 << r.status.max_lateness << " s late): processed in time order\n";
-    for (const auto& p : gssm::plot::writeProcessFigures(r, options.out_dir, static_cast<int>(options.threads)))
+    for (const auto& p : plot.functions().write_process_figures(r, options.out_dir, static_cast<int>(options.threads)))
       std::cout << "figure: " << p << "\n";
     std::cout << "gssm-process: wrote " << options.out_dir << "/metrics.json and estimates-*.csv\n";
     if (r.status.partial) {

@@ -1,6 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+
 #include "gssm/analysis/bounds.h"
+#include "gssm/analysis/metrics.h"
 #include "gssm/core/error.h"
 #include "gssm/models/linear.h"
 #include "reference_kalman.h"
@@ -63,4 +67,25 @@ TEST(Identifiability, ConstantsEnteringOnlyAsTheirSumAreReported) {
   const auto id2 = constantsIdentifiability(observable, b2.smoothing.back().bottomRightCorner(2, 2));
   EXPECT_EQ(id2.rank, 2);
   EXPECT_TRUE(id2.determined());
+}
+
+// The latency percentiles by selection equal the sorted sample's linear
+// interpolation between order statistics, for any size and p, with ties.
+TEST(Percentile, EqualsInterpolationInTheSortedSample) {
+  std::mt19937 rng(7);
+  for (std::size_t n : {1u, 2u, 3u, 10u, 101u, 1000u}) {
+    std::vector<double> v(n);
+    std::uniform_int_distribution<int> value(0, 20);  // ties
+    for (double& x : v) x = value(rng) * 0.5;
+    std::vector<double> sorted = v;
+    std::sort(sorted.begin(), sorted.end());
+    for (double p : {0.0, 1.0, 37.5, 50.0, 99.0, 100.0}) {
+      const double pos = p / 100.0 * static_cast<double>(n - 1);
+      const auto lo = static_cast<std::size_t>(pos);
+      const auto hi = std::min(lo + 1, n - 1);
+      const double expected = sorted[lo] + (pos - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
+      EXPECT_DOUBLE_EQ(gssm::percentile(v, p), expected) << "n = " << n << ", p = " << p;
+    }
+  }
+  EXPECT_EQ(gssm::percentile({}, 50), 0.0);
 }

@@ -29,6 +29,8 @@ RunErrors runErrors(const OfflineRun& run, const Truth& truth, const std::vector
   for (Eigen::Index i = 0; i < n; ++i)
     if (std::find(angles.begin(), angles.end(), out.components[static_cast<std::size_t>(i)]) != angles.end())
       wrapped.push_back(static_cast<int>(i));
+  Eigen::MatrixXd P(n, n);  // one buffer for every row's covariance and its factor
+  Eigen::LDLT<Eigen::MatrixXd> factor(n);
   for (const auto& row : run.rows) {
     const auto j = match.find(row.t);
     if (!j && !truth.covers_every_row) {
@@ -42,7 +44,6 @@ RunErrors runErrors(const OfflineRun& run, const Truth& truth, const std::vector
       throw InvalidArgument(os.str());
     }
     Eigen::VectorXd e(n);
-    Eigen::MatrixXd P(n, n);
     for (Eigen::Index a = 0; a < n; ++a) {
       const int ia = out.components[static_cast<std::size_t>(a)];
       e[a] = row.mean[ia] - truth.states[*j][a];
@@ -50,7 +51,7 @@ RunErrors runErrors(const OfflineRun& run, const Truth& truth, const std::vector
     }
     wrapAngles(e, wrapped);
     out.times.push_back(row.t);
-    out.nees.push_back(e.dot(P.ldlt().solve(e)));
+    out.nees.push_back(e.dot(factor.compute(P).solve(e)));
     out.error.push_back(e);
   }
   return out;
