@@ -80,5 +80,31 @@ TEST(LearnConfig, BadLearnKeysAreNamedByFileAndLine) {
   }
 }
 
+// [learn] likelihood_channels names channels: the learnt noise is the one
+// whose counted likelihood is highest (here the only channel, "y": the same
+// as counting all), and a name that is no channel is refused with the
+// model's channels and the file and line.
+TEST(LearnConfig, LikelihoodChannelsAreChannelNames) {
+  const auto model = makeModel(IniDocument::parse(kScenario, "cv.ini"));
+  Dataset d;
+  d.measurements = simulate(*model, SimulationSpec{}, testing::normalSampler(4)).measurements;
+  const auto out = std::filesystem::temp_directory_path() / "gssm_learn_channels";
+  const LearnResult all = learnAndWrite(*model, IniDocument::parse(kScenario, "cv.ini"), d, out.string(),
+                                        learnSettings(IniDocument::parse(kScenario, "cv.ini")).options);
+  std::string text = std::string(kScenario) + "likelihood_channels = y\n";
+  const IniDocument named = IniDocument::parse(text, "named.ini");
+  const LearnResult only_y = learnAndWrite(*model, named, d, out.string(), learnSettings(named).options);
+  EXPECT_EQ(only_y.report.final_log_likelihood, all.report.final_log_likelihood);
+  text = std::string(kScenario) + "likelihood_channels = y gnss\n";
+  const IniDocument bad = IniDocument::parse(text, "bad.ini");
+  try {
+    learnAndWrite(*model, bad, d, out.string(), learnSettings(bad).options);
+    FAIL() << "an unknown channel must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.ini:17: [learn] likelihood_channels"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'gnss' is not a channel of linear (y)"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace gssm::io

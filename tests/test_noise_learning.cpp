@@ -88,6 +88,30 @@ TEST(NoiseLearning, PredictionErrorLikelihoodIsTheKalmanFiltersOnALinearModel) {
   }
 }
 
+// Counting only some channels' innovations (likelihood_channels) gives the
+// likelihood of those given the rest: with the other channel carrying no
+// information (R = 1e12), the textbook filter's on channel 0's data alone.
+TEST(NoiseLearning, LikelihoodOfTheCountedChannelsGivenTheRest) {
+  const SimulatedRun run = simulateRun(cvWithBias(0.04, 0.01, 1.0), 200, 9);
+  models::LinearSystem sys = testing::trackWithBias(0.04, 0.01, 1.0, 1.0, 0.5, 1.0);
+  sys.channels.push_back({"aux", Eigen::RowVector2d(1, 0), Eigen::MatrixXd::Ones(1, 1), Eigen::MatrixXd::Constant(1, 1, 1e12), {}});
+  const models::LinearModel two(sys);
+  std::vector<Measurement> both;
+  for (const auto& m : run.measurements) {
+    both.push_back(m);
+    both.push_back({m.t, Eigen::VectorXd::Constant(1, 5.0), 1});  // after channel 0's at the same time
+  }
+  const auto s = testing::stack(cvWithBias(0.04, 0.01, 1.0), 1.0);
+  const double ref = kalmanLogLikelihood(s, testing::kalmanAndRts(s, run.measurements), run.measurements);
+  ExtendedKalmanFilterOptions counted;
+  counted.likelihood_channels = {0};
+  EXPECT_NEAR(predictionErrorLogLikelihood(two, both, {}, 0.0, counted), ref, 1e-8 * std::abs(ref));
+  // Every channel counted: the aux terms, each about −½ log(2π·1e12).
+  EXPECT_LT(predictionErrorLogLikelihood(two, both, {}, 0.0), ref - 100 * 14);
+  counted.likelihood_channels = {2};
+  EXPECT_THROW(predictionErrorLogLikelihood(two, both, {}, 0.0, counted), InvalidArgument);
+}
+
 TEST(NoiseLearning, EqualsShumwayStofferEmOnALinearModel) {
   const SimulatedRun run = simulateRun(cvWithBias(0.04, 0.01, 1.0), 400, 11);
   const EmResult em = shumwayStofferEm(run.measurements, Eigen::Vector2d(1, 1), 1.0);

@@ -15,8 +15,9 @@ namespace gssm::io {
 namespace fs = std::filesystem;
 
 std::vector<std::string> learnIniKeys() {
-  return {"enabled",   "parameters",   "start",        "search_range",   "outliers",
-          "max_evaluations", "tolerance", "max_restarts", "standard_errors", "prior_iterations", "prior_tolerance"};
+  return {"enabled",         "parameters", "start",        "search_range",    "outliers",         "max_evaluations",
+          "tolerance",       "max_restarts", "standard_errors", "prior_iterations", "prior_tolerance",
+          "likelihood_channels"};
 }
 
 LearnSettings learnSettings(const IniDocument& ini) {
@@ -146,8 +147,31 @@ std::string learnReportJson(const NoiseLearningReport& r, const std::string& dat
   return os.str();
 }
 
+namespace {
+// [learn] likelihood_channels: the channels, by name, whose innovations the
+// likelihood counts (the others condition it: a vehicle's constraint
+// pseudo-measurements); none given: every channel, or what the options say.
+void readLikelihoodChannels(const IniDocument& input, const Model& model, NoiseLearningOptions& o) {
+  std::istringstream words(input.getString("learn", "likelihood_channels", ""));
+  for (std::string name; words >> name;) {
+    int found = -1;
+    for (int c = 0; c < model.numChannels(); ++c)
+      if (model.channel(c).name == name) found = c;
+    if (found < 0) {
+      std::string names;
+      for (int c = 0; c < model.numChannels(); ++c) names += (c ? ", " : "") + model.channel(c).name;
+      throw InputError(input.where("learn", "likelihood_channels") + ": '" + name + "' is not a channel of " +
+                       model.name() + " (" + names + ")");
+    }
+    o.ekf.likelihood_channels.push_back(found);
+  }
+}
+}  // namespace
+
 LearnResult learnAndWrite(const Model& model, const IniDocument& input, const Dataset& dataset,
-                          const std::string& out_dir, const NoiseLearningOptions& options) {
+                          const std::string& out_dir, const NoiseLearningOptions& given) {
+  NoiseLearningOptions options = given;
+  if (options.ekf.likelihood_channels.empty()) readLikelihoodChannels(input, model, options);
   std::error_code ec;
   if (!dataset.dir.empty() && fs::exists(out_dir) && fs::equivalent(out_dir, dataset.dir, ec))
     throw InvalidArgument("the output folder " + out_dir +

@@ -44,6 +44,13 @@ ExtendedKalmanFilter::ExtendedKalmanFilter(const Model& model, ExtendedKalmanFil
   if (!options_.validate(d.nb, &why)) throw InvalidArgument(why);
   if (options_.constant_process_noise.size() == 0)
     options_.constant_process_noise = Eigen::VectorXd::Zero(d.nb);
+  if (!options_.likelihood_channels.empty()) counted_.assign(static_cast<std::size_t>(model.numChannels()), 0);
+  for (int c : options_.likelihood_channels) {
+    if (c < 0 || c >= model.numChannels())
+      throw InvalidArgument("ExtendedKalmanFilter: likelihood channel " + std::to_string(c) + " is not one of the " +
+                            std::to_string(model.numChannels()) + " channels of " + model.name());
+    counted_[static_cast<std::size_t>(c)] = 1;
+  }
   z_.resize(d.nc + d.nb);
   z_ << model.priorState().mean, model.priorConstants().mean;
   P_ = Eigen::MatrixXd::Zero(d.nc + d.nb, d.nc + d.nb);
@@ -135,7 +142,7 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   const auto [log_p, w] = mixture(log_normal, options_.outlier_probability, outlierLogDensity(m.channel));
   commitUpdate(w);
   nis_ = nis;
-  log_likelihood_ += log_p;
+  if (counted_.empty() || counted_[static_cast<std::size_t>(m.channel)]) log_likelihood_ += log_p;
   return true;
 }
 

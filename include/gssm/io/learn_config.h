@@ -45,7 +45,9 @@ struct LearnResult {
 
 /// Learns the noise of `model` (read from `input` over `dataset`) and writes
 /// out_dir/scenario.ini and out_dir/learn.json with `options`
-/// (the [learn] options, or the caller's). Refuses an out_dir that is the dataset's
+/// (the [learn] options, or the caller's; [learn] likelihood_channels, the
+/// channels the likelihood counts by name, unless the options name them).
+/// Refuses an out_dir that is the dataset's
 /// folder (its scenario.ini would be overwritten).
 LearnResult learnAndWrite(const Model& model, const IniDocument& input, const Dataset& dataset,
                           const std::string& out_dir, const NoiseLearningOptions& options);

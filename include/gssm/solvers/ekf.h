@@ -36,6 +36,12 @@ struct ExtendedKalmanFilterOptions {
   /// log-likelihood counts the mixture. 0: plain Gaussian.
   double outlier_probability = 0;
   std::vector<double> outlier_log_density;
+  /// The channels whose innovations the log-likelihood counts (not an INI
+  /// key; noise learning's [learn] likelihood_channels); empty: every
+  /// channel. The others still update the estimate: the likelihood is then
+  /// that of the counted channels given the rest (e.g. GNSS fixes given the
+  /// vehicle constraints' pseudo-measurements).
+  std::vector<int> likelihood_channels;
   bool validate(int nb, std::string* why = nullptr) const;
 };
 
@@ -100,6 +106,7 @@ class ExtendedKalmanFilter {
   Eigen::MatrixXd P_;
   double nis_ = 0.0;
   double log_likelihood_ = 0.0;
+  std::vector<char> counted_;  // per channel, from likelihood_channels (empty: all)
   std::int64_t rejected_ = 0;
   UpdateBuffers u_;
 };
