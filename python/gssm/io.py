@@ -8,4 +8,5 @@ from_arrays = _gssm.io.from_arrays
 scenarios = _gssm.io.scenarios
 scenario_ini = _gssm.io.scenario_ini
 ini_option_keys = _gssm.io.ini_option_keys
-__all__ = ["Dataset", "read_dataset", "write_dataset", "from_arrays", "scenarios", "scenario_ini", "ini_option_keys"]
+ini_reference = _gssm.io.ini_reference
+__all__ = ["Dataset", "read_dataset", "write_dataset", "from_arrays", "scenarios", "scenario_ini", "ini_option_keys", "ini_reference"]

@@ -73,11 +73,11 @@ struct OptionGetter {
   const std::string& key;
   py::object value;
   template <class T>
-  void operator()(const char* k, T& v) {
+  void operator()(const char* k, T& v, const char*) {
     if (key == k) value = py::cast(v);
   }
   template <class E>
-  void operator()(const char* k, Choice<E>& c) {
+  void operator()(const char* k, Choice<E>& c, const char*) {
     if (key == k) value = py::str(c.name(c.value));
   }
 };
@@ -86,7 +86,7 @@ struct OptionSetter {
   const std::string& key;
   const py::object& value;
   template <class T>
-  void operator()(const char* k, T& v) {
+  void operator()(const char* k, T& v, const char*) {
     if (key != k) return;
     try {
       v = value.cast<T>();
@@ -95,7 +95,7 @@ struct OptionSetter {
     }
   }
   template <class E>
-  void operator()(const char* k, Choice<E>& c) {
+  void operator()(const char* k, Choice<E>& c, const char*) {
     if (key != k) return;
     const auto named = c.named(py::str(value).cast<std::string>());
     if (!named) throw InvalidArgument("option '" + key + "' = " + py::repr(value).cast<std::string>() + ": expected " + c.expected);

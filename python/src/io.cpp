@@ -7,6 +7,7 @@
 #include "bindings.h"
 #include "gssm/core/error.h"
 #include "gssm/io/config.h"
+#include "gssm/io/ini_keys.h"
 #include "gssm/io/ini.h"
 #include "gssm/model/registry.h"
 #include "gssm/model/simulation.h"
@@ -241,6 +242,8 @@ void bindDatasetFiles(py::module_& io) {
 
   io.def("ini_option_keys", &io::estimatorIniKeys,
          "[(section, [keys])] of every estimator section of a scenario.ini, as the INI reader takes them");
+  io.def("ini_reference", &io::iniReferenceMarkdown,
+         "The INI reference (Markdown): every section and key the readers accept, with type, default and meaning");
 }
 
 void bindSimulation(py::module_& io) {

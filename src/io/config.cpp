@@ -21,19 +21,19 @@ std::string sectionOf(Method m) { return methodInfo(m).ini_section; }
 class IniOptionReader {
  public:
   IniOptionReader(const IniDocument& ini, std::string section) : ini_(ini), section_(std::move(section)) {}
-  void operator()(const char* key, bool& v) const { v = ini_.getBool(section_, key, v); }
-  void operator()(const char* key, double& v) const { v = ini_.getDouble(section_, key, v); }
-  void operator()(const char* key, Eigen::VectorXd& v) const {
+  void operator()(const char* key, bool& v, const char* /*doc*/) const { v = ini_.getBool(section_, key, v); }
+  void operator()(const char* key, double& v, const char* /*doc*/) const { v = ini_.getDouble(section_, key, v); }
+  void operator()(const char* key, Eigen::VectorXd& v, const char* /*doc*/) const {
     if (ini_.has(section_, key)) v = ini_.getVector(section_, key);
   }
-  void operator()(const char* key, int& v) const {
+  void operator()(const char* key, int& v, const char* /*doc*/) const {
     const long long n = ini_.getInt(section_, key, v);
     if (n < std::numeric_limits<int>::min() || n > std::numeric_limits<int>::max())
       throw InputError(ini_.where(section_, key) + " = " + std::to_string(n) + ": out of range");
     v = static_cast<int>(n);
   }
   template <class E>
-  void operator()(const char* key, Choice<E>& c) const {
+  void operator()(const char* key, Choice<E>& c, const char* /*doc*/) const {
     const std::string text = ini_.getString(section_, key, c.name(c.value));
     const auto named = c.named(text);
     if (!named) throw InputError(ini_.where(section_, key) + " = '" + text + "': expected " + c.expected);
@@ -49,16 +49,16 @@ class IniOptionReader {
 class IniOptionWriter {
  public:
   IniOptionWriter(IniDocument& ini, std::string section) : ini_(ini), section_(std::move(section)) {}
-  void operator()(const char* key, bool& v) { ini_.set(section_, key, v ? "true" : "false"); }
-  void operator()(const char* key, int& v) { ini_.set(section_, key, std::to_string(v)); }
-  void operator()(const char* key, double& v) {
+  void operator()(const char* key, bool& v, const char* /*doc*/) { ini_.set(section_, key, v ? "true" : "false"); }
+  void operator()(const char* key, int& v, const char* /*doc*/) { ini_.set(section_, key, std::to_string(v)); }
+  void operator()(const char* key, double& v, const char* /*doc*/) {
     if (std::isfinite(v)) ini_.set(section_, key, v);  // ∞ (a wildfire threshold: none) is the default; not written
   }
-  void operator()(const char* key, Eigen::VectorXd& v) {
+  void operator()(const char* key, Eigen::VectorXd& v, const char* /*doc*/) {
     if (v.size() > 0) ini_.set(section_, key, Eigen::MatrixXd(v.transpose()));
   }
   template <class E>
-  void operator()(const char* key, Choice<E>& c) { ini_.set(section_, key, c.name(c.value)); }
+  void operator()(const char* key, Choice<E>& c, const char* /*doc*/) { ini_.set(section_, key, c.name(c.value)); }
 
  private:
   IniDocument& ini_;
@@ -161,7 +161,41 @@ std::vector<std::pair<std::string, std::vector<std::string>>> estimatorIniKeys()
           {sectionOf(Method::Batch), optionKeyNames<BatchSolverOptions>()}};
 }
 
+std::vector<IniKey> scenarioIniKeys() {
+  return {{"name", "word", "(the folder's name)", "the run's name, in figures and reports"},
+          {"methods", "words", "(all)", "the methods gssm-process runs when --method is all"},
+          {"seed", "integer", "1", "the random seed gssm-simulate drew the data with (a record)"},
+          {"steps", "integer", "", "simulated steps (gssm-simulate, gssm-montecarlo)"},
+          {"measure_every", "integer", "1", "a simulated measurement every this many steps"},
+          {"channels", "word", "default", "simulated measurements on the default channel, or cycle (every channel in turn)"}};
+}
+
+std::vector<IniKey> truthIniKeys() {
+  return {{"state0", "numbers", "(the prior's mean)", "the simulated x_c at t0"},
+          {"constants", "numbers", "(the prior's mean)", "the simulated x_b"},
+          {"process_noise", "flag", "true", "draw process noise"},
+          {"measurement_noise", "flag", "true", "draw measurement noise"},
+          {"input", "numbers", "", "a constant input (odometry speed and turn rate)"},
+          {"input_amplitude", "number", "", "an input a·(cos ωt, sin ωt) (a turning vehicle's acceleration)"},
+          {"input_omega", "number", "", "its ω (rad/s)"},
+          {"input_includes_bias", "flag", "true", "the input measured with the first n_u constants as its bias"}};
+}
+
+namespace {
+std::vector<std::string> namesOf(const std::vector<IniKey>& keys) {
+  std::vector<std::string> out;
+  for (const auto& k : keys) out.push_back(k.key);
+  return out;
+}
+}  // namespace
+
+void requireScenarioKeys(const IniDocument& ini) {
+  ini.requireOnlyKeys("scenario", namesOf(scenarioIniKeys()));
+  ini.requireOnlyKeys("truth", namesOf(truthIniKeys()));
+}
+
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {
+  requireScenarioKeys(ini);
   SimulationSpec s;
   s.steps = static_cast<int>(ini.getInt("scenario", "steps"));
   if (s.steps < 1) throw InputError(ini.source() + ": [scenario] steps must be >= 1");

@@ -8,6 +8,7 @@
 
 #include "gssm/core/angles.h"
 #include "gssm/core/error.h"
+#include "gssm/io/config.h"
 #include "gssm/core/time.h"
 #include "gssm/io/csv.h"
 #include "io/gnss_measurements.h"
@@ -41,10 +42,42 @@ void checkTable(const CsvTable& t, const std::vector<std::string>& names) {
 }
 }  // namespace
 
+std::vector<IniKey> datasetIniKeys() {
+  return {
+      {"inputs", "file", "", "the inputs' CSV (odometry, IMU): a column t and the input columns"},
+      {"input_columns", "words", "", "the inputs' columns, in the model's input order"},
+      {"input_kind", "word", "rates", "rates (held over each interval) or increments (summed over it)"},
+      {"measurements", "file", "measurements.csv", "the measurements' CSV: a column t and the measurement columns"},
+      {"measurement_columns", "words", "", "the columns of one measurement, in the channel's component order"},
+      {"channel_column", "words", "", "the column(s) naming each row's channel: beacon → <prefix><value>; tag anchor → <prefix><tag>_<anchor>"},
+      {"channel_prefix", "word", "", "put before the channel column's value to make a channel name"},
+      {"channel_by", "word", "name", "the channel column holds the channel's name or its index"},
+      {"truth", "file", "", "the truth's CSV: never given to an estimator, only compared with"},
+      {"truth_columns", "words", "", "the states the truth gives: px, px=x (another column), yaw=yaw(qw,qx,qy,qz)"},
+      {"truth_interpolate", "flag", "false", "the truth linearly interpolated to each estimate time (angles wrapped)"},
+      {"start_time", "number or word", "0", "t0: a number, truth (its first time), first (a step before the first measurement), first_input"},
+      {"rows", "word", "measurements", "estimate rows at measurements, inputs, epochs (distinct measurement times) or states"},
+      {"drop_at_or_below", "number", "-inf", "values at or below this are dropped as non-physical, listed in metrics.json"},
+      {"out_of_order", "word", "sort", "rows going back in time: sort (read in time order, counted) or error"},
+      {"constants_reference", "file", "", "a calibration of the constants to compare with (never used by an estimator)"},
+      {"gnss", "file", "", "an RTKLIB .pos solution file (latitude/longitude/height), its fixes a channel"},
+      {"gnss_channel", "word", "gnss", "the channel of the GNSS fixes"},
+      {"gnss_max_quality", "integer", "1", "fixes of RTKLIB quality above this are dropped (1 fixed, 2 float, 5 single)"},
+      {"gnss_float_scale", "number", "3", "σ factor of the fixes kept above quality 1"},
+      {"gnss_outages", "file", "", "a CSV of start,end times: the fixes inside are withheld and scored (metrics.json withheld)"},
+      {"gnss_still_channel", "word", "", "a zero-velocity measurement on this channel at every fix slower than gnss_still_speed"},
+      {"gnss_still_speed", "number", "0.05", "a fix's own speed (m/s) below which the vehicle is standing"},
+      {"gnss_still_rates", "word", "", "while standing, the mean of the inputs' first components since the previous fix on this channel"},
+      {"zero_channels", "words", "", "channels measured as zero at zero_rate (vehicle constraints)"},
+      {"zero_rate", "number", "0", "rate (Hz) of the zero_channels' pseudo-measurements"}};
+}
+
 IniDocument readScenario(const std::string& dir, const std::string& config_override) {
   const std::string path = config_override.empty() ? (fs::path(dir) / "scenario.ini").string()
                                                    : config_override;
-  return IniDocument::load(path);
+  IniDocument ini = IniDocument::load(path);
+  requireScenarioKeys(ini);
+  return ini;
 }
 
 namespace {
@@ -425,12 +458,9 @@ void addZeroMeasurements(const IniDocument& ini, const Model& model, Dataset& ou
 
 // One CSV per sensor stream, as the config's [dataset] describes.
 void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
-  ini.requireOnlyKeys("dataset", {"inputs", "input_columns", "input_kind", "measurements", "measurement_columns",
-                                  "channel_column", "channel_prefix", "channel_by", "truth", "truth_columns",
-                                  "truth_interpolate", "start_time", "rows", "drop_at_or_below", "out_of_order",
-                                  "constants_reference", "gnss", "gnss_channel", "gnss_max_quality", "gnss_float_scale",
-                                  "gnss_outages", "gnss_still_channel", "gnss_still_speed", "gnss_still_rates", "zero_channels",
-                                  "zero_rate"});
+  std::vector<std::string> keys;
+  for (const IniKey& k : datasetIniKeys()) keys.push_back(k.key);
+  ini.requireOnlyKeys("dataset", keys);
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   out.truth.reset();
   if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0

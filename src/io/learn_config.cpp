@@ -14,10 +14,29 @@ namespace gssm::io {
 
 namespace fs = std::filesystem;
 
+std::vector<IniKey> learnIniKeyDocs() {
+  const NoiseLearningOptions o;
+  const auto number = [](double v) { return formatDouble(v); };
+  return {
+      {"enabled", "flag", "false", "learn before the run (gssm-process; gssm-learn always does)"},
+      {"parameters", "words", "(all)", "the learnable parameters to learn, by key (see each model's keys)"},
+      {"start", "number", number(o.start), "every learnt σ starts here (0: the model's values)"},
+      {"search_range", "number", number(o.search_range), "each σ is searched within this factor of its start"},
+      {"outliers", "flag", "false", "then learn again with each measurement an outlier with a learnt probability"},
+      {"max_evaluations", "integer", std::to_string(o.max_evaluations), "likelihood evaluations (EKF passes) in all"},
+      {"tolerance", "number", number(o.tolerance), "converged when a restart gains less than this, relative"},
+      {"max_restarts", "integer", std::to_string(o.max_restarts), "Nelder–Mead restarts from the best point"},
+      {"standard_errors", "flag", "true", "standard errors from the likelihood's curvature (2p² more passes)"},
+      {"prior_iterations", "integer", std::to_string(o.prior_iterations), "EM E-steps for the constants' prior σs"},
+      {"prior_tolerance", "number", number(o.prior_tolerance), "EM converged when no σ changes by more than this, relative"},
+      {"likelihood_channels", "words", "(all)",
+       "the channels whose innovations the likelihood counts; the others condition it"}};
+}
+
 std::vector<std::string> learnIniKeys() {
-  return {"enabled",         "parameters", "start",        "search_range",    "outliers",         "max_evaluations",
-          "tolerance",       "max_restarts", "standard_errors", "prior_iterations", "prior_tolerance",
-          "likelihood_channels"};
+  std::vector<std::string> out;
+  for (const auto& k : learnIniKeyDocs()) out.push_back(k.key);
+  return out;
 }
 
 LearnSettings learnSettings(const IniDocument& ini) {

@@ -236,7 +236,8 @@ const ModelRegistration registration{{
     "`discretization`), y = C_c x_c + C_b x_b; channels: further sensors.",
     linearParams(), readLinear,
     [](const Model& m, ParamSink& out) { writeLinear(dynamic_cast<const LinearModel&>(m), out); },
-    [](const Model& m) { return dynamic_cast<const LinearModel*>(&m) != nullptr; }}};
+    [](const Model& m) { return dynamic_cast<const LinearModel*>(&m) != nullptr; },
+    {}}};
 }  // namespace
 
 }  // namespace gssm::models

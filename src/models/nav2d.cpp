@@ -123,7 +123,8 @@ const ModelRegistration registration{{
       out.real("model", "accel_noise", nav.accelNoise());
       writeNoise(m, out, {false, true});
     },
-    [](const Model& m) { return dynamic_cast<const Nav2D*>(&m) != nullptr; }}};
+    [](const Model& m) { return dynamic_cast<const Nav2D*>(&m) != nullptr; },
+    {}}};
 }  // namespace
 
 }  // namespace gssm::models

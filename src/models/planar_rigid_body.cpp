@@ -312,7 +312,8 @@ const ModelRegistration registration{{
     bodyParams(),
     [](const ParamSource& in) -> std::unique_ptr<Model> { return std::make_unique<PlanarRigidBody>(readBody(in)); },
     [](const Model& m, ParamSink& out) { writeBody(dynamic_cast<const PlanarRigidBody&>(m).params(), out); },
-    [](const Model& m) { return dynamic_cast<const PlanarRigidBody*>(&m) != nullptr; }}};
+    [](const Model& m) { return dynamic_cast<const PlanarRigidBody*>(&m) != nullptr; },
+    [](ParamSink& out) { writeBody(PlanarRigidBody::Params{}, out); }}};
 }  // namespace
 
 }  // namespace gssm::models

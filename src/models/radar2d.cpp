@@ -68,7 +68,8 @@ const ModelRegistration registration{{
       return std::make_unique<Radar2D>(readNoise(in, paper.dims(), paper.noise()));
     },
     [](const Model& m, ParamSink& out) { writeNoise(m, out); },
-    [](const Model& m) { return dynamic_cast<const Radar2D*>(&m) != nullptr; }}};
+    [](const Model& m) { return dynamic_cast<const Radar2D*>(&m) != nullptr; },
+    [](ParamSink& out) { writeNoise(Radar2D(), out); }}};
 }  // namespace
 
 }  // namespace gssm::models

@@ -240,7 +240,8 @@ const ModelRegistration registration{{
     rangeBeaconParams(),
     [](const ParamSource& in) -> std::unique_ptr<Model> { return std::make_unique<RangeBeacon2D>(readRangeBeacon(in)); },
     [](const Model& m, ParamSink& out) { writeRangeBeacon(dynamic_cast<const RangeBeacon2D&>(m).params(), out); },
-    [](const Model& m) { return dynamic_cast<const RangeBeacon2D*>(&m) != nullptr; }}};
+    [](const Model& m) { return dynamic_cast<const RangeBeacon2D*>(&m) != nullptr; },
+    [](ParamSink& out) { writeRangeBeacon(RangeBeacon2D::Params{}, out); }}};
 }  // namespace
 
 }  // namespace gssm::models

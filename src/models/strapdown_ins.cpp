@@ -397,7 +397,8 @@ const ModelRegistration registration{{
     insParams(),
     [](const ParamSource& in) -> std::unique_ptr<Model> { return std::make_unique<StrapdownIns>(readIns(in)); },
     [](const Model& m, ParamSink& out) { writeIns(dynamic_cast<const StrapdownIns&>(m).params(), out); },
-    [](const Model& m) { return dynamic_cast<const StrapdownIns*>(&m) != nullptr; }}};
+    [](const Model& m) { return dynamic_cast<const StrapdownIns*>(&m) != nullptr; },
+    [](ParamSink& out) { writeIns(StrapdownIns::Params{}, out); }}};
 }  // namespace
 
 }  // namespace gssm::models

@@ -56,7 +56,8 @@ const ModelRegistration registration{{
             {"prior", "start_sd", p.start_sd}, {"prior", "drift_sd", p.drift_sd}, {"prior", "offset_sd", p.offset_sd}})
         out.real(section, key, value);
     },
-    [](const Model& m) { return dynamic_cast<const Drift1D*>(&m) != nullptr; }}};
+    [](const Model& m) { return dynamic_cast<const Drift1D*>(&m) != nullptr; },
+    {}}};
 }  // namespace
 
 }  // namespace gssm::testing

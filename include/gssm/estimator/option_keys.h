@@ -5,8 +5,10 @@
 // lists, so a key exists in both or in neither, and Python's defaults are
 // the C++ structs' own.
 //
-// A visitor has   template <class T> void operator()(const char* key, T& value)
-// for T = bool, int, double, Eigen::VectorXd and Choice<E> (a named enum).
+// A visitor has   template <class T> void operator()(const char* key, T& value, const char* doc)
+// for T = bool, int, double, Eigen::VectorXd and Choice<E> (a named enum);
+// `doc` is the key's one-line meaning (the manual's INI reference, Python's
+// docstrings).
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,44 +30,45 @@ struct Choice {
 
 template <class Visitor>
 void optionKeys(Visitor& v, ExtendedKalmanFilterOptions& o) {
-  v("constant_process_noise", o.constant_process_noise);
-  v("joseph_form", o.joseph_form);
+  v("constant_process_noise", o.constant_process_noise,
+    "process noise variance per constant per nominal step (n_b numbers; empty: none): the EKF's constants as random walks");
+  v("joseph_form", o.joseph_form, "Joseph-form covariance update (the same in exact arithmetic, numerically safer)");
 }
 
 template <class Visitor>
 void optionKeys(Visitor& v, SmootherOptions& o) {
-  v("relinearize", o.relinearize);
-  v("relinearize_threshold", o.relinearize_threshold);
-  v("constants_check_sigmas", o.constants_check_sigmas);
-  v("full_pass_growth", o.full_pass_growth);
-  v("max_local_iterations", o.max_local_iterations);
-  v("wildfire_threshold", o.wildfire_threshold);
-  v("iterate_to_convergence", o.iterate_to_convergence);
-  v("convergence_tolerance", o.convergence_tolerance);
-  v("max_iterations", o.max_iterations);
-  v("newton_polish_steps", o.newton_polish_steps);
+  v("relinearize", o.relinearize, "relinearize factors whose linearization error exceeds relinearize_threshold (false: keep each as added)");
+  v("relinearize_threshold", o.relinearize_threshold, "whitened linearization error ‖r(x̂) − r_lin(x̂)‖ above which a factor is relinearized");
+  v("constants_check_sigmas", o.constants_check_sigmas, "check every factor when the constants moved more than this many marginal σ since the last check");
+  v("full_pass_growth", o.full_pass_growth, "> 1: a full relinearization pass only once the history grew by this factor since the last (1: whenever the constants moved)");
+  v("max_local_iterations", o.max_local_iterations, "relinearize-and-re-eliminate rounds on the re-eliminated top per update");
+  v("wildfire_threshold", o.wildfire_threshold, "back-substitution descends only while the change exceeds this (iSAM2's wildfire; default: never, lazy)");
+  v("iterate_to_convergence", o.iterate_to_convergence, "iterate every update to convergence over all factors (O(n): equals the batch)");
+  v("convergence_tolerance", o.convergence_tolerance, "iterate_to_convergence stops when no estimate changes by more than this, relative");
+  v("max_iterations", o.max_iterations, "iterate_to_convergence: at most this many iterations per update");
+  v("newton_polish_steps", o.newton_polish_steps, "iterate_to_convergence: full Newton steps after convergence (0: off)");
 }
 
 template <class Visitor>
 void optionKeys(Visitor& v, BatchSolverOptions& o) {
   Choice<BatchSolverOptions::Method> algorithm{o.method, &BatchSolverOptions::methodName,
                                                &BatchSolverOptions::methodNamed, "levenberg-marquardt or gauss-newton"};
-  v("algorithm", algorithm);
-  v("max_iterations", o.max_iterations);
-  v("relative_cost_tolerance", o.relative_cost_tolerance);
-  v("step_tolerance", o.step_tolerance);
-  v("gradient_tolerance", o.gradient_tolerance);
-  v("decrease_tolerance", o.decrease_tolerance);
-  v("initial_lambda", o.initial_lambda);
-  v("max_lambda", o.max_lambda);
-  v("newton_polish_steps", o.newton_polish_steps);
+  v("algorithm", algorithm, "levenberg-marquardt or gauss-newton");
+  v("max_iterations", o.max_iterations, "at most this many iterations");
+  v("relative_cost_tolerance", o.relative_cost_tolerance, "stop when an accepted step lowers the cost by less than this fraction");
+  v("step_tolerance", o.step_tolerance, "stop when ‖δ‖ ≤ tol·(‖x‖ + tol)");
+  v("gradient_tolerance", o.gradient_tolerance, "stop when max |Jᵀr| ≤ tol");
+  v("decrease_tolerance", o.decrease_tolerance, "stop when an undamped step's predicted decrease is at most this, in cost units (0: no such test)");
+  v("initial_lambda", o.initial_lambda, "Levenberg–Marquardt damping λ₀, relative to diag(JᵀJ)");
+  v("max_lambda", o.max_lambda, "largest damping before the solve gives up");
+  v("newton_polish_steps", o.newton_polish_steps, "full Newton steps after convergence, for large residuals at the optimum (0: off)");
 }
 
 /// Collects the keys (optionKeyNames).
 struct OptionKeyNames {
   std::vector<std::string> keys;
   template <class T>
-  void operator()(const char* key, T&) { keys.push_back(key); }
+  void operator()(const char* key, T&, const char*) { keys.push_back(key); }
 };
 
 /// The keys optionKeys visits for an options type, in order.

@@ -16,6 +16,7 @@
 
 #include "gssm/estimator/estimator.h"
 #include "gssm/io/ini.h"
+#include "gssm/io/ini_keys.h"
 #include "gssm/model/model.h"
 #include "gssm/analysis/montecarlo.h"
 #include "gssm/model/simulation.h"
@@ -59,6 +60,11 @@ void writeEstimatorOptions(const EstimatorOptions& options, IniDocument& ini);
 /// the Python options objects: docs/DESIGN.md §4).
 std::vector<std::pair<std::string, std::vector<std::string>>> estimatorIniKeys();
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model);
+/// [scenario]'s and [truth]'s keys, with type, default and meaning.
+std::vector<IniKey> scenarioIniKeys();
+std::vector<IniKey> truthIniKeys();
+/// Refuses a key of [scenario] or [truth] not in those tables (file and line).
+void requireScenarioKeys(const IniDocument& ini);
 
 /// A Monte Carlo scenario from INI documents, with the models it points to.
 struct LoadedScenario {

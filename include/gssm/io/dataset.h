@@ -10,6 +10,7 @@
 #include "gssm/core/data.h"
 #include "gssm/analysis/offline.h"  // RowTimes
 #include "gssm/io/ini.h"
+#include "gssm/io/ini_keys.h"
 #include "gssm/model/model.h"
 #include "gssm/model/simulation.h"
 
@@ -61,6 +62,8 @@ std::vector<Measurement> usedOnWithheldChannel(const Dataset& d);
 
 /// Reads scenario.ini (or `config_override` when non-empty).
 IniDocument readScenario(const std::string& dir, const std::string& config_override = "");
+/// [dataset]'s keys, with type, default and meaning (the reader accepts these only).
+std::vector<IniKey> datasetIniKeys();
 /// Reads a dataset of a model's shape, naming file, line and column in
 /// every error. Two layouts:
 /// * gssm's own (no [dataset] section in `config`): measurements.csv

@@ -9,6 +9,7 @@
 
 #include "gssm/io/dataset.h"
 #include "gssm/io/ini.h"
+#include "gssm/io/ini_keys.h"
 #include "gssm/learn/noise_learning.h"
 
 namespace gssm::io {
@@ -25,6 +26,8 @@ struct LearnSettings {
 /// Reads [learn]; InputError naming file:line for a bad or unknown key.
 LearnSettings learnSettings(const IniDocument& ini);
 /// The keys of [learn], in order.
+/// [learn]'s keys, with type, default and meaning (the manual's reference).
+std::vector<IniKey> learnIniKeyDocs();
 std::vector<std::string> learnIniKeys();
 
 /// The scenario as learnt: the input file's text (its comments kept) with

@@ -34,6 +34,9 @@ struct ModelType {
   std::function<void(const Model&, ParamSink&)> write;
   /// Whether `model` is of this type (a dynamic_cast in the model's own file).
   std::function<bool(const Model&)> owns;
+  /// Optional: writes the value each parameter takes when a source leaves it
+  /// out (the manual's INI reference shows them).
+  std::function<void(ParamSink&)> defaults;
 
   const ParamSpec* param(const std::string& section, const std::string& key) const;
   /// The Sections parameter whose sub-sections are "<prefix>.<name>", if any.
