@@ -39,7 +39,7 @@ void stream(gssm::Method method, int window, long steps, long every, Fn sample) 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
+  if (argc < 2 || argv[1][0] == '-') {  // an option is no folder name ("--help")
     std::cerr << "usage: gssm_latency_plots OUTDIR [HISTORY_STEPS]\n";
     return 2;
   }

@@ -15,6 +15,7 @@ GSSM_PACKAGES=(
   python3-venv python3-pip python3-setuptools python3-wheel
   clang libclang-rt-14-dev
   locales
+  doxygen python3-sphinx python3-breathe python3-sphinx-rtd-theme python3-myst-parser
 )
 
 gssm_install_deps() {

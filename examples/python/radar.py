@@ -5,14 +5,16 @@ the whole run with the loop in C++.  Run from the repository root:
 """
 import numpy as np
 
+# [quickstart]
 import gssm
-
 model = gssm.models.Radar2D()                           # the paper's settings
 data = gssm.io.read_dataset("datasets/radar-paper")     # data.t (N,), data.y (N, 1)
 est = gssm.make_estimator(model, method="fixed-lag", window=10)
 for t, y in zip(data.t, data.y):
     est.add_measurement(t, y)
-e = est.current()
+e = est.current()                                       # e.mean (n,), e.covariance (n, n): NumPy
+run = gssm.run(model, data, method="ekf")               # the loop in C++: run.t (N,), run.mean (N, n), run.sd (N, n)
+# [/quickstart]
 print("fixed-lag at t = %.2f s: %s ± %s" % (e.t, np.round(e.mean, 2), np.round(e.sd, 2)))
 truth = data.truth_x[-1]
 for method in ("ekf", "batch"):

@@ -4,14 +4,18 @@ The C++ library at C++ speed: constants kept as one node for the whole run,
 an incremental (Bayes tree) smoother, an exact fixed-lag smoother, the EKF
 baseline and the batch MAP, on the same model object.
 
-    import gssm
-    model = gssm.models.Radar2D()
-    data = gssm.io.read_dataset("datasets/radar-paper")
-    est = gssm.make_estimator(model, method="fixed-lag", window=10)
-    for t, y in zip(data.t, data.y):
-        est.add_measurement(t, y)
-    e = est.current()                      # e.mean, e.covariance: NumPy
-    run = gssm.run(model, data, method="ekf")   # run.t, run.mean, run.sd
+Run from the repository root (the tests run this example as a doctest)::
+
+    >>> import gssm
+    >>> model = gssm.models.Radar2D()
+    >>> data = gssm.io.read_dataset("datasets/radar-paper")
+    >>> est = gssm.make_estimator(model, method="fixed-lag", window=10)
+    >>> for t, y in zip(data.t, data.y):
+    ...     _ = est.add_measurement(t, y)
+    >>> e = est.current()                          # e.mean, e.covariance: NumPy
+    >>> run = gssm.run(model, data, method="ekf")  # run.t, run.mean, run.sd
+    >>> run.mean.shape == (len(data.t), 3)
+    True
 
 Methods are named as gssm-process names them: see gssm.methods().
 """
@@ -167,7 +171,7 @@ def learn(model_or_folder, data=None, *, out=None, config=None, parameters=None,
 def process(data, out, *, method="all", config=None, window=None, checkpoint_every=None, resume=None,
             skip_bad_rows=False, figures=True, progress=None, learn=None, threads=1):
     """gssm-process in this process: runs estimators over a dataset folder and
-    writes estimates-<method>.csv, metrics.json and (figures=True) the fig-*.png
+    writes estimates-<method>.csv, metrics.json and (figures=True) the ``fig-*.png``
     into `out`, the same files gssm-process writes. Returns a gssm.ProcessResult
     (its runs, metrics.json's text, the files written; partial and stopped_at
     when a bad row stopped it, after what came before was processed).

@@ -31,7 +31,7 @@ namespace gssm::io {
 /// from the INI's folder.
 std::unique_ptr<Model> makeModel(const IniDocument& ini, const std::string& data_dir = "");
 /// Writes a model's [model] and [prior] sections (and a linear model's
-/// [channel.<name>]s); InvalidArgument for a model type not registered.
+/// channel sections, `[channel.NAME]`); InvalidArgument for a model type not registered.
 void writeModel(const Model& model, IniDocument& ini);
 /// A file named in the INI: in `data_dir` when given, else beside the INI.
 std::string dataFile(const IniDocument& ini, const std::string& data_dir, const std::string& file);

@@ -25,7 +25,7 @@ struct Dataset {
   RowTimes rows = RowTimes::Measurements;
   IniDocument scenario;
   std::vector<Measurement> measurements;
-  std::vector<Input> inputs;  ///< inputs.csv (t,<input names>), if the model has inputs
+  std::vector<Input> inputs;  ///< inputs.csv (`t,<input names>`), if the model has inputs
   std::optional<Truth> truth;
   /// The constants a calibration file implies ([dataset] constants_reference,
   /// Model::referenceConstants; NaN where it says nothing): for judging only.
@@ -67,7 +67,7 @@ std::vector<IniKey> datasetIniKeys();
 /// Reads a dataset of a model's shape, naming file, line and column in
 /// every error. Two layouts:
 /// * gssm's own (no [dataset] section in `config`): measurements.csv
-///   (t,<channel 0 names>), inputs.csv, truth.csv (t,<stacked names>);
+///   (`t,<channel 0 names>`), inputs.csv, truth.csv (`t,<stacked names>`);
 /// * one CSV per sensor stream, described by the config's [dataset]:
 ///     inputs = FILE, input_columns = NAMES, input_kind = rates | increments
 ///       (increments: each row's change over the interval since the

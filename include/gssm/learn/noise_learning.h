@@ -130,7 +130,7 @@ double predictionErrorLogLikelihood(const Model& model, const std::vector<Measur
 /// The models of a noise family: `make(σ)` builds the model with the σs
 /// named `names` (a model without a registered type, a Python model).
 /// `parameters` (optional) describes each σ; by default each is a Real
-/// parameter [model] <name> started at `start` (or `given`).
+/// parameter `[model] <name>` started at `start` (or `given`).
 struct NoiseFamily {
   std::vector<std::string> names;
   Eigen::VectorXd given;  ///< the σs of the model as given

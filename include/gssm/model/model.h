@@ -184,7 +184,7 @@ class Model {
   /// All state names in the stacked order [x_c; x_b].
   std::vector<std::string> stackedStateNames() const;
 
-  /// What a user reads of an estimate (estimates-<method>.csv's columns,
+  /// What a user reads of an estimate (`estimates-<method>.csv`'s columns,
   /// each with an sd_ column): by default the stacked state itself. A model
   /// whose states are not the quantities its users judge (an INS: the
   /// antenna's latitude and longitude, the vehicle's Euler angles in

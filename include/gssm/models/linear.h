@@ -12,7 +12,7 @@ namespace gssm::models {
 struct LinearChannel {
   std::string name;
   Eigen::MatrixXd C_c, C_b, R;
-  std::vector<std::string> components;  ///< optional: left empty, <name>_1.. are used
+  std::vector<std::string> components;  ///< optional: left empty, `<name>_1`.. are used
 };
 
 struct LinearSystem {

@@ -27,7 +27,7 @@ struct PlanView {
   std::vector<std::pair<std::string, std::vector<Eigen::Vector2d>>> paths;
 };
 
-/// Writes fig-<constant>.png, fig-<state>-error.png (with truth),
+/// Writes `fig-<constant>.png`, `fig-<state>-error.png` (with truth),
 /// fig-trajectory.png (with a plan view) and fig-latency.png into `dir`,
 /// drawing up to `threads` at a time (savePngs); returns the paths written.
 std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,

@@ -11,7 +11,7 @@
 
 namespace gssm::plot {
 
-/// fig-track.png, fig-horizontal-error.png and fig-outage-<k>.png (each
+/// fig-track.png, fig-horizontal-error.png and `fig-outage-<k>.png` (each
 /// outage up close), to draw; none when the dataset withholds nothing. `r`
 /// must outlive them.
 std::vector<FigureJob> withheldFigureJobs(const io::ProcessResult& r, const std::string& dir);
