@@ -49,6 +49,12 @@ ModelType takingColoredNoise(ModelType t) {
     if (const ColoredNoise* c = coloredNoiseOf(m)) writeColoredNoise(*c, out);
   };
   t.owns = [owns = std::move(t.owns)](const Model& m) { return owns(withoutColoredNoise(m)); };
+  t.defaults = [defaults = std::move(t.defaults)](ParamSink& out) {
+    if (defaults) defaults(out);
+    const ColoredNoise none;  // τ and σ as a file that names channels but not them gets
+    out.real("colored_noise", "tau", none.tau);
+    out.real("colored_noise", "sd", none.sd);
+  };
   return t;
 }
 }  // namespace

@@ -99,6 +99,14 @@ std::vector<ParamSpec> navParams() {
   return p;
 }
 
+void writeNav(const Nav2D& nav, ParamSink& out) {
+  Eigen::MatrixXd B(static_cast<Eigen::Index>(nav.beacons().size()), 2);
+  for (std::size_t i = 0; i < nav.beacons().size(); ++i) B.row(static_cast<Eigen::Index>(i)) = nav.beacons()[i].transpose();
+  out.matrix("model", "beacons", B);
+  out.real("model", "accel_noise", nav.accelNoise());
+  writeNoise(nav, out, {false, true});
+}
+
 // [model] type = nav_2d: beacons, accel_noise, T, R and the priors; absent
 // keys keep Nav2D::Params' defaults (R: range_sigma² per beacon).
 const ModelRegistration registration{{
@@ -114,17 +122,9 @@ const ModelRegistration registration{{
       return std::make_unique<Nav2D>(readNoise(in, defaults.dims(), defaults.noise(), {false, true}), p.beacons,
                                      p.accel_noise);
     },
-    [](const Model& m, ParamSink& out) {
-      const auto& nav = dynamic_cast<const Nav2D&>(m);
-      Eigen::MatrixXd B(static_cast<Eigen::Index>(nav.beacons().size()), 2);
-      for (std::size_t i = 0; i < nav.beacons().size(); ++i)
-        B.row(static_cast<Eigen::Index>(i)) = nav.beacons()[i].transpose();
-      out.matrix("model", "beacons", B);
-      out.real("model", "accel_noise", nav.accelNoise());
-      writeNoise(m, out, {false, true});
-    },
+    [](const Model& m, ParamSink& out) { writeNav(dynamic_cast<const Nav2D&>(m), out); },
     [](const Model& m) { return dynamic_cast<const Nav2D*>(&m) != nullptr; },
-    {}}};
+    [](ParamSink& out) { writeNav(Nav2D(), out); }}};
 }  // namespace
 
 }  // namespace gssm::models
