@@ -27,3 +27,12 @@ def test_installed_package_runs_the_readme_lines(repo, tmp_path):
     assert int(files) >= 4 and (out / "estimates-ekf.csv").exists() and (out / "fig-latency.png").exists()
     for stub in ("__init__.pyi", "models.pyi", "io.pyi", "analysis.pyi", "campaign.pyi", "py.typed"):
         assert os.path.exists(os.path.join(packages[0], "gssm", stub)), stub
+    # The installed gssm-process finds its plotting library (loaded with
+    # dlopen beside its reading) through its own RUNPATH, $ORIGIN/../lib.
+    app = prefix / "bin" / "gssm-process"
+    if app.exists():
+        figures = tmp_path / "app-figures"
+        proc = subprocess.run([str(app), "--data", "datasets/radar-paper", "--method", "ekf", "--out", str(figures)],
+                              cwd=repo, capture_output=True, text=True, env=dict(os.environ, LD_LIBRARY_PATH=""))
+        assert proc.returncode == 0, proc.stderr
+        assert (figures / "fig-h.png").exists() and (figures / "metrics.json").exists(), proc.stdout
