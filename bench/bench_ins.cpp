@@ -14,26 +14,14 @@
 #include "gssm/estimator/estimator.h"
 #include "gssm/io/config.h"
 #include "gssm/io/dataset.h"
+#include "bundled_dataset.h"
 
 namespace {
 
-struct Drive {
-  std::unique_ptr<gssm::Model> model;
-  gssm::io::Dataset data;
-  gssm::EstimatorOptions options;
-};
+using Drive = gssm::bench::BundledDataset;
 
 const Drive& drive() {
-  static Drive d = [] {
-    Drive l;
-    const std::string dir = std::string(GSSM_SOURCE_DIR) + "/datasets/gnss-ins-drive";
-    const gssm::io::IniDocument ini = gssm::io::readScenario(dir);
-    l.model = gssm::io::makeModel(ini, dir);
-    gssm::io::readDatasetData(dir, *l.model, l.data, gssm::io::BadRows::Throw, &ini);
-    l.options = gssm::io::estimatorOptions(ini, *l.model);
-    l.options.t0 = l.data.t0;
-    return l;
-  }();
+  static const Drive d = gssm::bench::loadBundledDataset("gnss-ins-drive");
   return d;
 }
 

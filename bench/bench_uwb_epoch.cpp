@@ -15,6 +15,7 @@
 #include "gssm/estimator/estimator.h"
 #include "gssm/io/config.h"
 #include "gssm/io/dataset.h"
+#include "bundled_dataset.h"
 
 namespace {
 
@@ -26,20 +27,14 @@ double residentBytes() {
   return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
 }
 
-struct Log {
-  std::unique_ptr<gssm::Model> model;
-  gssm::io::Dataset data;
+// The log and its first 2000 epochs (a log line: all its ranges).
+struct Log : gssm::bench::BundledDataset {
   std::vector<std::vector<gssm::Measurement>> epochs;
-  gssm::EstimatorOptions options;
 };
 
 const Log& uwbLog() {
   static Log log = [] {
-    Log l;
-    const std::string dir = std::string(GSSM_SOURCE_DIR) + "/datasets/uwb-fast";
-    const gssm::io::IniDocument ini = gssm::io::readScenario(dir);
-    l.model = gssm::io::makeModel(ini, dir);
-    gssm::io::readDatasetData(dir, *l.model, l.data, gssm::io::BadRows::Throw, &ini);
+    Log l{gssm::bench::loadBundledDataset("uwb-fast"), {}};
     for (const auto& m : l.data.measurements) {
       if (l.epochs.empty() || l.epochs.back().front().t != m.t) {
         if (l.epochs.size() == 2000) break;
@@ -47,8 +42,6 @@ const Log& uwbLog() {
       }
       l.epochs.back().push_back(m);
     }
-    l.options = gssm::io::estimatorOptions(ini, *l.model);
-    l.options.t0 = l.data.t0;
     return l;
   }();
   return log;

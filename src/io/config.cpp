@@ -181,17 +181,9 @@ std::vector<IniKey> truthIniKeys() {
           {"input_includes_bias", "flag", "true", "the input measured with the first n_u constants as its bias"}};
 }
 
-namespace {
-std::vector<std::string> namesOf(const std::vector<IniKey>& keys) {
-  std::vector<std::string> out;
-  for (const auto& k : keys) out.push_back(k.key);
-  return out;
-}
-}  // namespace
-
 void requireScenarioKeys(const IniDocument& ini) {
-  ini.requireOnlyKeys("scenario", namesOf(scenarioIniKeys()));
-  ini.requireOnlyKeys("truth", namesOf(truthIniKeys()));
+  ini.requireOnlyKeys("scenario", iniKeyNames(scenarioIniKeys()));
+  ini.requireOnlyKeys("truth", iniKeyNames(truthIniKeys()));
 }
 
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {

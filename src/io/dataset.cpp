@@ -458,9 +458,7 @@ void addZeroMeasurements(const IniDocument& ini, const Model& model, Dataset& ou
 
 // One CSV per sensor stream, as the config's [dataset] describes.
 void readStreams(const std::string& dir, const IniDocument& ini, const Model& model, Dataset& out, BadRows bad_rows) {
-  std::vector<std::string> keys;
-  for (const IniKey& k : datasetIniKeys()) keys.push_back(k.key);
-  ini.requireOnlyKeys("dataset", keys);
+  ini.requireOnlyKeys("dataset", iniKeyNames(datasetIniKeys()));
   const auto file = [&](const std::string& key) { return (fs::path(dir) / ini.getString("dataset", key)).string(); };
   out.truth.reset();
   if (ini.has("dataset", "truth")) readTruth(file("truth"), ini, model, out);  // first: it may give t0

@@ -15,7 +15,7 @@
 
 namespace gssm::io {
 
-std::vector<std::string> IniSection::keyNames() const {
+std::vector<std::string> iniKeyNames(const std::vector<IniKey>& keys) {
   std::vector<std::string> out;
   for (const auto& k : keys) out.push_back(k.key);
   return out;
@@ -89,29 +89,6 @@ std::string typeOf(ParamKind kind) {
   return "?";
 }
 
-// The values a type's defaults write, by [section] key, as INI text.
-class DefaultsSink final : public ParamSink {
- public:
-  std::string at(const std::string& s, const std::string& k) const { return ini_.getString(s, k, ""); }
-  void real(const std::string& s, const std::string& k, double v) override { ini_.set(s, k, v); }
-  void flag(const std::string& s, const std::string& k, bool v) override { ini_.set(s, k, v ? "true" : "false"); }
-  void text(const std::string& s, const std::string& k, const std::string& v) override { ini_.set(s, k, v); }
-  void names(const std::string& s, const std::string& k, const std::vector<std::string>& v) override {
-    std::string joined;
-    for (const auto& w : v) joined += (joined.empty() ? "" : " ") + w;
-    ini_.set(s, k, joined);
-  }
-  void vector(const std::string& s, const std::string& k, const Eigen::VectorXd& v) override {
-    if (v.size()) ini_.set(s, k, Eigen::MatrixXd(v.transpose()));
-  }
-  void matrix(const std::string& s, const std::string& k, const Eigen::MatrixXd& v) override {
-    if (v.size()) ini_.set(s, k, v);
-  }
-
- private:
-  IniDocument ini_;
-};
-
 }  // namespace
 
 std::vector<IniSection> commonIniSections() {
@@ -124,8 +101,8 @@ std::vector<IniSection> commonIniSections() {
 }
 
 std::vector<IniSection> modelIniSections(const ModelType& type) {
-  DefaultsSink defaults;
-  if (type.defaults) type.defaults(defaults);
+  IniDocument defaults;
+  writeModelDefaults(type, defaults);
   std::vector<IniSection> out;
   auto sectionNamed = [&out](const std::string& name) -> IniSection& {
     for (auto& s : out)
@@ -142,7 +119,7 @@ std::vector<IniSection> modelIniSections(const ModelType& type) {
     std::string meaning = p.doc;
     if (p.learnable) meaning += p.constants_prior ? " (learnable by EM)" : " (learnable)";
     sectionNamed(section).keys.push_back(
-        {p.key, typeOf(p.kind), p.required ? "" : defaults.at(p.section, p.key), meaning, p.required});
+        {p.key, typeOf(p.kind), p.required ? "" : defaults.getString(p.section, p.key, ""), meaning, p.required});
   }
   return out;
 }

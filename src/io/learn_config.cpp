@@ -33,11 +33,7 @@ std::vector<IniKey> learnIniKeyDocs() {
        "the channels whose innovations the likelihood counts; the others condition it"}};
 }
 
-std::vector<std::string> learnIniKeys() {
-  std::vector<std::string> out;
-  for (const auto& k : learnIniKeyDocs()) out.push_back(k.key);
-  return out;
-}
+std::vector<std::string> learnIniKeys() { return iniKeyNames(learnIniKeyDocs()); }
 
 LearnSettings learnSettings(const IniDocument& ini) {
   LearnSettings s;

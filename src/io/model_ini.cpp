@@ -146,6 +146,12 @@ std::unique_ptr<Model> makeModel(const IniDocument& ini, const std::string& data
   }
 }
 
+void writeModelDefaults(const ModelType& type, IniDocument& ini) {
+  if (!type.defaults) return;
+  IniParamSink out(ini);
+  type.defaults(out);
+}
+
 void writeModel(const Model& model, IniDocument& ini) {
   const ModelType* type = modelTypeOf(model);
   if (!type) throw InvalidArgument("writeModel: model '" + model.name() + "' has no INI form (it is not registered)");

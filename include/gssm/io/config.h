@@ -33,6 +33,9 @@ std::unique_ptr<Model> makeModel(const IniDocument& ini, const std::string& data
 /// Writes a model's [model] and [prior] sections (and a linear model's
 /// channel sections, `[channel.NAME]`); InvalidArgument for a model type not registered.
 void writeModel(const Model& model, IniDocument& ini);
+/// Writes the values a type's parameters take when an INI leaves them out
+/// (ModelType::defaults; nothing for a type without them).
+void writeModelDefaults(const ModelType& type, IniDocument& ini);
 /// A file named in the INI: in `data_dir` when given, else beside the INI.
 std::string dataFile(const IniDocument& ini, const std::string& data_dir, const std::string& file);
 

@@ -24,8 +24,10 @@ struct IniSection {
   std::string name;   ///< "dataset", "model", "channel.<name>"
   std::string about;  ///< what the section is for, one line
   std::vector<IniKey> keys;
-  std::vector<std::string> keyNames() const;
 };
+
+/// The keys' names, in order (what a reader's requireOnlyKeys takes).
+std::vector<std::string> iniKeyNames(const std::vector<IniKey>& keys);
 
 /// [scenario], [dataset], [truth], [learn] and the estimators' sections
 /// ([ekf], [smoother], [fixed_lag], [paper_window], [batch]): what every

@@ -25,9 +25,9 @@ struct LearnSettings {
 };
 /// Reads [learn]; InputError naming file:line for a bad or unknown key.
 LearnSettings learnSettings(const IniDocument& ini);
-/// The keys of [learn], in order.
 /// [learn]'s keys, with type, default and meaning (the manual's reference).
 std::vector<IniKey> learnIniKeyDocs();
+/// The keys of [learn], in order.
 std::vector<std::string> learnIniKeys();
 
 /// The scenario as learnt: the input file's text (its comments kept) with
