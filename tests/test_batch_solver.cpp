@@ -642,3 +642,124 @@ TEST(BatchSolver, ASmallGraphThatIsNoChainIsFactoredDensely) {
     EXPECT_NE(std::string(e.what()).find(Key::state(3).toString()), std::string::npos) << e.what();
   }
 }
+
+namespace {
+// The radar window of the paper's scheme: priors on x_c(0) and x_b, then
+// `steps` steps of factors (process and range), by step.
+struct RadarWindow {
+  std::vector<FactorPtr> priors;
+  std::vector<std::vector<FactorPtr>> steps;  // steps[k − 1]: the step into x_c(k)
+  FactorGraph graph(std::size_t from_step = 0, const std::vector<FactorPtr>* other_priors = nullptr) const {
+    FactorGraph g;
+    for (const auto& f : other_priors ? *other_priors : priors) g.add(f);
+    for (std::size_t k = from_step; k < steps.size(); ++k)
+      for (const auto& f : steps[k]) g.add(f);
+    return g;
+  }
+};
+
+RadarWindow radarWindow(const Model& radar, const SimulatedRun& run, int steps) {
+  RadarWindow w;
+  w.priors = priorFactors(radar, radar.priorState(), radar.priorConstants());
+  for (int k = 1; k <= steps; ++k)
+    w.steps.push_back(stepFactors(radar, k, radar.noise().T, Eigen::VectorXd(0), &run.measurements[k - 1], 1));
+  return w;
+}
+}  // namespace
+
+// The step after dropping x_c(0) with its factors and re-prioritizing
+// x_c(1) and x_b (the paper window's re-solve) against the dense
+// Gauss–Newton step of the changed graph, linearized afresh at the same
+// point; with the last factorization before the last step and at the solution.
+TEST(BatchSolver, AStepAfterAChangeEqualsTheDenseStepOfTheChangedGraph) {
+  models::Radar2D::Params params;
+  params.q = 0.5;  // κ(H) small enough for a tight dense comparison
+  params.prior_x = 0, params.prior_xdot = 100, params.prior_h = 1000;
+  const models::Radar2D radar(params);
+  const SimulatedRun run = radarPaperRun(radar, 12, 5);
+  const RadarWindow w = radarWindow(radar, run, 12);
+  for (const bool at_solution : {false, true}) {
+    SCOPED_TRACE(at_solution ? "factored at the solution" : "factored before the last step");
+    BatchSolverOptions o;
+    o.method = BatchSolverOptions::Method::GaussNewton;
+    o.relative_cost_tolerance = 1e-9;
+    o.relinearize_at_solution = at_solution;
+    BatchSolver solver(o);
+    Problem p = buildProblem(radar, std::vector<Measurement>(run.measurements.begin(), run.measurements.begin() + 12));
+    Values x = p.initial;
+    ASSERT_TRUE(solver.solve(w.graph(), x).converged);
+    const Values x_f = solver.factoredAt(x);
+    // New priors away from the estimate: the step has somewhere to go.
+    const Gaussian state{x.at(Key::state(1)) + Eigen::VectorXd::Constant(1, 0.3), Eigen::MatrixXd::Identity(1, 1) * 0.04};
+    const Gaussian constants{x.at(Key::constants()) + Eigen::Vector2d(0.5, -2.0), Eigen::Vector2d(0.25, 9.0).asDiagonal()};
+    const std::vector<FactorPtr> new_priors = priorFactors(radar, state, constants, 1);
+    GraphChange change;
+    for (const auto& f : w.priors) change.removed.add(f);
+    for (const auto& f : w.steps[0]) change.removed.add(f);
+    for (const auto& f : new_priors) change.added.add(f);
+    change.dropped = {Key::state(0)};
+    const ChangeStep step = solver.stepAfterChange(change, x);
+
+    const FactorGraph changed = w.graph(1, &new_priors);
+    Values at = x_f;
+    at.erase(Key::state(0));
+    Eigen::MatrixXd H;
+    Eigen::VectorXd g;
+    denseNormalEquations(changed, at, H, g);
+    const Eigen::VectorXd delta = -H.ldlt().solve(g);
+    ASSERT_EQ(x.size(), at.size());
+    Eigen::Index off = 0;
+    for (const auto& kv : at) {
+      const Eigen::VectorXd expected = kv.second + delta.segment(off, kv.second.size());
+      EXPECT_LT((x.at(kv.first) - expected).norm(), 1e-9 * (1 + expected.norm())) << kv.first.toString();
+      off += kv.second.size();
+    }
+    EXPECT_NEAR(step.cost_before, changed.cost(at), 1e-9 * changed.cost(at));
+    EXPECT_NEAR(step.predicted_decrease, -0.5 * g.dot(delta), 1e-8 * std::abs(g.dot(delta)));
+    EXPECT_EQ(step.rank, 3);  // x_c(1) (x) and x_b (ẋ, h): the columns the change touches
+    EXPECT_GT(step.predicted_decrease, 1.0);
+    EXPECT_THROW(solver.marginalCovariance(Key::constants()), InvalidArgument) << "the factorization is the old graph's";
+  }
+}
+
+TEST(BatchSolver, AChangeThatLeavesAVariableUndeterminedIsRefusedAndChangesNothing) {
+  models::Radar2D::Params params;
+  params.q = 0.5;
+  params.prior_x = 0, params.prior_xdot = 100, params.prior_h = 1000;
+  const models::Radar2D radar(params);
+  const SimulatedRun run = radarPaperRun(radar, 6, 2);
+  const RadarWindow w = radarWindow(radar, run, 6);
+  BatchSolver solver;
+  Problem p = buildProblem(radar, std::vector<Measurement>(run.measurements.begin(), run.measurements.begin() + 6));
+  Values x = p.initial;
+  solver.solve(w.graph(), x);
+  const Values before = x;
+  const auto unchanged = [&] {
+    for (const auto& kv : before) EXPECT_EQ(x.at(kv.first), kv.second) << kv.first.toString();
+  };
+  GraphChange nothing_fixes_it;  // x_c(0) dropped, none of its factors removed
+  nothing_fixes_it.dropped = {Key::state(0)};
+  try {
+    solver.stepAfterChange(nothing_fixes_it, x);
+    ADD_FAILURE() << "expected NumericalError";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("x_c(0)"), std::string::npos) << e.what();
+  }
+  unchanged();
+  GraphChange on_dropped;  // a new factor on the variable that leaves
+  on_dropped.dropped = {Key::state(0)};
+  for (const auto& f : priorFactors(radar, radar.priorState(), radar.priorConstants(), 0)) on_dropped.added.add(f);
+  EXPECT_THROW(solver.stepAfterChange(on_dropped, x), InvalidArgument);
+  unchanged();
+  GraphChange no_prior;  // the constants' prior removed, nothing instead: h and ẋ trade off on 6 ranges? no: singular
+  no_prior.removed.add(w.priors[1]);
+  for (const auto& f : w.steps[5]) no_prior.removed.add(f);
+  for (const auto& f : w.steps[4]) no_prior.removed.add(f);
+  for (const auto& f : w.steps[3]) no_prior.removed.add(f);
+  for (const auto& f : w.steps[2]) no_prior.removed.add(f);
+  for (const auto& f : w.steps[1]) no_prior.removed.add(f);
+  EXPECT_THROW(solver.stepAfterChange(no_prior, x), NumericalError);
+  unchanged();
+  BatchSolver fresh;
+  EXPECT_THROW(fresh.stepAfterChange(GraphChange{}, x), InvalidArgument) << "no factorization yet";
+}

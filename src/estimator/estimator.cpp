@@ -624,20 +624,29 @@ class PaperWindowEstimator final : public Estimator {
     values.insert(Key::state(k), predictState(model_, values.at(Key::state(k - 1)), xb, u, dt, k));
     times.push_back(times.back() + dt);
     BatchSolver& solver = spare_;  // the committed solver_ stays as it is until the step succeeds
-    BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state, prior_constants, oldest), values);
+    std::vector<FactorPtr> priors = priorFactors(model_, prior_state, prior_constants, oldest);
+    BatchSolverSummary sum = solver.solve(windowGraph(steps, priors), values);
     if (static_cast<int>(times.size()) > window_) {
       // w + 1 states: the oldest leaves, new 1-D priors from this solve.
       const Key next = Key::state(oldest + 1);
       prior_state = diagonalPrior(values.at(next), solver.marginalCovariance(next));
       if (model_.dims().nb > 0)
         prior_constants = diagonalPrior(values.at(Key::constants()), solver.marginalCovariance(Key::constants()));
-      values.erase(Key::state(oldest));
+      // The re-solve's first Gauss–Newton step from the first solve's
+      // factorization: only the priors and the oldest step's factors change.
+      GraphChange change;
+      for (const auto& f : priors) change.removed.add(f);
+      for (const auto& f : steps.front()) change.removed.add(f);
+      priors = priorFactors(model_, prior_state, prior_constants, oldest + 1);
+      for (const auto& f : priors) change.added.add(f);
+      change.dropped = {Key::state(oldest)};
+      solver.stepAfterChange(change, values);
       steps.pop_front();
       times.pop_front();
       ++oldest;
       const BatchSolverSummary first = sum;
-      sum = solver.solve(windowGraph(steps, prior_state, prior_constants, oldest), values);
-      sum.iterations += first.iterations;
+      sum = solver.solve(windowGraph(steps, priors), values);
+      sum.iterations += first.iterations + 1;
       sum.factorizations += first.factorizations;
     }
     steps_ = std::move(steps);
@@ -655,7 +664,7 @@ class PaperWindowEstimator final : public Estimator {
     Values values = values_;
     for (std::size_t i = 0; i < count; ++i) steps.back().push_back(std::make_shared<MeasurementFactor>(model_, k, ms[i]));
     BatchSolver& solver = spare_;
-    const BatchSolverSummary sum = solver.solve(windowGraph(steps, prior_state_, prior_constants_, oldest_), values);
+    const BatchSolverSummary sum = solver.solve(graph(steps), values);
     steps_ = std::move(steps);
     values_ = std::move(values);
     commitSolve(sum);
@@ -691,15 +700,18 @@ class PaperWindowEstimator final : public Estimator {
   }
   // The window's graph: the priors on its oldest state and the constants,
   // then every step's factors.
-  FactorGraph windowGraph(const std::deque<std::vector<FactorPtr>>& steps, const Gaussian& prior_state,
-                          const Gaussian& prior_constants, std::int64_t oldest) const {
+  static FactorGraph windowGraph(const std::deque<std::vector<FactorPtr>>& steps, const std::vector<FactorPtr>& priors) {
     FactorGraph g;
-    for (const auto& f : priorFactors(model_, prior_state, prior_constants, oldest)) g.add(f);
+    for (const auto& f : priors) g.add(f);
     for (const auto& s : steps)
       for (const auto& f : s) g.add(f);
     return g;
   }
-  FactorGraph graph() const { return windowGraph(steps_, prior_state_, prior_constants_, oldest_); }
+  // The committed window's graph, with `steps` for its steps.
+  FactorGraph graph(const std::deque<std::vector<FactorPtr>>& steps) const {
+    return windowGraph(steps, priorFactors(model_, prior_state_, prior_constants_, oldest_));
+  }
+  FactorGraph graph() const { return graph(steps_); }
 
   void saveState(internal::ByteWriter& out) const override {
     out.u64(steps_.size());

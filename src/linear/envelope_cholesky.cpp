@@ -185,14 +185,23 @@ void EnvelopeCholesky::inverseRow(Eigen::Index i, const std::vector<int>& row, s
 }
 
 Eigen::MatrixXd EnvelopeCholesky::inverseBlock(Eigen::Index first, Eigen::Index size) const {
+  std::vector<Eigen::Index> columns(static_cast<std::size_t>(size));
+  for (Eigen::Index c = 0; c < size; ++c) columns[static_cast<std::size_t>(c)] = first + c;
+  return inverseColumns(columns);
+}
+
+Eigen::MatrixXd EnvelopeCholesky::inverseColumns(const std::vector<Eigen::Index>& columns) const {
   if (!factored_) throw NumericalError("EnvelopeCholesky: inverse block before a successful factorize()");
   const auto n = static_cast<std::ptrdiff_t>(first_.size());
+  const auto size = static_cast<Eigen::Index>(columns.size());
+  const std::ptrdiff_t first = size ? *std::min_element(columns.begin(), columns.end()) : 0;
   Eigen::MatrixXd W = Eigen::MatrixXd::Zero(n - first, size);  // rows first … n − 1 of U⁻ᵀE
   for (Eigen::Index c = 0; c < size; ++c) {
+    const std::ptrdiff_t from = columns[static_cast<std::size_t>(c)];
     double* w = W.col(c).data() - first;  // w[j]: row j
-    w[first + c] = 1.0;
-    for (std::ptrdiff_t j = first + c; j < n; ++j) {  // Uᵀw = e: rows above first + c are 0
-      const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(first_[static_cast<std::size_t>(j)], first + c);
+    w[from] = 1.0;
+    for (std::ptrdiff_t j = from; j < n; ++j) {  // Uᵀw = e: rows above `from` are 0
+      const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(first_[static_cast<std::size_t>(j)], from);
       const double* uj = u_.data() + base_[static_cast<std::size_t>(j)];
       w[j] = (w[j] - dot4(uj + lo, w + lo, j - lo)) * uj[j];
     }

@@ -58,6 +58,9 @@ class EnvelopeCholesky {
   /// substitution per column from row `first` down, no sweep — for a small
   /// block near the top, which the sweep reaches only at its end.
   Eigen::MatrixXd inverseBlock(Eigen::Index first, Eigen::Index size) const;
+  /// The same for any columns (H⁻¹ among them, in the order given): one
+  /// forward substitution per column from its own row down.
+  Eigen::MatrixXd inverseColumns(const std::vector<Eigen::Index>& columns) const;
   /// Work of inverseBlock(first, size) and of the sweep from where it stands
   /// up to row `first`, in multiply-adds (estimates, to choose between them).
   double inverseBlockWork(Eigen::Index first, Eigen::Index size) const;

@@ -1,5 +1,6 @@
 #include "gssm/solvers/batch_solver.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include "linear/envelope_cholesky.h"
 #include "linear/normal_equations.h"
 #include "linear/sparse_cholesky.h"
+#include "solvers/change_step.h"
 #include "solvers/damping.h"
 #include "solvers/newton.h"
 
@@ -140,6 +142,12 @@ struct BatchSolver::Impl {
   int threads = 1;
   bool has_solution = false;
   Eigen::VectorXd factored_point;  // where H was last factored, flat in the layout
+  Eigen::VectorXd factored_gradient;  // g = Jᵀr there (stepAfterChange)
+  double factored_cost = 0;           // ½Σ‖r‖² there
+  internal::Retraction retraction;    // the last graph's x ⊕ δ
+  Eigen::VectorXd change_backup;      // stepAfterChange's values before it
+  internal::LocalChange change;       // and its buffers, reused
+  internal::LowRankCorrection correction;
   // H⁻¹ on the factor's pattern, computed on the first covariance query.
   mutable std::optional<internal::SparseCholesky::SelectedInverse> selected;
   mutable bool envelope_inverse = false;  // envelope.selectedInverse() done for this solution
@@ -474,6 +482,73 @@ struct BatchSolver::Impl {
     for (Eigen::Index i = 0; i < n; ++i) H[diagonalOf(i)] = diag[i] + lambda * std::max(diag[i], 1e-12);
   }
 
+  // Global columns of the change's local keys: the dropped ones' and the others'.
+  void changeColumns(const internal::LocalChange& c, std::vector<Eigen::Index>& dropped,
+                     std::vector<Eigen::Index>& touched) const {
+    for (std::size_t i = 0; i < c.keys.size(); ++i) {
+      const std::size_t p = positionOf(c.keys[i]);
+      for (Eigen::Index j = offset[p]; j < offset[p + 1]; ++j) (i < c.dropped ? dropped : touched).push_back(j);
+    }
+  }
+  // δ = −(S + P·E·Pᵀ)⁻¹g' by Woodbury (batch_solver.h, stepAfterChange), in
+  // the layout's columns, zero on the dropped ones: with S⁻¹v = (H⁻¹[v; 0])_R
+  // and C = PᵀS⁻¹P (H⁻¹ on the touched columns), δ = −S⁻¹(g' − P·E·w),
+  // w = (I + C·E)⁻¹PᵀS⁻¹g': two solves with H's factor.
+  Eigen::VectorXd changedStep(const internal::LocalChange& c, const internal::LowRankCorrection& e,
+                              double& predicted) {
+    std::vector<Eigen::Index> ocol, tcol;
+    changeColumns(c, ocol, tcol);
+    const auto k = static_cast<Eigen::Index>(tcol.size());
+    const Eigen::MatrixXd C = inverseAmong(tcol);
+    Eigen::VectorXd g = factored_gradient;  // g' on R, 0 on O
+    for (Eigen::Index a = 0; a < k; ++a) g[tcol[static_cast<std::size_t>(a)]] += e.gradient_change[a];
+    for (Eigen::Index j : ocol) g[j] = 0.0;
+    Eigen::VectorXd v = g;
+    solveInPlace(v);  // (S⁻¹g')_R
+    Eigen::VectorXd w(k);
+    for (Eigen::Index a = 0; a < k; ++a) w[a] = v[tcol[static_cast<std::size_t>(a)]];
+    // (I + C·E)⁻¹ = (C⁻¹ + E)⁻¹C⁻¹, where C⁻¹ + E is the changed information
+    // on the touched columns once the rest is eliminated: positive definite
+    // exactly when the changed graph's is.
+    const Eigen::LLT<Eigen::MatrixXd> c_llt(C);
+    const Eigen::MatrixXd C_inv = c_llt.solve(Eigen::MatrixXd::Identity(k, k));
+    const Eigen::LLT<Eigen::MatrixXd> k_llt(C_inv + e.E);
+    if (k > 0 && (c_llt.info() != Eigen::Success || !positiveDefinite(k_llt, C_inv + e.E))) throwChangedSingular(c);
+    const Eigen::VectorXd Ew = e.E * k_llt.solve(C_inv * w);
+    v = g;
+    for (Eigen::Index a = 0; a < k; ++a) v[tcol[static_cast<std::size_t>(a)]] -= Ew[a];
+    solveInPlace(v);
+    for (Eigen::Index j : ocol) v[j] = 0.0;
+    v = -v;
+    predicted = -0.5 * g.dot(v);
+    if (!v.allFinite() || predicted < 0) throwChangedSingular(c);
+    return v;
+  }
+  // H⁻¹ among the given columns.
+  Eigen::MatrixXd inverseAmong(const std::vector<Eigen::Index>& columns) {
+    if (use_envelope) return envelope.inverseColumns(columns);
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(columns.size()));
+    for (std::size_t a = 0; a < columns.size(); ++a) E(columns[a], static_cast<Eigen::Index>(a)) = 1.0;
+    const Eigen::MatrixXd X = solve(E);
+    Eigen::MatrixXd out(E.cols(), E.cols());
+    for (std::size_t a = 0; a < columns.size(); ++a) out.row(static_cast<Eigen::Index>(a)) = X.row(columns[a]);
+    return 0.5 * (out + out.transpose());
+  }
+  // A Cholesky factor whose pivots are all clear of rounding.
+  static bool positiveDefinite(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::MatrixXd& A) {
+    if (llt.info() != Eigen::Success) return false;
+    const Eigen::VectorXd d = llt.matrixLLT().diagonal();
+    return d.cwiseAbs2().minCoeff() > 1e-14 * A.diagonal().cwiseAbs().maxCoeff();
+  }
+  [[noreturn]] static void throwChangedSingular(const internal::LocalChange& c) {
+    std::ostringstream os;
+    os << "BatchSolver::stepAfterChange: after the change the information matrix is singular or not positive "
+          "definite on ";
+    for (std::size_t i = c.dropped; i < c.keys.size(); ++i) os << (i > c.dropped ? ", " : "") << c.keys[i].toString();
+    os << ": the remaining factors and the added ones do not determine them (add a prior there)";
+    throw NumericalError(os.str());
+  }
+
   [[noreturn]] void throwSingular(Eigen::Index column) const {
     // The variable holding this column: the last offset at or before it.
     const std::size_t v = static_cast<std::size_t>(std::upper_bound(offset.begin(), offset.end(), column) - offset.begin()) - 1;
@@ -574,6 +649,8 @@ struct BatchSolver::Impl::Iteration {
     const double predicted = -0.5 * g.dot(delta);  // the Gauss–Newton model's decrease
     if (!options.relinearize_at_solution && policy.undamped() && predicted <= options.relative_cost_tolerance * cost) {
       internal::flatten(x, s.factored_point);
+      s.factored_gradient = g;
+      s.factored_cost = cost;
       internal::addStep(x, delta, x, &retraction);  // the last step: H as factored stays the solution's
       ++sum.iterations;
       cost -= predicted;
@@ -694,7 +771,10 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   if (!it.factored_at_solution) {
     it.factorAtSolution();
     internal::flatten(values, s.factored_point);
+    s.factored_gradient = it.g;
+    s.factored_cost = it.cost;
   }
+  s.retraction = it.retraction;
   s.has_solution = true;
   restore.armed = false;
 
@@ -710,12 +790,15 @@ void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
   Impl& s = *impl_;
   s.setup(graph, values, options_.threads);
   Eigen::VectorXd g, diag;
-  s.linearize(graph, values, g, diag);
+  const double cost = s.linearize(graph, values, g, diag);
   s.setDamping(diag, 0.0);
   const Eigen::Index bad = s.factorize();
   if (bad >= 0) s.throwSingular(bad);
   s.has_solution = true;
   internal::flatten(values, s.factored_point);
+  s.factored_gradient = std::move(g);
+  s.factored_cost = cost;
+  s.retraction = internal::Retraction::of(graph, values);
 }
 
 Values BatchSolver::factoredAt(const Values& like) const {
@@ -727,6 +810,35 @@ Values BatchSolver::factoredAt(const Values& like) const {
   Values out = like;
   internal::unflatten(s.factored_point, out);
   return out;
+}
+
+ChangeStep BatchSolver::stepAfterChange(const GraphChange& change, Values& values) {
+  Impl& s = *impl_;
+  if (!s.has_solution)
+    throw InvalidArgument("BatchSolver::stepAfterChange: no factorization of the graph before the change; solve() it first");
+  if (values.dim() != s.factored_point.size())
+    throw InvalidArgument("BatchSolver::stepAfterChange: the values have " + std::to_string(values.dim()) +
+                          " entries, the last solve " + std::to_string(s.factored_point.size()));
+  // x_f in `values` itself (no copy of every vector); put back on a throw.
+  internal::flatten(values, s.change_backup);
+  internal::unflatten(s.factored_point, values);
+  try {
+    internal::LocalChange& c = s.change;
+    internal::linearizeChange(change, values, c);
+    internal::LowRankCorrection& e = s.correction;
+    internal::lowRankCorrection(c, e);
+    ChangeStep out;
+    out.rank = e.E.rows();
+    out.cost_before = s.factored_cost - c.cost_removed + c.cost_added;
+    const Eigen::VectorXd delta = s.changedStep(c, e, out.predicted_decrease);
+    internal::addStep(values, delta, values, &s.retraction);
+    for (const Key& k : change.dropped) values.erase(k);
+    s.has_solution = false;  // H's factor is the old graph's
+    return out;
+  } catch (...) {
+    internal::unflatten(s.change_backup, values);
+    throw;
+  }
 }
 
 Eigen::MatrixXd BatchSolver::jointMarginalCovariance(const std::vector<Key>& keys) const {

@@ -102,6 +102,21 @@ struct BatchSolverSummary {
 
 const char* toString(BatchSolverSummary::Termination t);
 
+/// A change of the last solved graph confined to a few variables (the
+/// paper window's drop of its oldest state: docs/DESIGN.md §4).
+struct GraphChange {
+  FactorGraph removed;       ///< factors of the last solve's graph that leave
+  FactorGraph added;         ///< new factors, on variables of the last solve that stay
+  std::vector<Key> dropped;  ///< variables that leave; only `removed` factors may touch them
+};
+
+/// What BatchSolver::stepAfterChange() computed.
+struct ChangeStep {
+  double cost_before = 0;         ///< ½Σ‖r‖² of the changed graph at the factored point
+  double predicted_decrease = 0;  ///< −½g'ᵀδ: the Gauss–Newton model's decrease
+  Eigen::Index rank = 0;          ///< columns of the low-rank correction (the touched variables')
+};
+
 class BatchSolver {
  public:
   explicit BatchSolver(BatchSolverOptions options = {});  ///< throws if invalid
@@ -125,6 +140,26 @@ class BatchSolver {
   /// keys and sizes, which must be the last solve's). Restoring a solver
   /// exactly: evaluateAt(graph, factoredAt(values)).
   Values factoredAt(const Values& like) const;
+
+  /// One Gauss–Newton step of the last solved graph after `change`, from
+  /// the point x_f where that solve last factored H, without relinearizing
+  /// or refactoring the factors that stay. With O the dropped variables, R
+  /// the rest and H_d, H_a the removed and added factors' JᵀJ at x_f, the
+  /// changed graph's information on R is S + E: S, the Schur complement of
+  /// O in the factored H, and E = H_d,RO·H_d,OO⁻¹·H_d,OR − H_d,RR + H_a,RR,
+  /// nonzero only among the k columns of the variables the change touches.
+  /// So δ = −(S + E)⁻¹g' (g' the changed gradient at x_f) takes k + 1
+  /// solves with H's factor and a k × k system (Woodbury), the same step
+  /// a fresh linearization and factorization at x_f would give, to
+  /// rounding. `values` (the last solve's keys and sizes) becomes x_f ⊕ δ
+  /// without the dropped variables. The factorization belongs to the old
+  /// graph afterwards: solve() the changed graph before asking for
+  /// covariances. Throws InvalidArgument for a key the last solve did not
+  /// have or an added factor on a dropped variable, NumericalError (naming
+  /// the variables) when the removed factors do not determine the dropped
+  /// variables or the changed information matrix is singular; `values` is
+  /// then unchanged.
+  ChangeStep stepAfterChange(const GraphChange& change, Values& values);
 
   /// Marginal covariance of one variable at the last solution.
   Eigen::MatrixXd marginalCovariance(const Key& key) const;
