@@ -25,7 +25,7 @@ using testing::AttitudeModel;
 AttitudeModel attitude() { return AttitudeModel(0.05, 0.01, 0.05, 0.02, 0.3); }
 
 // Tiny, gimbal-lock pitch, yaw near ±π, |φ| near π, and a generic one.
-std::vector<Eigen::Vector3d> attitudes() {
+std::vector<Eigen::Vector3d> attitudeVectors() {
   return {Eigen::Vector3d(1e-9, -2e-9, 0.0),
           so3::Log(so3::fromRollPitchYaw(Eigen::Vector3d(0.3, M_PI / 2, 1.0))),
           so3::Log(so3::fromRollPitchYaw(Eigen::Vector3d(0.1, -0.2, M_PI - 1e-6))),
@@ -41,7 +41,7 @@ double rotationDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 TEST(RotationStates, RetractionAndLocalRoundTrip) {
   const std::vector<int> blocks{1};  // [a, φ, b]
   std::mt19937 rng(7);
-  for (const Eigen::Vector3d& phi : attitudes())
+  for (const Eigen::Vector3d& phi : attitudeVectors())
     for (double size : {1e-9, 0.3, 2.5}) {
       Eigen::VectorXd x(5), d = testing::uniformVector(rng, 5, -1, 1);
       x << 0.5, phi, -2.0;
@@ -60,7 +60,7 @@ TEST(RotationStates, RetractionAndLocalRoundTrip) {
 
 TEST(RotationStates, ModelJacobiansMatchTangentDifferences) {
   const AttitudeModel m = attitude();
-  const std::vector<Eigen::Vector3d> at = attitudes();
+  const std::vector<Eigen::Vector3d> at = attitudeVectors();
   testing::expectJacobiansMatchDifferences(m, [&](std::mt19937& rng) {
     testing::JacobianPoint p;
     p.xc = at[std::uniform_int_distribution<std::size_t>(0, at.size() - 1)(rng)];
@@ -100,7 +100,7 @@ void expectFactorJacobians(const Factor& f, const Values& x, const Model& m) {
 TEST(RotationStates, ProcessAndPriorFactorJacobiansMatchTangentDifferences) {
   const AttitudeModel m = attitude();
   const Eigen::Vector3d u(0.4, -1.1, 2.0), b(0.01, -0.02, 0.03);
-  for (const Eigen::Vector3d& phi : attitudes()) {
+  for (const Eigen::Vector3d& phi : attitudeVectors()) {
     Values x;
     x.insert(Key::state(0), phi);
     Eigen::VectorXd next = m.f(phi, b, u, 0.05);

@@ -36,7 +36,7 @@ std::vector<Vector3> tangents() {
 }
 
 // Attitudes: the above as rotations, gimbal lock both ways, yaw near ±π.
-std::vector<Matrix3> attitudes() {
+std::vector<Matrix3> attitudeMatrices() {
   std::vector<Matrix3> R;
   for (const auto& phi : tangents()) R.push_back(so3::Exp(phi));
   for (const Vector3& rpy : {Vector3(0.3, kPi / 2, 1.0), Vector3(-0.2, -kPi / 2, -2.5), Vector3(0.1, 0.2, kPi - 1e-9),
@@ -65,7 +65,7 @@ TEST(So3, ExpAndLogJacobiansMatchDifferences) {
 }
 
 TEST(So3, GroupOperationJacobiansMatchDifferences) {
-  const std::vector<Matrix3> Rs = attitudes();
+  const std::vector<Matrix3> Rs = attitudeMatrices();
   const Vector3 v(1.5, -0.4, 2.0), theta(0.2, -0.1, 0.3);
   for (std::size_t i = 0; i + 1 < Rs.size(); ++i) {
     const Matrix3 &R = Rs[i], &S = Rs[i + 1];
@@ -107,7 +107,7 @@ TEST(So3, EulerAnglesJacobianMatchesDifferencesAwayFromGimbalLock) {
     return d;
   };
   int i = 0, checked = 0;
-  for (const Matrix3& R : attitudes()) {
+  for (const Matrix3& R : attitudeMatrices()) {
     Matrix3 J;
     const Vector3 rpy = so3::rollPitchYaw(R, &J);
     if (std::abs(std::cos(rpy.y())) > 1e-3) {
@@ -123,7 +123,7 @@ TEST(So3, EulerAnglesJacobianMatchesDifferencesAwayFromGimbalLock) {
 TEST(So3, RotationOfEulerAnglesJacobianMatchesDifferences) {
   // J_out_rpy everywhere, gimbal lock included (the map itself is smooth).
   int i = 0;
-  for (const Matrix3& R : attitudes()) {
+  for (const Matrix3& R : attitudeMatrices()) {
     const Vector3 rpy = so3::rollPitchYaw(R) + Vector3(0.1, 0.0, -0.2);
     Matrix3 J;
     so3::fromRollPitchYaw(rpy, &J);
@@ -143,7 +143,7 @@ TEST(So3, MapsRoundTrip) {
     EXPECT_LT((so3::rightJacobian(phi) * so3::rightJacobianInverse(phi) - Matrix3::Identity()).norm(), 1e-9)
         << phi.transpose();
   }
-  const std::vector<Matrix3> Rs = attitudes();
+  const std::vector<Matrix3> Rs = attitudeMatrices();
   for (std::size_t i = 0; i < Rs.size(); ++i) {
     const Matrix3& R = Rs[i];
     EXPECT_LT((so3::Exp(so3::Log(R)) - R).norm(), 1e-9) << "point " << i;

@@ -20,8 +20,8 @@ using so3::Vector3;
 using strapdown::NavState;
 
 namespace {
-constexpr double kDeg = M_PI / 180;
-const geodesy::Geodetic kAnchor{40.0966268 * kDeg, -105.1474483 * kDeg, 1601.474};
+constexpr double kRadPerDeg = M_PI / 180;
+const geodesy::Geodetic kAnchor{40.0966268 * kRadPerDeg, -105.1474483 * kRadPerDeg, 1601.474};
 
 Space<NavState> navStates() {
   return {[](const NavState& x, const Eigen::VectorXd& d) {
@@ -70,7 +70,7 @@ TEST(Strapdown, AnImuAtRestStaysWhereItIs) {
   // At rest the gyros sense the Earth's rotation and the accelerometers the
   // reaction to gravity, in body axes; 100 s at 100 Hz must not move it.
   const strapdown::NavFrame frame(kAnchor);
-  for (const Vector3& rpy : {Vector3(0, 0, 0.3), Vector3(M_PI, -6.79 * kDeg, 185.35 * kDeg)}) {
+  for (const Vector3& rpy : {Vector3(0, 0, 0.3), Vector3(M_PI, -6.79 * kRadPerDeg, 185.35 * kRadPerDeg)}) {
     NavState x;
     x.R = so3::fromRollPitchYaw(rpy);
     const Vector3 gyro = x.R.transpose() * frame.earthRate(), accel = -x.R.transpose() * frame.gravity(x.p);

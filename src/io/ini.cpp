@@ -45,7 +45,7 @@ std::string stripComment(const std::string& line) {
 
 // Parses a full string as a finite double, whatever the C locale says a
 // decimal point is (std::from_chars: "0.5" is a half under de_DE too).
-bool parseDouble(const std::string& text, double& out) {
+bool parseFiniteDouble(const std::string& text, double& out) {
   const std::string t = trim(text);
   return io::parseDouble(t.data(), t.data() + t.size(), out) && std::isfinite(out);
 }
@@ -72,7 +72,7 @@ bool parseRows(const std::string& value, std::vector<std::vector<double>>& rows,
     std::string tok;
     while (ts >> tok) {
       double d;
-      if (!parseDouble(tok, d)) {
+      if (!parseFiniteDouble(tok, d)) {
         bad = "'" + tok + "' is not a finite number";
         return false;
       }
@@ -199,7 +199,7 @@ std::string IniDocument::getString(const std::string& section, const std::string
 double IniDocument::getDouble(const std::string& section, const std::string& key) const {
   const Entry& e = require(section, key);
   double d;
-  if (!parseDouble(e.value, d)) fail(section, e, "expected a finite number");
+  if (!parseFiniteDouble(e.value, d)) fail(section, e, "expected a finite number");
   return d;
 }
 double IniDocument::getDouble(const std::string& section, const std::string& key,

@@ -230,7 +230,7 @@ void writeLinear(const LinearModel& lin, ParamSink& out) {
   writeNoise(lin, out);
 }
 
-const ModelRegistration registration{{
+const ModelRegistration linear_registration{{
     "linear", {}, "Linear",
     "A linear GSSM from matrices: x_c' = A_c x_c + A_b x_b + B u (continuous time, discretized by "
     "`discretization`), y = C_c x_c + C_b x_b; channels: further sensors.",

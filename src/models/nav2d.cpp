@@ -109,7 +109,7 @@ void writeNav(const Nav2D& nav, ParamSink& out) {
 
 // [model] type = nav_2d: beacons, accel_noise, T, R and the priors; absent
 // keys keep Nav2D::Params' defaults (R: range_sigma² per beacon).
-const ModelRegistration registration{{
+const ModelRegistration nav2d_registration{{
     "nav_2d", {"nav2d"}, "Nav2D",
     "Constant-velocity vehicle ranging to beacons, with an accelerometer bias and a range bias as constants.",
     navParams(),

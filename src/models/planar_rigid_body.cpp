@@ -305,7 +305,7 @@ void writeBody(const PlanarRigidBody::Params& p, ParamSink& out) {
     out.real("prior", key, value);
 }
 
-const ModelRegistration registration{{
+const ModelRegistration planar_rigid_body_registration{{
     "planar_rigid_body", {}, "PlanarRigidBody",
     "A rigid body in a plane (constant velocity) with range tags at lever arms, ranging to anchors; a bias per "
     "link and a common range scale as optional constants; one channel per link.",

@@ -59,7 +59,7 @@ Eigen::VectorXd Radar2D::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
 namespace {
 // [model] type = radar_2d: T, Q, R and the priors; absent keys keep the
 // paper's settings.
-const ModelRegistration registration{{
+const ModelRegistration radar2d_registration{{
     "radar_2d", {"radar2d"}, "Radar2D",
     "The paper's radar example: x_c = x, x_b = [xdot, h], y = range (docs/DESIGN.md §2).",
     noiseParams(),

@@ -233,7 +233,7 @@ void writeRangeBeacon(const RangeBeacon2D::Params& p, ParamSink& out) {
   out.real("prior", "heading_rate_bias_sd", p.heading_rate_bias_sd);
 }
 
-const ModelRegistration registration{{
+const ModelRegistration range_beacon2d_registration{{
     "range_beacon_2d", {}, "RangeBeacon2D",
     "A vehicle with odometry ranging to known beacons (the CMU Plaza logs); range scale, per-beacon offsets and "
     "odometry scale as optional constants; one channel per beacon.",

@@ -390,7 +390,7 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
     out.real("prior", key, value);
 }
 
-const ModelRegistration registration{{
+const ModelRegistration strapdown_ins_registration{{
     "strapdown_ins", {}, "StrapdownIns",
     "Strapdown GNSS/INS: IMU inputs, attitude on SO(3), velocity and position in an Earth-fixed NED frame; gyro "
     "and accelerometer biases, lever arm and mounting as constants; GNSS, non-holonomic and zero-velocity channels.",

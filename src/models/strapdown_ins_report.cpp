@@ -11,7 +11,7 @@
 namespace gssm::models {
 
 namespace {
-constexpr double kDeg = 180.0 / M_PI;  // rad → deg
+constexpr double kDegPerRad = 180.0 / M_PI;  // rad → deg
 constexpr int kNc = StrapdownIns::kStates, kTheta = 0, kVel = 3;
 }  // namespace
 
@@ -34,9 +34,9 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   Eigen::MatrixXd J_xc, J_xb;
   const Eigen::Vector3d ned = antenna(xc, xb, &J_xc, &J_xb);
   const geodesy::Geodetic g = frame_.local().toGeodetic(ned);
-  const Eigen::Vector3d to_geo(kDeg / (geodesy::meridianRadius(g.lat) + g.height),
-                               kDeg / ((geodesy::transverseRadius(g.lat) + g.height) * std::cos(g.lat)), -1.0);
-  value.head<3>() << g.lat * kDeg, g.lon * kDeg, g.height;
+  const Eigen::Vector3d to_geo(kDegPerRad / (geodesy::meridianRadius(g.lat) + g.height),
+                               kDegPerRad / ((geodesy::transverseRadius(g.lat) + g.height) * std::cos(g.lat)), -1.0);
+  value.head<3>() << g.lat * kDegPerRad, g.lon * kDegPerRad, g.height;
   J.block(0, 0, 3, kNc) = to_geo.asDiagonal() * J_xc;
   J.block(0, b, 3, kConstants) = to_geo.asDiagonal() * J_xb;
   value.segment<3>(3) = xc.segment<3>(kVel);
@@ -44,9 +44,9 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   // The vehicle: R_nv = R·R_vbᵀ, perturbed R_nv·Exp(R_vb·(δθ − E·δμ)).
   Eigen::Matrix3d E, J_rpy = Eigen::Matrix3d::Zero();
   const Eigen::Matrix3d R = so3::Exp(xc.head<3>()), R_vb = mounting(xb, &E);
-  value.segment<3>(6) = so3::rollPitchYaw(R * R_vb.transpose(), &J_rpy) * kDeg;
-  J.block<3, 3>(6, kTheta) = kDeg * J_rpy * R_vb;
-  J.block<3, 3>(6, b + kMount) = -kDeg * J_rpy * R_vb * E;
+  value.segment<3>(6) = so3::rollPitchYaw(R * R_vb.transpose(), &J_rpy) * kDegPerRad;
+  J.block<3, 3>(6, kTheta) = kDegPerRad * J_rpy * R_vb;
+  J.block<3, 3>(6, b + kMount) = -kDegPerRad * J_rpy * R_vb * E;
   value.segment<6>(9) = xb.segment<6>(kGyroBias);
   J.block<6, 6>(9, b + kGyroBias).setIdentity();
   // The lever arm in vehicle axes, R_vb·ℓ.
@@ -58,8 +58,8 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   J(18, b + kDelay) = 1;
   // The mounting as the ZYX angles of R_vb (IMU → vehicle), as the source's.
   J_rpy.setZero();
-  value.segment<3>(19) = so3::rollPitchYaw(R_vb, &J_rpy) * kDeg;
-  J.block<3, 3>(19, b + kMount) = kDeg * J_rpy * E;
+  value.segment<3>(19) = so3::rollPitchYaw(R_vb, &J_rpy) * kDegPerRad;
+  J.block<3, 3>(19, b + kMount) = kDegPerRad * J_rpy * E;
   value.segment<6>(22) = xb.segment<6>(kGyroScale);
   J.block<6, 6>(22, b + kGyroScale).setIdentity();
   value[28] = xb[kClockRate];
