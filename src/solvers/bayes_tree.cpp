@@ -30,7 +30,8 @@ void chartJacobian(const std::vector<int>& blocks, int offset, const Eigen::Ref<
 }
 }  // namespace
 
-namespace {
+// (A named type, not in an anonymous namespace: BayesTreeEngine::EliminationQueue
+// holds two, and a unity source includes this file like a header.)
 // Key → value table for the variables of one update: a linear scan over an
 // inline array while small (appending a step touches 3-4 variables; no
 // hashing, no allocation: three tables are built per clique), a hash map
@@ -80,6 +81,8 @@ class KeyTable {
   std::size_t size_ = 0;
   std::unordered_map<Key, T, KeyHash> big_;
 };
+
+namespace {
 // Householder triangularization of a clique's stacked system [A | b] in
 // place: the strict lower triangle is left holding reflector data (the
 // caller zeroes it). Eigen's unblocked algorithm (same reflectors: β = ∓‖x‖,
