@@ -51,6 +51,16 @@ void denseNormalEquations(const FactorGraph& graph, const Values& x, Eigen::Matr
   g = J.transpose() * r_all;
 }
 
+// Priors at the truth (the paper's, 143σ off, leave residuals so large that
+// the Gauss–Newton model overstates every step's decrease) and a process
+// noise that keeps κ(H) small enough for a tight dense comparison.
+models::Radar2D radarWithPriorsAtTheTruth() {
+  models::Radar2D::Params params;
+  params.q = 0.5;
+  params.prior_x = 0, params.prior_xdot = 100, params.prior_h = 1000;
+  return models::Radar2D(params);
+}
+
 // A linear model whose constant b2 enters neither f nor h (with its prior
 // left out, nothing determines it).
 models::LinearModel modelBlindToB2() {
@@ -269,12 +279,7 @@ TEST(BatchSolver, MarginalCovariancesEqualDenseInverse) {
 
 // Gauss–Newton's last step, or Levenberg–Marquardt's undamped finishing one.
 TEST(BatchSolver, ALastUndampedStepWithoutRelinearizationKeepsTheFactorizationItCameFrom) {
-  // Priors at the truth (the paper's, 143σ off, leave residuals so large
-  // that the Gauss–Newton model overstates every step's decrease).
-  models::Radar2D::Params params;
-  params.q = 0.5;  // κ(H) small enough for a tight dense comparison
-  params.prior_x = 0, params.prior_xdot = 100, params.prior_h = 1000;
-  const models::Radar2D radar(params);
+  const models::Radar2D radar = radarWithPriorsAtTheTruth();
   const SimulatedRun run = radarPaperRun(radar, 25, 3);
   const Problem p = buildProblem(radar, run.measurements);
   for (const auto method : {BatchSolverOptions::Method::GaussNewton, BatchSolverOptions::Method::LevenbergMarquardt}) {
@@ -672,10 +677,7 @@ RadarWindow radarWindow(const Model& radar, const SimulatedRun& run, int steps) 
 // Gauss–Newton step of the changed graph, linearized afresh at the same
 // point; with the last factorization before the last step and at the solution.
 TEST(BatchSolver, AStepAfterAChangeEqualsTheDenseStepOfTheChangedGraph) {
-  models::Radar2D::Params params;
-  params.q = 0.5;  // κ(H) small enough for a tight dense comparison
-  params.prior_x = 0, params.prior_xdot = 100, params.prior_h = 1000;
-  const models::Radar2D radar(params);
+  const models::Radar2D radar = radarWithPriorsAtTheTruth();
   const SimulatedRun run = radarPaperRun(radar, 12, 5);
   const RadarWindow w = radarWindow(radar, run, 12);
   for (const bool at_solution : {false, true}) {
@@ -723,10 +725,7 @@ TEST(BatchSolver, AStepAfterAChangeEqualsTheDenseStepOfTheChangedGraph) {
 }
 
 TEST(BatchSolver, AChangeThatLeavesAVariableUndeterminedIsRefusedAndChangesNothing) {
-  models::Radar2D::Params params;
-  params.q = 0.5;
-  params.prior_x = 0, params.prior_xdot = 100, params.prior_h = 1000;
-  const models::Radar2D radar(params);
+  const models::Radar2D radar = radarWithPriorsAtTheTruth();
   const SimulatedRun run = radarPaperRun(radar, 6, 2);
   const RadarWindow w = radarWindow(radar, run, 6);
   BatchSolver solver;
@@ -751,13 +750,10 @@ TEST(BatchSolver, AChangeThatLeavesAVariableUndeterminedIsRefusedAndChangesNothi
   for (const auto& f : priorFactors(radar, radar.priorState(), radar.priorConstants(), 0)) on_dropped.added.add(f);
   EXPECT_THROW(solver.stepAfterChange(on_dropped, x), InvalidArgument);
   unchanged();
-  GraphChange no_prior;  // the constants' prior removed, nothing instead: h and ẋ trade off on 6 ranges? no: singular
+  GraphChange no_prior;  // the constants' prior and steps 2–6 removed: x_c(2…6) and x_b undetermined
   no_prior.removed.add(w.priors[1]);
-  for (const auto& f : w.steps[5]) no_prior.removed.add(f);
-  for (const auto& f : w.steps[4]) no_prior.removed.add(f);
-  for (const auto& f : w.steps[3]) no_prior.removed.add(f);
-  for (const auto& f : w.steps[2]) no_prior.removed.add(f);
-  for (const auto& f : w.steps[1]) no_prior.removed.add(f);
+  for (std::size_t k = 1; k < w.steps.size(); ++k)
+    for (const auto& f : w.steps[k]) no_prior.removed.add(f);
   EXPECT_THROW(solver.stepAfterChange(no_prior, x), NumericalError);
   unchanged();
   BatchSolver fresh;
