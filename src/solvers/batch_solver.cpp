@@ -1,6 +1,5 @@
 #include "gssm/solvers/batch_solver.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -512,8 +511,9 @@ struct BatchSolver::Impl {
     // exactly when the changed graph's is.
     const Eigen::LLT<Eigen::MatrixXd> c_llt(C);
     const Eigen::MatrixXd C_inv = c_llt.solve(Eigen::MatrixXd::Identity(k, k));
-    const Eigen::LLT<Eigen::MatrixXd> k_llt(C_inv + e.E);
-    if (k > 0 && (c_llt.info() != Eigen::Success || !positiveDefinite(k_llt, C_inv + e.E))) throwChangedSingular(c);
+    const Eigen::MatrixXd K = C_inv + e.E;
+    const Eigen::LLT<Eigen::MatrixXd> k_llt(K);
+    if (k > 0 && (c_llt.info() != Eigen::Success || !internal::clearlyPositiveDefinite(k_llt, K))) throwChangedSingular(c);
     const Eigen::VectorXd Ew = e.E * k_llt.solve(C_inv * w);
     v = g;
     for (Eigen::Index a = 0; a < k; ++a) v[tcol[static_cast<std::size_t>(a)]] -= Ew[a];
@@ -533,12 +533,6 @@ struct BatchSolver::Impl {
     Eigen::MatrixXd out(E.cols(), E.cols());
     for (std::size_t a = 0; a < columns.size(); ++a) out.row(static_cast<Eigen::Index>(a)) = X.row(columns[a]);
     return 0.5 * (out + out.transpose());
-  }
-  // A Cholesky factor whose pivots are all clear of rounding.
-  static bool positiveDefinite(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::MatrixXd& A) {
-    if (llt.info() != Eigen::Success) return false;
-    const Eigen::VectorXd d = llt.matrixLLT().diagonal();
-    return d.cwiseAbs2().minCoeff() > 1e-14 * A.diagonal().cwiseAbs().maxCoeff();
   }
   [[noreturn]] static void throwChangedSingular(const internal::LocalChange& c) {
     std::ostringstream os;
@@ -598,7 +592,8 @@ struct BatchSolver::Impl::Iteration {
   // steps.
   Eigen::VectorXd x_before;
   bool factored_at_solution = false;  // the last step kept its factorization (relinearize_at_solution false)
-  const internal::Retraction retraction;  // x ⊕ δ on rotation blocks (docs/DESIGN.md §12)
+  double factored_cost = 0;           // the cost where it was factored (g is that point's)
+  internal::Retraction retraction;  // x ⊕ δ on rotation blocks (docs/DESIGN.md §12)
 
   Iteration(Impl& impl, const BatchSolverOptions& o, const FactorGraph& gr, Values& values, BatchSolverSummary& summary)
       : s(impl), options(o), graph(gr), x(values), sum(summary), retraction(internal::Retraction::of(gr, values)) {
@@ -649,8 +644,7 @@ struct BatchSolver::Impl::Iteration {
     const double predicted = -0.5 * g.dot(delta);  // the Gauss–Newton model's decrease
     if (!options.relinearize_at_solution && policy.undamped() && predicted <= options.relative_cost_tolerance * cost) {
       internal::flatten(x, s.factored_point);
-      s.factored_gradient = g;
-      s.factored_cost = cost;
+      factored_cost = cost;
       internal::addStep(x, delta, x, &retraction);  // the last step: H as factored stays the solution's
       ++sum.iterations;
       cost -= predicted;
@@ -771,15 +765,17 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
   if (!it.factored_at_solution) {
     it.factorAtSolution();
     internal::flatten(values, s.factored_point);
-    s.factored_gradient = it.g;
-    s.factored_cost = it.cost;
+    it.factored_cost = it.cost;
   }
-  s.retraction = it.retraction;
   s.has_solution = true;
   restore.armed = false;
 
   sum.final_cost = it.cost;
   sum.gradient_norm = it.g.lpNorm<Eigen::Infinity>();
+  // What stepAfterChange() starts from, moved (no copy of n doubles a solve).
+  s.factored_gradient = std::move(it.g);
+  s.factored_cost = it.factored_cost;
+  s.retraction = std::move(it.retraction);
   sum.converged = isConverged(sum.termination);
   sum.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   sum.message = toString(sum.termination);

@@ -1,6 +1,5 @@
 #include "solvers/change_step.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <sstream>
 
@@ -37,6 +36,11 @@ double accumulate(LocalChange& c, const Factor& f, const Values& x_f, Eigen::Mat
 }
 }  // namespace
 
+bool clearlyPositiveDefinite(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::MatrixXd& A) {
+  if (llt.info() != Eigen::Success) return false;
+  return A.size() == 0 || llt.matrixLLT().diagonal().cwiseAbs2().minCoeff() > 1e-14 * A.diagonal().cwiseAbs().maxCoeff();
+}
+
 void linearizeChange(const GraphChange& change, const Values& x_f, LocalChange& c) {
   c.keys.clear();
   c.offset.assign(1, 0);
@@ -70,9 +74,9 @@ void lowRankCorrection(const LocalChange& c, LowRankCorrection& out) {
   out.E = c.H_added.bottomRightCorner(t, t) - c.H_removed.bottomRightCorner(t, t);
   out.gradient_change = c.g_added.tail(t) - c.g_removed.tail(t);
   if (o == 0) return;
-  const Eigen::LLT<Eigen::MatrixXd> oo(c.H_removed.topLeftCorner(o, o));
-  const double scale = c.H_removed.topLeftCorner(o, o).diagonal().cwiseAbs().maxCoeff();
-  if (oo.info() != Eigen::Success || !(oo.matrixL().toDenseMatrix().diagonal().minCoeff() > 1e-12 * std::sqrt(scale))) {
+  const Eigen::MatrixXd OO = c.H_removed.topLeftCorner(o, o);
+  const Eigen::LLT<Eigen::MatrixXd> oo(OO);
+  if (!clearlyPositiveDefinite(oo, OO)) {
     std::ostringstream os;
     os << "BatchSolver::stepAfterChange: the removed factors do not determine the dropped variables (";
     for (std::size_t i = 0; i < c.dropped; ++i) os << (i ? ", " : "") << c.keys[i].toString();

@@ -4,6 +4,7 @@
 // few variables they reach, and from them the low-rank correction E that
 // turns the Schur complement S of the dropped variables into the changed
 // graph's information matrix (S + E; batch_solver.h).
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <vector>
 
@@ -25,6 +26,10 @@ struct LocalChange {
   Eigen::Index droppedColumns() const { return offset[dropped]; }
   Eigen::Index columns() const { return offset.back(); }
 };
+
+/// A Cholesky factorization of A that succeeded with every pivot clear of
+/// rounding (relative to A's largest diagonal entry).
+bool clearlyPositiveDefinite(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::MatrixXd& A);
 
 /// Linearizes the change's factors at x_f (robust losses reweighted there)
 /// into `c` (its buffers reused from call to call). InvalidArgument for an

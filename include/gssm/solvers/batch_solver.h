@@ -148,8 +148,9 @@ class BatchSolver {
   /// changed graph's information on R is S + E: S, the Schur complement of
   /// O in the factored H, and E = H_d,RO·H_d,OO⁻¹·H_d,OR − H_d,RR + H_a,RR,
   /// nonzero only among the k columns of the variables the change touches.
-  /// So δ = −(S + E)⁻¹g' (g' the changed gradient at x_f) takes k + 1
-  /// solves with H's factor and a k × k system (Woodbury), the same step
+  /// So δ = −(S + E)⁻¹g' (g' the changed gradient at x_f) takes two solves
+  /// with H's factor, H⁻¹ among the k columns and k × k algebra
+  /// (Woodbury), the same step
   /// a fresh linearization and factorization at x_f would give, to
   /// rounding. `values` (the last solve's keys and sizes) becomes x_f ⊕ δ
   /// without the dropped variables. The factorization belongs to the old
