@@ -38,16 +38,18 @@ PlanarRigidBody::Params uwbLayout() {
 }  // namespace
 
 TEST(PlanarRigidBody, AnalyticJacobiansMatchCentralDifferencesOnEveryLink) {
-  for (int variant = 0; variant < 3; ++variant) {
-    const bool scale = variant == 1, errors = variant == 2;
+  for (int variant = 0; variant < 4; ++variant) {
+    const bool scale = variant == 1 || variant == 3, errors = variant == 2;
+    const int antenna = variant == 3 ? 2 * 2 * 3 : 0;  // harmonics 2 and 3 of three tags
     PlanarRigidBody::Params p = uwbLayout();
     p.range_scale = scale;
+    p.antenna_harmonics = variant == 3 ? 3 : 0;
     ColoredNoise gm;  // a Gauss–Markov error state per link
     if (errors) gm.channels = {"all"}, gm.tau = 0.3, gm.sd = 0.05;
     const std::unique_ptr<Model> wrapped = withColoredNoise(std::make_unique<PlanarRigidBody>(p), gm);
     const Model& model = *wrapped;
     ASSERT_EQ(model.numChannels(), 24);
-    ASSERT_EQ(model.dims().nb, 24 + (scale ? 1 : 0));
+    ASSERT_EQ(model.dims().nb, 24 + (scale ? 1 : 0) + antenna);
     ASSERT_EQ(model.dims().nc, errors ? 30 : 6);
     gssm::testing::expectJacobiansMatchDifferences(model, [&](std::mt19937& rng) {
       gssm::testing::JacobianPoint pt;
@@ -57,6 +59,7 @@ TEST(PlanarRigidBody, AnalyticJacobiansMatchCentralDifferencesOnEveryLink) {
       pt.xc[2] = std::uniform_int_distribution<int>(0, 1)(rng) ? yaw(rng) : M_PI - 1e-4;  // near the cut too
       pt.xb = gssm::testing::uniformVector(rng, model.dims().nb, -0.3, 0.3);
       if (scale) pt.xb[24] = 1.02;
+      if (antenna) pt.xb.tail(antenna) *= 0.2;
       pt.u = Eigen::VectorXd(0);
       pt.dt = 0.013;
       return pt;
@@ -85,6 +88,8 @@ TEST(PlanarRigidBody, RoundTripsThroughItsIniForm) {
   p.range_sd = 0.05;
   p.range_scale = true;
   p.bias_common_sd = 0.4;
+  p.antenna_harmonics = 2;
+  p.antenna_sd = 0.02;
   const PlanarRigidBody model(p);
   io::IniDocument ini;
   io::writeModel(model, ini);
@@ -96,6 +101,35 @@ TEST(PlanarRigidBody, RoundTripsThroughItsIniForm) {
   EXPECT_EQ(again->noise().Q, model.noise().Q);
   EXPECT_EQ(again->priorConstants().covariance, model.priorConstants().covariance);
   EXPECT_EQ(q.bias_common_sd, 0.4);
+  EXPECT_EQ(q.antenna_harmonics, 2);
+  EXPECT_EQ(q.antenna_sd, 0.02);
+}
+
+// g_i(β) = a cos 2β + b sin 2β of tag i, β the anchor's bearing in the body
+// frame seen from the tag: checked against that bearing computed here from
+// the geometry, on every link of tag 1; the other tags' ranges unchanged.
+TEST(PlanarRigidBody, AntennaDelayIsTheTagsHarmonicsOfTheAnchorsBodyFrameBearing) {
+  PlanarRigidBody::Params p = uwbLayout();
+  p.antenna_harmonics = 2;
+  const PlanarRigidBody model(p);
+  ASSERT_EQ(model.dims().nb, 24 + 6);
+  EXPECT_EQ(model.stackedStateNames()[6 + 24 + 2], "antenna_1_c2");
+  const Eigen::VectorXd xc = (Eigen::VectorXd(6) << 0.5, -0.3, 2.4, 0.2, 0.1, 0.05).finished();
+  Eigen::VectorXd xb = Eigen::VectorXd::Zero(30);
+  xb[26] = 0.04, xb[27] = -0.03;  // tag 1: a, b
+  const Eigen::Rotation2Dd R(xc[2]);
+  for (std::size_t a = 0; a < p.anchors.size(); ++a) {
+    const Eigen::Vector2d tag = xc.head<2>() + R * p.tags[1].head<2>();
+    const Eigen::Vector2d body = R.inverse() * (p.anchors[a].head<2>() - tag);
+    const double beta = std::atan2(body.y(), body.x());
+    const int c = model.channelOf(1, a);
+    EXPECT_NEAR(model.h(c, xc, xb)[0] - model.h(c, xc, Eigen::VectorXd::Zero(30))[0],
+                0.04 * std::cos(2 * beta) - 0.03 * std::sin(2 * beta), 1e-14);
+    const int other = model.channelOf(0, a);
+    EXPECT_EQ(model.h(other, xc, xb)[0], model.h(other, xc, Eigen::VectorXd::Zero(30))[0]);
+  }
+  p.antenna_harmonics = 9;
+  EXPECT_THROW(PlanarRigidBody{p}, gssm::InvalidArgument);
 }
 
 // A link's Gauss–Markov range error (the general mechanism,
@@ -197,6 +231,29 @@ TEST(PlanarRigidBody, EveryMethodRecoversTheLinkBiasesWithinTwoSigmaOverSeeds) {
     // 2σ holds ~95% of the time for a consistent estimator.
     EXPECT_GE(inside, 0.9 * total) << methodName(method) << ": " << inside << " of " << total << " biases within 2σ";
   }
+}
+
+// The antennas' bearing-dependent delays (harmonics 2 and 3, drawn from
+// their prior like the biases) are recovered by the batch within 2σ.
+TEST(PlanarRigidBody, AntennaHarmonicsAreRecoveredWithinTwoSigmaOverSeeds) {
+  PlanarRigidBody::Params p = simulatedLayout();
+  p.bias_sd = 0.06;
+  p.bias_common_sd = 1.0;
+  p.antenna_harmonics = 3;
+  p.antenna_sd = 0.03;
+  const PlanarRigidBody model(p);
+  int inside = 0, total = 0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    const SimulatedRun run = layoutRun(model, seed, 1200);
+    const OfflineRun r = runOffline(model, EstimatorOptions(Method::Batch), run.measurements);
+    const EstimateRow& last = r.rows.back();
+    for (int i = 24; i < 36; ++i, ++total) {
+      const double err = last.mean[6 + i] - run.constants[i];
+      inside += std::abs(err) <= 2 * std::sqrt(last.covariance(6 + i, 6 + i)) ? 1 : 0;
+    }
+  }
+  std::printf("batch: %d of %d antenna coefficients within 2σ\n", inside, total);
+  EXPECT_GE(inside, 0.9 * total);
 }
 
 TEST(PlanarRigidBody, IncrementalSmootherEqualsTheBatchOnTheLayout) {

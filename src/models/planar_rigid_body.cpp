@@ -14,8 +14,17 @@ std::string linkName(const PlanarRigidBody::Params& p, std::size_t i, std::size_
   return std::to_string(p.tag_ids[i]) + "_" + std::to_string(p.anchor_ids[j]);
 }
 
+int countLinkBiases(const PlanarRigidBody::Params& p) {
+  return p.link_biases ? static_cast<int>(p.tags.size() * p.anchors.size()) : 0;
+}
+// Harmonics 2..K: the first is a lever-arm error (a tag's position), which
+// the ranges cannot tell from the body origin's.
+int antennaTermsPerTag(const PlanarRigidBody::Params& p) { return 2 * std::max(0, p.antenna_harmonics - 1); }
+int countAntennaTerms(const PlanarRigidBody::Params& p) {
+  return antennaTermsPerTag(p) * static_cast<int>(p.tags.size());
+}
 int countConstants(const PlanarRigidBody::Params& p) {
-  return (p.link_biases ? static_cast<int>(p.tags.size() * p.anchors.size()) : 0) + (p.range_scale ? 1 : 0);
+  return countLinkBiases(p) + (p.range_scale ? 1 : 0) + countAntennaTerms(p);
 }
 
 ModelNames bodyNames(const PlanarRigidBody::Params& p) {
@@ -24,6 +33,10 @@ ModelNames bodyNames(const PlanarRigidBody::Params& p) {
     for (std::size_t i = 0; i < p.tags.size(); ++i)
       for (std::size_t j = 0; j < p.anchors.size(); ++j) n.constants.push_back("bias_" + linkName(p, i, j));
   if (p.range_scale) n.constants.push_back("range_scale");
+  for (std::size_t i = 0; i < p.tags.size(); ++i)
+    for (int k = 2; k <= p.antenna_harmonics; ++k)
+      for (const char* part : {"_c", "_s"})
+        n.constants.push_back("antenna_" + std::to_string(p.tag_ids[i]) + part + std::to_string(k));
   if (!p.tags.empty() && !p.anchors.empty()) n.measurement = {"range_" + linkName(p, 0, 0)};
   return n;
 }
@@ -45,10 +58,13 @@ ModelNoise bodyNoise(const PlanarRigidBody::Params& p) {
   if (p.tags.empty() || p.anchors.empty() || p.tags.size() != p.tag_ids.size() || p.anchors.size() != p.anchor_ids.size())
     throw InvalidArgument("PlanarRigidBody: need at least one tag and one anchor, each with an id");
   for (double v : {p.accel_sd, p.yaw_accel_sd, p.range_sd, p.position_sd, p.yaw_sd, p.velocity_sd, p.omega_sd,
-                   p.bias_sd, p.range_scale_sd, p.T})
+                   p.bias_sd, p.range_scale_sd, p.antenna_sd, p.T})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("PlanarRigidBody: every σ and T must be > 0");
   if (!(p.bias_common_sd >= 0) || !std::isfinite(p.bias_common_sd))
     throw InvalidArgument("PlanarRigidBody: bias_common_sd must be >= 0 (0: the links' biases independent)");
+  if (p.antenna_harmonics < 0 || p.antenna_harmonics > 8)
+    throw InvalidArgument("PlanarRigidBody: antenna_harmonics must be in [0, 8], got " +
+                          std::to_string(p.antenna_harmonics));
   ModelNoise n;
   n.T = p.T;
   n.Q = bodyProcessNoise(p, p.T);
@@ -59,11 +75,12 @@ ModelNoise bodyNoise(const PlanarRigidBody::Params& p) {
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
   const int nb = countConstants(p);
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(nb), bsd = Eigen::VectorXd::Constant(nb, p.bias_sd);
-  if (p.range_scale) bmean[nb - 1] = 1, bsd[nb - 1] = p.range_scale_sd;
+  const int nl = countLinkBiases(p);
+  if (p.range_scale) bmean[nl] = 1, bsd[nl] = p.range_scale_sd;
+  bsd.tail(countAntennaTerms(p)).setConstant(p.antenna_sd);
   Eigen::MatrixXd P = bsd.cwiseAbs2().asDiagonal();
   // b_ij = c + d_ij: the part all links share (c ~ N(0, σ_c²)) marginalized
   // out of the prior, so every link keeps its own node and its own factors.
-  const int nl = p.link_biases ? nb - (p.range_scale ? 1 : 0) : 0;
   P.topLeftCorner(nl, nl).array() += p.bias_common_sd * p.bias_common_sd;
   n.prior_constants = {bmean, P};
   return n;
@@ -78,6 +95,8 @@ PlanarRigidBody::PlanarRigidBody(const Params& p)
     i += static_cast<int>(p.tags.size() * p.anchors.size());
   }
   if (p.range_scale) i_scale_ = i++;
+  const int per_tag = antennaTermsPerTag(p);
+  if (per_tag > 0) i_antenna_ = i;
   std::vector<MeasurementChannel> channels;
   for (std::size_t t = 0; t < p.tags.size(); ++t)
     for (std::size_t a = 0; a < p.anchors.size(); ++a) {
@@ -89,6 +108,7 @@ PlanarRigidBody::PlanarRigidBody(const Params& p)
       ch.ekf_gate = p.ekf_gate;
       if (i_bias_ >= 0) ch.constants.push_back(i_bias_ + static_cast<int>(t * p.anchors.size() + a));
       if (i_scale_ >= 0) ch.constants.push_back(i_scale_);
+      for (int k = 0; k < per_tag; ++k) ch.constants.push_back(i_antenna_ + static_cast<int>(t) * per_tag + k);
       channels.push_back(std::move(ch));
     }
   setChannels(std::move(channels));
@@ -199,6 +219,19 @@ void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen:
   const double rho = std::sqrt(d.squaredNorm() + dz * dz);
   const double scale = i_scale_ >= 0 ? xb[i_scale_] : 1.0;
   const int ib = biasIndex(channel);
+  if (J_h_xb) {
+    *J_h_xb = Eigen::MatrixXd::Zero(1, dims().nb);
+    if (ib >= 0) (*J_h_xb)(0, ib) = 1.0;
+    if (i_scale_ >= 0) (*J_h_xb)(0, i_scale_) = rho;
+  }
+  // The anchor in the body frame, seen from the tag: v = R(yaw)ᵀ(−d), β = atan2(v_y, v_x).
+  const Eigen::Vector2d v(-(c * d.x() + s * d.y()), -(-s * d.x() + c * d.y()));
+  const double vn2 = v.squaredNorm();
+  double dg_dbeta = 0, g = 0;
+  if (i_antenna_ >= 0 && vn2 > 0) {
+    const double vn = std::sqrt(vn2);
+    g = antennaDelay(t, v.x() / vn, v.y() / vn, xb, &dg_dbeta, J_h_xb);
+  }
   if (J_h_xc) {
     *J_h_xc = Eigen::MatrixXd::Zero(1, 6);
     if (rho > 0) {
@@ -206,14 +239,35 @@ void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen:
       (*J_h_xc)(0, 1) = scale * d.y() / rho;
       (*J_h_xc)(0, 2) = scale * (d.x() * -rl.y() + d.y() * rl.x()) / rho;  // R'(yaw) l = (−rl_y, rl_x)
     }
-  }
-  if (J_h_xb) {
-    *J_h_xb = Eigen::MatrixXd::Zero(1, dims().nb);
-    if (ib >= 0) (*J_h_xb)(0, ib) = 1.0;
-    if (i_scale_ >= 0) (*J_h_xb)(0, i_scale_) = rho;
+    if (dg_dbeta != 0) {
+      // ∂β/∂v = (−v_y, v_x)/|v|²; ∂v/∂p = −Rᵀ; ∂v/∂yaw = ((v + l)_y, −(v + l)_x).
+      const Eigen::Vector2d db_dv = Eigen::Vector2d(-v.y(), v.x()) / vn2;
+      const Eigen::Vector2d vl = v + l.head<2>();
+      (*J_h_xc)(0, 0) += dg_dbeta * -(db_dv.x() * c - db_dv.y() * s);
+      (*J_h_xc)(0, 1) += dg_dbeta * -(db_dv.x() * s + db_dv.y() * c);
+      (*J_h_xc)(0, 2) += dg_dbeta * (db_dv.x() * vl.y() - db_dv.y() * vl.x());
+    }
   }
   out.resize(1);
-  out[0] = scale * rho + (ib >= 0 ? xb[ib] : 0.0);
+  out[0] = scale * rho + (ib >= 0 ? xb[ib] : 0.0) + g;
+}
+
+// g_t(β) = Σ_{k=2..K} a_k cos kβ + b_k sin kβ, cos kβ and sin kβ by the angle-sum recurrence.
+double PlanarRigidBody::antennaDelay(std::size_t t, double cos_b, double sin_b, const Eigen::VectorXd& xb,
+                                     double* dg_dbeta, Eigen::MatrixXd* J_h_xb) const {
+  const int i0 = i_antenna_ + static_cast<int>(t) * antennaTermsPerTag(p_);
+  double ck = cos_b * cos_b - sin_b * sin_b, sk = 2 * sin_b * cos_b, g = 0, dg = 0;  // k = 2
+  for (int k = 2; k <= p_.antenna_harmonics; ++k) {
+    const int i = i0 + 2 * (k - 2);
+    g += xb[i] * ck + xb[i + 1] * sk;
+    dg += k * (-xb[i] * sk + xb[i + 1] * ck);
+    if (J_h_xb) (*J_h_xb)(0, i) = ck, (*J_h_xb)(0, i + 1) = sk;
+    const double next_c = ck * cos_b - sk * sin_b;
+    sk = sk * cos_b + ck * sin_b;
+    ck = next_c;
+  }
+  *dg_dbeta = dg;
+  return g;
 }
 
 Eigen::MatrixXd PlanarRigidBody::processNoise(double dt) const {
@@ -232,7 +286,9 @@ std::vector<ParamSpec> bodyParams() {
       learnable(real("model", "yaw_accel_sd", "white angular acceleration, rad/s² per √Hz")),
       learnable(real("model", "range_sd", "σ of one range (m)")),
       flag("model", "link_biases", "estimate a bias per link (bias_<tag>_<anchor>)"),
-      flag("model", "range_scale", "estimate a common range scale")};
+      flag("model", "range_scale", "estimate a common range scale"),
+      real("model", "antenna_harmonics",
+              "harmonics K of each tag's antenna delay in the anchor's body-frame bearing (0: none)")};
   for (auto& l : lossParams("model")) p.push_back(l);
   for (auto& q : {real("model", "ekf_gate", "EKF NIS gate of every range (0: none)"),
                   vector("prior", "start", "prior mean of [px, py, yaw] (default: the anchors' centroid, 0)"),
@@ -241,7 +297,8 @@ std::vector<ParamSpec> bodyParams() {
                   real("prior", "omega_sd", "prior σ of the yaw rate (rad/s)"),
                   learnablePrior(real("prior", "bias_sd", "prior σ of each link's own bias (about the common part), m")),
                   real("prior", "bias_common_sd", "prior σ of a bias every link shares (0: none), m"),
-                  real("prior", "range_scale_sd", "prior σ of the range scale (mean 1)")})
+                  real("prior", "range_scale_sd", "prior σ of the range scale (mean 1)"),
+                  learnablePrior(real("prior", "antenna_sd", "prior σ of each antenna-delay harmonic's coefficient, m"))})
     p.push_back(q);
   return p;
 }
@@ -266,6 +323,11 @@ PlanarRigidBody::Params readBody(const ParamSource& in) {
     *value = in.real("model", key, *value);
   p.link_biases = in.flag("model", "link_biases", p.link_biases);
   p.range_scale = in.flag("model", "range_scale", p.range_scale);
+  const double harmonics = in.real("model", "antenna_harmonics", p.antenna_harmonics);
+  if (harmonics != std::floor(harmonics) || harmonics < 0 || harmonics > 8)
+    throw InputError(in.where("model", "antenna_harmonics") + ": must be a whole number in [0, 8], got " +
+                     std::to_string(harmonics));
+  p.antenna_harmonics = static_cast<int>(harmonics);
   p.range_loss = readLoss(in, "model");
   if (in.has("prior", "start")) {
     p.start = in.vector("prior", "start", 3);
@@ -276,7 +338,8 @@ PlanarRigidBody::Params readBody(const ParamSource& in) {
   }
   for (auto [key, value] : {std::pair{"position_sd", &p.position_sd}, {"yaw_sd", &p.yaw_sd},
                             {"velocity_sd", &p.velocity_sd}, {"omega_sd", &p.omega_sd}, {"bias_sd", &p.bias_sd},
-                            {"bias_common_sd", &p.bias_common_sd}, {"range_scale_sd", &p.range_scale_sd}})
+                            {"bias_common_sd", &p.bias_common_sd}, {"range_scale_sd", &p.range_scale_sd},
+                            {"antenna_sd", &p.antenna_sd}})
     *value = in.real("prior", key, *value);
   return p;
 }
@@ -296,12 +359,14 @@ void writeBody(const PlanarRigidBody::Params& p, ParamSink& out) {
     out.real("model", key, value);
   out.flag("model", "link_biases", p.link_biases);
   out.flag("model", "range_scale", p.range_scale);
+  out.real("model", "antenna_harmonics", p.antenna_harmonics);
   writeLoss(p.range_loss, "model", out);
   out.real("model", "ekf_gate", p.ekf_gate);
   out.vector("prior", "start", p.start);
   for (auto [key, value] : {std::pair{"position_sd", p.position_sd}, {"yaw_sd", p.yaw_sd},
                             {"velocity_sd", p.velocity_sd}, {"omega_sd", p.omega_sd}, {"bias_sd", p.bias_sd},
-                            {"bias_common_sd", p.bias_common_sd}, {"range_scale_sd", p.range_scale_sd}})
+                            {"bias_common_sd", p.bias_common_sd}, {"range_scale_sd", p.range_scale_sd},
+                            {"antenna_sd", p.antenna_sd}})
     out.real("prior", key, value);
 }
 

@@ -10,7 +10,11 @@
 // body origin (the problem is planar: the height difference only shortens
 // the horizontal part), a_j the anchor. The constants, each chosen in the
 // configuration: a bias b_ij per link (one node each, only in that link's
-// factors: bias_<i>_<j>), and a common range scale s (1 when off).
+// factors: bias_<i>_<j>), a common range scale s (1 when off), and each
+// tag's antenna delay as a function of the bearing β of the anchor in the
+// body frame, g_i(β) = Σ_{k=1..K} a_ik cos kβ + b_ik sin kβ (K harmonics,
+// antenna_<i>_c<k>, antenna_<i>_s<k>; only in tag i's factors):
+//   range = s · ‖…‖ + b_ij + g_i(β_ij).
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,6 +37,8 @@ class PlanarRigidBody final : public Model {
     double range_sd = 0.07;
     bool link_biases = true;                ///< a bias per link
     bool range_scale = false;               ///< a common range scale
+    /// K: harmonics of each tag's bearing-dependent antenna delay (0: none)
+    int antenna_harmonics = 0;
     RobustLoss range_loss;                  ///< on every range
     double ekf_gate = 0;                    ///< EKF NIS gate of every range (0: none)
     Eigen::Vector3d start{0, 0, 0};         ///< prior mean of [px, py, yaw]
@@ -44,6 +50,7 @@ class PlanarRigidBody final : public Model {
     double bias_sd = 0.3;
     double bias_common_sd = 0.0;
     double range_scale_sd = 0.05;           ///< prior σ of the scale (mean 1)
+    double antenna_sd = 0.03;               ///< prior σ of each harmonic's coefficient (mean 0), m
   };
 
   explicit PlanarRigidBody(const Params& p);
@@ -84,7 +91,10 @@ class PlanarRigidBody final : public Model {
   /// Each link's mean geometric distance along the truth's rows.
   Eigen::VectorXd meanTrueDistances(const Truth& truth) const;
   Params p_;
-  int i_bias_ = -1, i_scale_ = -1;
+  /// g_i(β) and ∂g/∂β of tag t at bearing (cos β, sin β); 0 without harmonics.
+  double antennaDelay(std::size_t t, double cos_b, double sin_b, const Eigen::VectorXd& xb, double* dg_dbeta,
+                      Eigen::MatrixXd* J_h_xb) const;
+  int i_bias_ = -1, i_scale_ = -1, i_antenna_ = -1;
 };
 
 }  // namespace gssm::models
