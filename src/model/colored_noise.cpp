@@ -95,6 +95,10 @@ class ColoredNoiseModel final : public Model {
   const ColoredNoise& coloredNoise() const { return noise_; }
   std::string name() const override { return inner_->name(); }
 
+  // The error states' own step φe is linear, h adds e: affine where the inner model is.
+  bool processIsAffine() const override { return inner_->processIsAffine(); }
+  bool measurementIsAffine(int channel) const override { return inner_->measurementIsAffine(channel); }
+
   Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::VectorXd& u, double dt,
                     Eigen::MatrixXd* J_f_xc, Eigen::MatrixXd* J_f_xb) const override {
     const double phi = std::exp(-dt / noise_.tau);

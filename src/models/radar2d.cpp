@@ -41,6 +41,14 @@ Eigen::VectorXd Radar2D::f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
 // α = x/ρ and β = h/ρ (the paper's H row [β, α] on [h, x_k]).
 Eigen::VectorXd Radar2D::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                            Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  Eigen::VectorXd out;
+  hInto(0, xc, xb, out, J_h_xc, J_h_xb);
+  return out;
+}
+
+void Radar2D::hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
+                    Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  this->channel(channel);  // range check: throws, naming the channels
   const double x = xc[0], alt = xb[1];
   const double rho = std::hypot(x, alt);
   if (J_h_xc || J_h_xb) {
@@ -53,7 +61,8 @@ Eigen::VectorXd Radar2D::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
       *J_h_xb << 0.0, alt * inv;
     }
   }
-  return Eigen::VectorXd::Constant(1, rho);
+  out.resize(1);
+  out[0] = rho;
 }
 
 namespace {

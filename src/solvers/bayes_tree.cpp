@@ -7,9 +7,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <optional>
 #include <ccolamd.h>
 #include <sstream>
+#include <type_traits>
 #include <unordered_set>
 
 #include "gssm/core/error.h"
@@ -41,21 +43,22 @@ void chartJacobian(const std::vector<int>& blocks, int offset, const Eigen::Ref<
 template <class T>
 class KeyTable {
  public:
+  KeyTable() {}  // user-provided: `KeyTable{}` must not zero the inline entries first
   void set(const Key& k, T v) {
     if (!big_.empty()) {
       big_[k] = v;
       return;
     }
     for (std::size_t i = 0; i < size_; ++i)
-      if (small_[i].first == k) {
-        small_[i].second = v;
+      if (small_.entry[i].key == k) {
+        small_.entry[i].value = v;
         return;
       }
     if (size_ < kSmall) {
-      small_[size_++] = {k, v};
+      new (&small_.entry[size_++]) Entry{k, v};
       return;
     }
-    for (std::size_t i = 0; i < size_; ++i) big_.emplace(small_[i].first, small_[i].second);
+    for (std::size_t i = 0; i < size_; ++i) big_.emplace(small_.entry[i].key, small_.entry[i].value);
     size_ = 0;
     big_[k] = v;
   }
@@ -65,7 +68,7 @@ class KeyTable {
       return it == big_.end() ? nullptr : &it->second;
     }
     for (std::size_t i = 0; i < size_; ++i)
-      if (small_[i].first == k) return &small_[i].second;
+      if (small_.entry[i].key == k) return &small_.entry[i].value;
     return nullptr;
   }
   bool count(const Key& k) const { return find(k) != nullptr; }
@@ -77,7 +80,17 @@ class KeyTable {
 
  private:
   static constexpr std::size_t kSmall = 16;
-  std::array<std::pair<Key, T>, kSmall> small_;
+  struct Entry {
+    Key key;
+    T value;
+  };
+  static_assert(std::is_trivially_copyable_v<Entry> && std::is_trivially_destructible_v<Entry>);
+  // Left uninitialized (entries [0, size_) are made as they are set):
+  // zeroing 16 entries cost more than the lookups of a 3-variable update.
+  union Inline {
+    Inline() {}
+    Entry entry[kSmall];
+  } small_;
   std::size_t size_ = 0;
   std::unordered_map<Key, T, KeyHash> big_;
 };
@@ -207,6 +220,7 @@ void BayesTreeEngine::storeLinearization(Slot& s, const LinearView& f) {
 
 void BayesTreeEngine::storeClique(const EliminatedClique& e, Clique& c) {
   c.frontal = e.frontal;
+  c.solved = false;
   const KeyList& sep = e.marginal.keys();
   c.nsep = narrow16(static_cast<Eigen::Index>(sep.size()));
   c.dv = narrow16(e.conditional.rows());
@@ -258,6 +272,12 @@ void BayesTreeEngine::estimateInto(const Key& k, const Var& v, Eigen::VectorXd& 
   retractBlocks(out, v.delta(), *r.blocks, r.offset);
 }
 
+void BayesTreeEngine::estimateInto(const Key& k, Eigen::VectorXd& out) const {
+  const Var* v = vars_.find(k);
+  if (!v) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
+  estimateInto(k, *v, out);
+}
+
 Eigen::VectorXd BayesTreeEngine::estimate(const Key& k) const {
   const Var* v = vars_.find(k);
   if (!v) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
@@ -306,7 +326,7 @@ LinearFactor BayesTreeEngine::linearize(const SlotFactor& f, const Model* model,
   }
   lf.setKeys(keys);
   Eigen::VectorXd& r = scratch_.r;
-  std::vector<Eigen::MatrixXd>& J = scratch_.J;
+  std::vector<Eigen::MatrixXd>& J = scratch_.J[std::min<std::size_t>(keys.size(), scratch_.J.size() - 1)];
   f.linearizeRobustAt(model, scratch_.x.data(), r, &J);  // robust factors reweighted at each linearization
   bool finite = r.allFinite();
   for (const auto& a : J) finite = finite && a.allFinite();
@@ -722,6 +742,7 @@ Eigen::Index BayesTreeEngine::stackFactors(UpdatePlan& p, const EliminationQueue
 // slots, and re-attach the orphans below the lowest of their separator's
 // cliques. Nothing here throws short of memory.
 void BayesTreeEngine::commit(UpdatePlan& p, EngineCounts& counts) {
+  forgetSolved();
   model_ = p.model;
   for (int s : p.update.remove) killSlot(s);
   commitFactors(p, counts);
@@ -851,8 +872,17 @@ void BayesTreeEngine::backSubstituteTop(const UpdatePlan& p, EngineCounts& count
   clearKeepingSmall(stack);  // a wildfire through the whole history grew it
 }
 
+void BayesTreeEngine::forgetSolved() {
+  for (int c : solved_cliques_) cliques_[static_cast<std::size_t>(c)].solved = false;
+  clearKeepingSmall(solved_cliques_);
+}
+
 void BayesTreeEngine::backSubstitute(int c) {
-  const Clique& cl = cliques_[static_cast<std::size_t>(c)];
+  Clique& cl = cliques_[static_cast<std::size_t>(c)];
+  if (!cl.solved) {
+    cl.solved = true;
+    solved_cliques_.push_back(c);
+  }
   const auto C = conditional(cl);  // [R S d]
   // Solved in the frontal's own δ (its size: no allocation), the products
   // in a buffer that only grows (a scratch vector resized between a state's
@@ -867,7 +897,17 @@ void BayesTreeEngine::backSubstitute(int c) {
   Eigen::Index col = 0;
   for (const auto& k : separator(cl)) {
     const auto ds = vars_.at(k).delta();
-    term.noalias() = S.middleCols(col, ds.size()) * ds;  // the product, then the difference
+    if (n <= 8) {
+      // The product S_k·δ_k by columns, then the difference, in plain loops:
+      // at a state's size Eigen's product expression cost more than the
+      // arithmetic (its operands built on the stack, then reloaded).
+      const double* Sk = C.data() + (n + col) * n;
+      for (Eigen::Index i = 0; i < n; ++i) term[i] = 0;
+      for (Eigen::Index j = 0; j < ds.size(); ++j)
+        for (Eigen::Index i = 0; i < n; ++i) term[i] += Sk[i + j * n] * ds[j];
+    } else {
+      term.noalias() = S.middleCols(col, ds.size()) * ds;
+    }
     rhs -= term;
     col += ds.size();
   }
@@ -887,6 +927,7 @@ void BayesTreeEngine::backSubstitute(int c) {
 }
 
 void BayesTreeEngine::setEstimates(const Values& x) {
+  forgetSolved();
   Eigen::VectorXd d;
   for (const auto& kv : x) {
     Var& v = vars_.at(kv.first);
@@ -927,7 +968,10 @@ void BayesTreeEngine::solvePath(const Key& k) {
   std::vector<int>& path = scratch_.path;
   path.clear();
   for (int c = vars_.at(k).clique; c >= 0; c = cliques_[static_cast<std::size_t>(c)].parent) path.push_back(c);
-  for (auto it = path.rbegin(); it != path.rend(); ++it) backSubstitute(*it);
+  // Root first; a clique solved since the last change has solved ancestors,
+  // so the path's solved part is its top and is skipped (the same numbers).
+  for (auto it = path.rbegin(); it != path.rend(); ++it)
+    if (!cliques_[static_cast<std::size_t>(*it)].solved) backSubstitute(*it);
   clearKeepingSmall(path);  // an old state's path grew it to the history's length
 }
 
@@ -960,6 +1004,33 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
 // system (8k instructions per fixed-lag update before) or even listing the
 // path. Y = R⁻ᵀ by forward substitution, column by column; Σ = YᵀY is
 // symmetric as computed (entry (i, j) and (j, i) sum the same products).
+void BayesTreeEngine::marginalSd(const Key& k, Eigen::VectorXd& out) const {
+  const Var* v = vars_.find(k);
+  if (!v) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
+  const Clique& c = cliques_[static_cast<std::size_t>(v->clique)];
+  if (c.parent >= 0 || rotationsOf(k).blocks) {
+    out = pathMarginalCovariance({k}).diagonal().cwiseSqrt();
+    return;
+  }
+  // rootCovariance's Y = R⁻¹ and its diagonal Σ(i, i) = Σ_k≥i Y(k, i)², the same loops.
+  const auto R = conditional(c).leftCols(c.dv);
+  const Eigen::Index n = R.rows();
+  Eigen::MatrixXd& Y = scratch_.stacked;
+  Y.setIdentity(n, n);
+  for (Eigen::Index col = 0; col < n; ++col)
+    for (Eigen::Index i = col; i < n; ++i) {
+      double y = Y(i, col);
+      for (Eigen::Index j = col; j < i; ++j) y -= R(j, i) * Y(j, col);
+      Y(i, col) = y / R(i, i);
+    }
+  out.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double s = 0;
+    for (Eigen::Index j = i; j < n; ++j) s += Y(j, i) * Y(j, i);
+    out[i] = std::sqrt(s);
+  }
+}
+
 Eigen::MatrixXd BayesTreeEngine::rootCovariance(const Clique& root) const {
   const auto R = conditional(root).leftCols(root.dv);
   const Eigen::Index n = R.rows();
@@ -1050,7 +1121,7 @@ void BayesTreeEngine::forEachPathEntry(const std::vector<int>& path, const Offse
 
 double BayesTreeEngine::linearizationError(int slot) const {
   const Slot& s = slots_.at(static_cast<std::size_t>(slot));
-  if (!s.nonlinear) return 0.0;
+  if (!s.nonlinear || s.nonlinear.affine(model_)) return 0.0;  // exact: its error is rounding
   Scratch& e = scratch_;
   const LinearView f = slotView(s);
   pointAt(f.keys(), nullptr);  // x̂ = anchor + δ̂

@@ -14,6 +14,7 @@
 // engine's RecordStore.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -168,6 +169,9 @@ struct Clique {
   RecordStore::Ref record = 0;
   std::uint16_t nsep = 0, dv = 0, width = 0, mrows = 0;  // [R S d] is dv × (dv + width + 1); marginal mrows × (width + 1)
   int parent = -1;
+  /// δ of the frontal is its back-substitution from the current tree (and so
+  /// is every ancestor's): solvePath() need not redo it.
+  bool solved = false;
   SmallList<int, 2> owned;     // factor slots consumed by this clique's elimination
   SmallList<int, 2> children;  // a chain's clique owns two factors and has one child: inline
   std::size_t conditionalOffset() const { return nsep; }
@@ -308,6 +312,8 @@ class BayesTreeEngine {
   /// Current estimate anchor + δ (δ as of the last back-substitution that
   /// reached this variable; see solveAll()).
   Eigen::VectorXd estimate(const Key& k) const;
+  /// estimate(k) into `out` (its storage reused).
+  void estimateInto(const Key& k, Eigen::VectorXd& out) const;
   /// Sets δ so that the estimate of every variable in `x` is x (used by
   /// line searches; the next elimination must relinearize there).
   void setEstimates(const Values& x);
@@ -321,6 +327,10 @@ class BayesTreeEngine {
   /// Joint marginal covariance of keys that all lie on one root path (e.g. a
   /// state and the constants), from the conditionals on that path.
   Eigen::MatrixXd pathMarginalCovariance(const std::vector<Key>& keys) const;
+  /// The marginal standard deviations of one variable, into `out`: the
+  /// square roots of pathMarginalCovariance({k})'s diagonal, the same
+  /// numbers (without its matrices when k's clique is the root).
+  void marginalSd(const Key& k, Eigen::VectorXd& out) const;
 
   /// Whitened nonlinearity error ‖r(x̂) − r_lin(δ̂)‖ of a nonlinear slot at
   /// the current estimate; 0 for linear slots.
@@ -452,6 +462,7 @@ class BayesTreeEngine {
   void order(const std::vector<Key>& keys, const std::vector<std::pair<LinearView, InputSource>>& factors,
              const Values& new_vars, std::vector<Key>& out) const;
   void backSubstitute(int c);
+  void forgetSolved();  // after any change of the tree or of a δ
   int allocClique();
   int allocSlot();
   /// Lists slot s under each of its states (Var::slots).
@@ -467,6 +478,7 @@ class BayesTreeEngine {
   std::vector<Clique> cliques_;
   std::vector<bool> clique_alive_;
   std::vector<int> free_cliques_;
+  std::vector<int> solved_cliques_;  // those with `solved` set, to clear when the tree or a δ changes
   std::vector<Slot> slots_;
   std::vector<int> free_slots_;
   std::size_t slots_alive_ = 0, cliques_alive_ = 0;
@@ -483,7 +495,10 @@ class BayesTreeEngine {
     std::vector<const Var*> factor_vars;        // a factor's variables, null if new
     Eigen::VectorXd r, rlin, term;
     std::vector<double> product;  // backSubstitute's S·δ_sep, as long as the widest frontal
-    std::vector<Eigen::MatrixXd> J;  // a factor's Jacobian blocks, copied into its Ab
+    // A factor's Jacobian blocks, copied into its Ab: one set per number of
+    // keys (a process factor's 3 blocks, a measurement's 2), each keeping
+    // its shapes (one set resized 3 → 2 → 3 reallocated a block per factor).
+    std::array<std::vector<Eigen::MatrixXd>, 4> J;
     Eigen::MatrixXd stacked;  // a clique's [A | b] while it is triangularized
     std::vector<Eigen::Index> last_row;  // triangularize's: the last row each column's reflection reaches
     std::vector<Key> separator;

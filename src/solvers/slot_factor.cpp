@@ -1,21 +1,34 @@
 #include "solvers/slot_factor.h"
 
 #include <new>
+#include <type_traits>
+#include <typeinfo>
 
 #include "factors/model_factors.h"
 
 namespace gssm::internal {
 
+namespace {
+// f as a T (a final class: its exact type is the only match), by one type
+// comparison instead of dynamic_cast's walk of the hierarchy (two per new
+// factor of every update).
+template <class T>
+const T* exactly(const Factor* f) {
+  static_assert(std::is_final_v<T>);
+  return f && typeid(*f) == typeid(T) ? static_cast<const T*>(f) : nullptr;
+}
+}  // namespace
+
 const Model* SlotFactor::modelOf(const FactorPtr& f) {
-  if (const auto* p = dynamic_cast<const ProcessFactor*>(f.get())) return &p->model();
-  if (const auto* m = dynamic_cast<const MeasurementFactor*>(f.get())) return &m->model();
+  if (const auto* p = exactly<ProcessFactor>(f.get())) return &p->model();
+  if (const auto* m = exactly<MeasurementFactor>(f.get())) return &m->model();
   return nullptr;
 }
 
 SlotFactor::SlotFactor(const FactorPtr& f, const Model* model) : SlotFactor() {
   if (!f) return;
-  const auto* p = dynamic_cast<const ProcessFactor*>(f.get());
-  const auto* m = p ? nullptr : dynamic_cast<const MeasurementFactor*>(f.get());
+  const auto* p = exactly<ProcessFactor>(f.get());
+  const auto* m = p ? nullptr : exactly<MeasurementFactor>(f.get());
   if (p && &p->model() == model) {
     noise_ = p->noise();
     new (&step_) Step{p->dt(), p->input()};

@@ -68,6 +68,14 @@ class SlotFactor {
     }
     return states == 1 || *keys.begin() != *(keys.begin() + 1);
   }
+  /// Its linearization is exact everywhere (Model::processIsAffine, an affine
+  /// channel without a loss): no linearization check needed.
+  bool affine(const Model* model) const {
+    if (kind_ == Kind::Process) return model->processIsAffine();
+    if (kind_ == Kind::Measurement)
+      return loss_kind_ == static_cast<std::uint8_t>(RobustLoss::Kind::None) && model->measurementIsAffine(channel_);
+    return false;
+  }
   /// What Factor::linearizeRobustAt returns for the factor it was made from,
   /// with its variables' values in key order.
   double linearizeRobustAt(const Model* model, const Eigen::VectorXd* const* x, Eigen::VectorXd& r,

@@ -13,8 +13,10 @@ class SmootherCore {
   /// One update: add, then relinearize the top (start-up), then a full check
   /// when the constants moved, or iterate to convergence. Strong guarantee for
   /// the add; a failed relinearization is skipped and noted in the report.
+  /// `timed` false leaves the report's seconds to the caller (the fixed lag
+  /// times the update and its marginalization with one pair of clock reads).
   UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values,
-                      const std::vector<int>& remove_slots = {});
+                      const std::vector<int>& remove_slots = {}, bool timed = true);
   void fillSizes(UpdateReport& r) const;
   /// Checkpoint: the engine, the last report and the relinearization state.
   void save(internal::ByteWriter& out) const;
@@ -31,12 +33,14 @@ class SmootherCore {
   double levenbergMarquardt(UpdateReport& rep, internal::EngineCounts& counts, double& tree_lambda);
   double reEliminateUndamped(UpdateReport& rep, internal::EngineCounts& counts, double cost);
   void newtonPolishTree(UpdateReport& rep, internal::EngineCounts& counts, double cost);
+  void checkAllWhenTheConstantsMoved(UpdateReport& rep, internal::EngineCounts& counts);
   Eigen::VectorXd constants_at_last_check_;
   // Variables held at the last full pass and added since (full_pass_growth).
   std::int64_t held_at_last_pass_ = 0, added_since_pass_ = 0;
   // Per-update buffers kept for their capacity (not state: not saved).
   internal::EngineCounts counts_;
   std::vector<int> local_slots_;
+  Eigen::VectorXd constants_now_, constants_sd_;
 };
 
 }  // namespace gssm

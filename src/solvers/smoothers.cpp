@@ -229,9 +229,35 @@ void SmootherCore::newtonPolishTree(UpdateReport& rep, internal::EngineCounts& c
   else if (!failure.empty()) rep.note = "Newton polish stopped: " + failure;
 }
 
+// Old factors all touch the constants: check them all, in one bounded pass,
+// only when the constants moved enough to matter (in buffers: this runs
+// after every update).
+void SmootherCore::checkAllWhenTheConstantsMoved(UpdateReport& rep, internal::EngineCounts& counts) {
+  Eigen::VectorXd& xb = constants_now_;
+  engine.estimateInto(Key::constants(), xb);
+  if (constants_at_last_check_.size() != xb.size()) {
+    constants_at_last_check_ = xb;
+    return;
+  }
+  if (static_cast<double>(added_since_pass_) <
+      (options.full_pass_growth - 1) * static_cast<double>(held_at_last_pass_))
+    return;
+  // Grown enough for a pass (full_pass_growth); only then the constants' marginal.
+  Eigen::VectorXd& sd = constants_sd_;
+  engine.marginalSd(Key::constants(), sd);
+  const double moved = ((xb - constants_at_last_check_).cwiseAbs().array() / sd.array()).maxCoeff();
+  if (moved <= options.constants_check_sigmas) return;
+  counts.variables_backsubstituted += engine.solveAll();
+  relinearize(engine.nonlinearSlots(), options.relinearize_threshold, rep, counts);
+  rep.relinearization_pass = true;
+  engine.estimateInto(Key::constants(), constants_at_last_check_);
+  held_at_last_pass_ = static_cast<std::int64_t>(engine.numVariables());
+  added_since_pass_ = 0;
+}
+
 UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, const Values& new_values,
-                                  const std::vector<int>& remove_slots) {
-  const auto start = std::chrono::steady_clock::now();
+                                  const std::vector<int>& remove_slots, bool timed) {
+  const auto start = timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
   UpdateReport rep;
   rep.new_factors = static_cast<int>(new_factors.size());
   rep.new_variables = static_cast<int>(new_values.size());
@@ -262,35 +288,14 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
       relinearize(local, options.relinearize_threshold, rep, counts);
       if (rep.iterations == before) break;
     }
-    // Old factors all touch the constants: check them all, in one bounded
-    // pass, only when the constants moved enough to matter.
-    if (engine.hasVariable(Key::constants())) {
-      const Eigen::VectorXd xb = engine.estimate(Key::constants());
-      if (constants_at_last_check_.size() != xb.size()) {
-        constants_at_last_check_ = xb;
-      } else if (static_cast<double>(added_since_pass_) >=
-                 (options.full_pass_growth - 1) * static_cast<double>(held_at_last_pass_)) {
-        // Grown enough for a pass (full_pass_growth); only then the constants' marginal.
-        const Eigen::VectorXd sd =
-            engine.pathMarginalCovariance({Key::constants()}).diagonal().cwiseSqrt();
-        const double moved = ((xb - constants_at_last_check_).cwiseAbs().array() / sd.array()).maxCoeff();
-        if (moved > options.constants_check_sigmas) {
-          counts.variables_backsubstituted += engine.solveAll();
-          relinearize(engine.nonlinearSlots(), options.relinearize_threshold, rep, counts);
-          rep.relinearization_pass = true;
-          constants_at_last_check_ = engine.estimate(Key::constants());
-          held_at_last_pass_ = static_cast<std::int64_t>(engine.numVariables());
-          added_since_pass_ = 0;
-        }
-      }
-    }
+    if (engine.hasVariable(Key::constants())) checkAllWhenTheConstantsMoved(rep, counts);
   }
   rep.cliques_reeliminated = counts.cliques_reeliminated;
   rep.orphans = counts.orphans;
   rep.factors_relinearized = counts.factors_relinearized;
   rep.variables_backsubstituted = counts.variables_backsubstituted;
   fillSizes(rep);
-  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (timed) rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   last = rep;
   return rep;
 }
@@ -358,10 +363,10 @@ UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Val
       newest = std::max(newest, kv.first.step);
       if (oldest_ < 0) oldest = oldest < 0 ? kv.first.step : std::min(oldest, kv.first.step);
     }
-  UpdateReport rep = core_->update(f, v);
+  const auto start = std::chrono::steady_clock::now();
+  UpdateReport rep = core_->update(f, v, {}, false);
   newest_ = newest;
   oldest_ = oldest;
-  const auto start = std::chrono::steady_clock::now();
   while (oldest_ >= 0 && oldest_ < newest_ - options_.window + 1) {
     // States inserted for late measurements next to it are eliminated before
     // it (their keys sort first): marginalized first, leaves first.
@@ -377,7 +382,7 @@ UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Val
     ++rep.variables_marginalized;
   }
   core_->fillSizes(rep);
-  rep.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   core_->last = rep;
   return rep;
 }

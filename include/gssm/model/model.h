@@ -136,6 +136,16 @@ class Model {
   virtual Eigen::MatrixXd processNoiseOf(double dt, const Eigen::VectorXd& u) const;
   virtual bool processNoiseDependsOnInput() const { return false; }
 
+  /// True when f is affine in (x_c, x_b) for every u and dt and x_c has no
+  /// rotation block: a process factor's linearization is then exact
+  /// everywhere, and the smoothers skip its linearization check (the
+  /// residual wrap of an angle state moves nothing below |r| = π).
+  /// Default false (always safe).
+  virtual bool processIsAffine() const { return false; }
+  /// The same for channel c's h (a robust loss still makes its factor's
+  /// weight move: those are checked whatever this says). Default false.
+  virtual bool measurementIsAffine(int /*channel*/) const { return false; }
+
   const ModelDims& dims() const { return dims_; }
   const ModelNames& names() const { return names_; }
   const ModelNoise& noise() const { return noise_; }

@@ -29,6 +29,8 @@ class LinearModel final : public Model {
   explicit LinearModel(LinearSystem sys, Discretization d = Discretization::Euler);
 
   std::string name() const override { return "linear"; }
+  bool processIsAffine() const override { return true; }
+  bool measurementIsAffine(int) const override { return true; }
   const LinearSystem& system() const { return sys_; }
   Discretization discretization() const { return disc_; }
 

@@ -56,6 +56,7 @@ class PlanarRigidBody final : public Model {
   explicit PlanarRigidBody(const Params& p);
 
   std::string name() const override { return "planar_rigid_body"; }
+  bool processIsAffine() const override { return true; }  // constant velocity
   const Params& params() const { return p_; }
   std::vector<Eigen::Vector2d> landmarks() const override;
   /// The tags in the world frame: p + R(yaw)·l_i.

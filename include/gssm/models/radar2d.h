@@ -23,6 +23,7 @@ class Radar2D final : public Model {
   explicit Radar2D(const ModelNoise& noise);
 
   std::string name() const override { return "radar_2d"; }
+  bool processIsAffine() const override { return true; }  // x + ẋ·dt
 
   Eigen::VectorXd f(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     const Eigen::VectorXd& u, double dt, Eigen::MatrixXd* J_f_xc = nullptr,
@@ -30,6 +31,8 @@ class Radar2D final : public Model {
   using Model::h;  // h(channel, ...) for channel 0
   Eigen::VectorXd h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  void hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
+             Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
 };
 
 }  // namespace gssm::models
