@@ -42,12 +42,17 @@ StrapdownIns::Params driveParams(double T) {
 }
 
 TEST(StrapdownIns, JacobiansMatchTangentDifferencesAtEveryAttitude) {
-  const StrapdownIns model(driveParams(0.01));
+  for (double walk : {0.0, 1e-4}) {  // the gyro bias constant, then with its walking part β_g in x_c
+  StrapdownIns::Params params = driveParams(0.01);
+  params.gyro_bias_walk = walk;
+  const StrapdownIns model(params);
+  ASSERT_EQ(model.dims().nc, walk > 0 ? 13 : 10);
   const std::vector<Eigen::Vector3d> rpy{{0.01, -0.02, 0.3}, {0.3, M_PI / 2, 1.0}, {0.1, -0.2, M_PI - 1e-6},
                                          {0.0, 0.0, -M_PI + 1e-6}, {M_PI - 1e-3, 0.2, 2.0}};
   testing::expectJacobiansMatchDifferences(model, [&](std::mt19937& rng) {
     testing::JacobianPoint p;
-    p.xc = testing::uniformVector(rng, StrapdownIns::kStates, -20, 20);
+    p.xc = testing::uniformVector(rng, model.dims().nc, -20, 20);
+    if (walk > 0) p.xc.tail<3>() *= 1e-4;  // β_g in rad/s
     p.xc.head<3>() = so3::Log(so3::fromRollPitchYaw(rpy[std::uniform_int_distribution<std::size_t>(0, rpy.size() - 1)(rng)]));
     p.xb = testing::uniformVector(rng, StrapdownIns::kConstants, -0.1, 0.1);
     p.xb.segment<3>(StrapdownIns::kLever) = testing::uniformVector(rng, 3, -1, 1);
@@ -56,19 +61,25 @@ TEST(StrapdownIns, JacobiansMatchTangentDifferencesAtEveryAttitude) {
     p.dt = 0.01;
     return p;
   }, 40, 1e-5);
+  }
 }
 
 // Model::report against central differences on the stacked tangent (its
 // sds: J·Σ·Jᵀ) and against the model's own pieces (its values).
 TEST(StrapdownIns, ReportsAntennaVehicleAttitudeAndConstantsWithFirstOrderSds) {
-  const StrapdownIns model(driveParams(0.01));
-  const int n = StrapdownIns::kStates + StrapdownIns::kConstants;
+  for (double walk : {0.0, 1e-4}) {  // with β_g the reported gyro bias is b_g + β_g
+  StrapdownIns::Params params = driveParams(0.01);
+  params.gyro_bias_walk = walk;
+  const StrapdownIns model(params);
+  const int nc = model.dims().nc, n = nc + StrapdownIns::kConstants;
   const std::vector<int> angles{6, 7, 8, 19, 20, 21};  // degrees: differences wrap
   std::mt19937 rng(11);
   for (int trial = 0; trial < 6; ++trial) {
     Eigen::VectorXd x(n);
-    x << so3::Log(so3::fromRollPitchYaw(testing::uniformVector(rng, 3, -1.2, 1.2))), testing::uniformVector(rng, 6, -50, 50),
-        100.0, testing::uniformVector(rng, StrapdownIns::kConstants, -0.05, 0.05);
+    x.head<10>() << so3::Log(so3::fromRollPitchYaw(testing::uniformVector(rng, 3, -1.2, 1.2))),
+        testing::uniformVector(rng, 6, -50, 50), 100.0;
+    x.tail(StrapdownIns::kConstants) = testing::uniformVector(rng, StrapdownIns::kConstants, -0.05, 0.05);
+    x.segment(10, nc - 10) = testing::uniformVector(rng, nc - 10, -0.01, 0.01);
     const Eigen::MatrixXd A = testing::uniformVector(rng, n * n, -0.03, 0.03).reshaped(n, n);
     const Eigen::MatrixXd cov = A * A.transpose();
     Eigen::VectorXd value, sd;
@@ -93,8 +104,10 @@ TEST(StrapdownIns, ReportsAntennaVehicleAttitudeAndConstantsWithFirstOrderSds) {
     // not the frame's tilt over the distance from the anchor (50 m / R_E)
     for (int i = 0; i < m; ++i)
       EXPECT_NEAR(sd[i], numeric[i], (i < 3 ? 1e-3 : 1e-6) * numeric[i] + 1e-12)
-          << model.reportNames()[static_cast<std::size_t>(i)];
-    const Eigen::VectorXd xc = x.head(StrapdownIns::kStates), xb = x.tail(StrapdownIns::kConstants);
+          << model.reportNames()[static_cast<std::size_t>(i)] << " (gyro bias walk " << walk << ")";
+    const Eigen::VectorXd xc = x.head(nc), xb = x.tail(StrapdownIns::kConstants);
+    const Eigen::Vector3d bias = xb.head<3>() + (walk > 0 ? Eigen::Vector3d(xc.tail<3>()) : Eigen::Vector3d::Zero());
+    EXPECT_LT((value.segment<3>(9) - bias).norm(), 1e-15);
     const geodesy::Geodetic g = model.frame().local().toGeodetic(model.h(StrapdownIns::kGnss, xc, xb));
     EXPECT_NEAR(value[0], g.lat * 180 / M_PI, 1e-12);
     EXPECT_NEAR(value[1], g.lon * 180 / M_PI, 1e-12);
@@ -103,6 +116,7 @@ TEST(StrapdownIns, ReportsAntennaVehicleAttitudeAndConstantsWithFirstOrderSds) {
     EXPECT_LT((value.segment<3>(15) - R_vb * xb.segment<3>(StrapdownIns::kLever)).norm(), 1e-12);
     EXPECT_LT((so3::fromRollPitchYaw(value.segment<3>(6) * M_PI / 180) - so3::Exp(xc.head<3>()) * R_vb.transpose()).norm(),
               1e-12);
+  }
   }
 }
 

@@ -14,9 +14,12 @@ namespace gssm::models {
 namespace {
 using so3::hat;
 
-ModelNames insNames() {
+int insStates(const StrapdownIns::Params& p) { return StrapdownIns::kStates + (p.gyro_bias_walk > 0 ? 3 : 0); }
+
+ModelNames insNames(const StrapdownIns::Params& p) {
   ModelNames n;
   n.state = {"att_x", "att_y", "att_z", "vn", "ve", "vd", "pn", "pe", "pd", "clock"};
+  if (p.gyro_bias_walk > 0) n.state.insert(n.state.end(), {"bgw_x", "bgw_y", "bgw_z"});
   n.constants = {"bg_x", "bg_y", "bg_z", "ba_x", "ba_y", "ba_z", "lever_x", "lever_y", "lever_z",
                  "mount_roll", "mount_pitch", "mount_yaw", "imu_delay", "sg_x", "sg_y", "sg_z", "sa_x", "sa_y", "sa_z", "clock_rate"};
   n.input = {"gx", "gy", "gz", "ax", "ay", "az"};
@@ -26,10 +29,14 @@ ModelNames insNames() {
 
 // θ: the gyro's white noise in the body tangent; (v, p): white acceleration,
 // σ_a²·[[dt, dt²/2], [dt²/2, dt³/3]] on each axis (isotropic: R·σ²I·Rᵀ = σ²I);
-// the clock: its wander beyond the constant rate.
+// the clock: its wander beyond the constant rate; β_g: its walk.
 Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
-  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(10, 10);
+  const int nc = insStates(p);
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(nc, nc);
   Q(9, 9) = p.clock_wander_sd * p.clock_wander_sd * dt;
+  if (nc > StrapdownIns::kStates)
+    Q.block<3, 3>(StrapdownIns::kGyroWalk, StrapdownIns::kGyroWalk).diagonal().setConstant(
+        p.gyro_bias_walk * p.gyro_bias_walk * dt);
   const double g = p.gyro_sd * p.gyro_sd, a = p.accel_sd * p.accel_sd;
   for (int i = 0; i < 3; ++i) {
     Q(i, i) = g * dt;
@@ -45,14 +52,19 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
                    p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd,
                    p.gyro_scale_sd, p.accel_scale_sd, p.clock_rate_sd, p.clock_wander_sd})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
+  if (!(p.gyro_bias_walk >= 0) || !std::isfinite(p.gyro_bias_walk))
+    throw InvalidArgument("StrapdownIns: gyro_bias_walk must be >= 0 (0: a constant gyro bias)");
   ModelNoise n;
   n.T = p.T;
   n.Q = insProcessNoise(p, p.T);
   n.R = Eigen::Matrix3d::Identity() * p.gnss_sd * p.gnss_sd;
-  Eigen::VectorXd mean(10), sd(10);
-  mean << so3::Log(so3::fromRollPitchYaw(p.start_rpy)), p.start_velocity, p.start_position, 0.0;
-  sd << Eigen::Vector3d::Constant(p.attitude_sd), Eigen::Vector3d::Constant(p.velocity_sd),
+  const int nc = insStates(p);
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(nc), sd(nc);
+  mean.head<10>() << so3::Log(so3::fromRollPitchYaw(p.start_rpy)), p.start_velocity, p.start_position, 0.0;
+  sd.head<10>() << Eigen::Vector3d::Constant(p.attitude_sd), Eigen::Vector3d::Constant(p.velocity_sd),
       Eigen::Vector3d::Constant(p.position_sd), p.clock_wander_sd * std::sqrt(p.T);  // the clock starts at 0
+  // β_g starts at 0 (b_g holds the bias at the start), as firmly as the clock.
+  if (nc > 10) sd.tail<3>().setConstant(p.gyro_bias_walk * std::sqrt(p.T));
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
   bmean.segment<3>(StrapdownIns::kLever) = so3::fromRollPitchYaw(p.mount_rpy).transpose() * p.lever;  // IMU axes
@@ -75,7 +87,7 @@ MeasurementChannel channelOf(const std::string& name, std::vector<std::string> c
 }  // namespace
 
 StrapdownIns::StrapdownIns(const Params& p)
-    : Model({kStates, kConstants, 6, 3}, insNames(), insNoise(p)),
+    : Model({insStates(p), kConstants, 6, 3}, insNames(p), insNoise(p)),
       p_(p),
       frame_(p.anchor),
       mount0_(so3::fromRollPitchYaw(p.mount_rpy)) {
@@ -114,23 +126,31 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
   const Eigen::Vector3d gyro = u.head<3>(), accel = u.tail<3>();
   const Eigen::Vector3d gyro_c = gyro - xb.segment<3>(kGyroScale).cwiseProduct(gyro);
   const Eigen::Vector3d accel_c = accel - xb.segment<3>(kAccelScale).cwiseProduct(accel);
-  const strapdown::NavState next = strapdown::step(x, gyro_c, accel_c, xb.segment<3>(kGyroBias),
-                                                   xb.segment<3>(kAccelBias), dt, frame_,
-                                                   J_f_xc || J_f_xb ? &J : nullptr);
+  const int nc = dims().nc;
+  const Eigen::Vector3d gyro_bias =
+      gyroBiasWalks() ? Eigen::Vector3d(xb.segment<3>(kGyroBias) + xc.segment<3>(kGyroWalk))
+                      : Eigen::Vector3d(xb.segment<3>(kGyroBias));
+  const strapdown::NavState next = strapdown::step(x, gyro_c, accel_c, gyro_bias, xb.segment<3>(kAccelBias), dt,
+                                                   frame_, J_f_xc || J_f_xb ? &J : nullptr);
   if (J_f_xc) {
-    J_f_xc->setZero(kStates, kStates);
+    J_f_xc->setZero(nc, nc);
     J_f_xc->topLeftCorner<9, 9>() = J.J_next_x;
     (*J_f_xc)(kClock, kClock) = 1;
+    if (gyroBiasWalks()) {
+      J_f_xc->block<9, 3>(0, kGyroWalk) = J.J_next_bg;  // β_g enters as b_g does
+      J_f_xc->block<3, 3>(kGyroWalk, kGyroWalk).setIdentity();
+    }
   }
   if (J_f_xb) {
-    J_f_xb->setZero(kStates, kConstants);
+    J_f_xb->setZero(nc, kConstants);
     J_f_xb->block<9, 3>(0, kGyroBias) = J.J_next_bg;
     J_f_xb->block<9, 3>(0, kAccelBias) = J.J_next_ba;
     J_f_xb->block<9, 3>(0, kGyroScale) = J.J_next_bg * gyro.asDiagonal();
     J_f_xb->block<9, 3>(0, kAccelScale) = J.J_next_ba * accel.asDiagonal();
   }
-  Eigen::VectorXd out(kStates);
-  out << so3::Log(next.R), next.v, next.p, xc[kClock] + dt;
+  Eigen::VectorXd out(nc);
+  out.head<10>() << so3::Log(next.R), next.v, next.p, xc[kClock] + dt;
+  if (gyroBiasWalks()) out.tail<3>() = xc.segment<3>(kGyroWalk);
   return out;
 }
 
@@ -146,7 +166,7 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
   if (channel == kNhc) return vehicleVelocity(xc, xb, J_h_xc, J_h_xb);
   if (channel == kZaru) return restingGyro(xc, xb, J_h_xc, J_h_xb);
   if (J_h_xc) {
-    J_h_xc->setZero(3, kStates);
+    J_h_xc->setZero(3, dims().nc);
     J_h_xc->middleCols<3>(3).setIdentity();
   }
   if (J_h_xb) J_h_xb->setZero(3, kConstants);
@@ -165,7 +185,7 @@ Eigen::VectorXd StrapdownIns::antenna(const Eigen::VectorXd& xc, const Eigen::Ve
   const Eigen::Vector3d v = xc.segment<3>(3), w = xb.segment<3>(kLever);
   const double delay = xb[kDelay] + xb[kClockRate] * xc[kClock];
   if (J_h_xc) {
-    J_h_xc->setZero(3, kStates);
+    J_h_xc->setZero(3, dims().nc);
     J_h_xc->leftCols<3>() = -R * hat(w);
     J_h_xc->middleCols<3>(3).diagonal().setConstant(-delay);
     J_h_xc->middleCols<3>(6).setIdentity();
@@ -190,7 +210,7 @@ Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const E
   const Eigen::Vector3d u = R.transpose() * xc.segment<3>(3);
   const Eigen::Vector3d w = M * u;
   if (J_h_xc) {
-    J_h_xc->setZero(2, kStates);
+    J_h_xc->setZero(2, dims().nc);
     J_h_xc->leftCols<3>() = (M * hat(u)).bottomRows<2>();
     J_h_xc->middleCols<3>(3) = (M * R.transpose()).bottomRows<2>();
   }
@@ -203,18 +223,20 @@ Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const E
 
 // What the gyro reads while the car stands: its bias and the Earth's rate in
 // the IMU's axes (the scale factor's part of it, 1e-7 rad/s, left out):
-// y = b_g + Rᵀ·ω_ie; ∂y/∂δθ = [Rᵀ·ω_ie]×, ∂y/∂b_g = I.
+// y = b_g (+ β_g) + Rᵀ·ω_ie; ∂y/∂δθ = [Rᵀ·ω_ie]×, ∂y/∂b_g = ∂y/∂β_g = I.
 Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                                           Eigen::MatrixXd* J_h_xb) const {
   const Eigen::Vector3d w = so3::Exp(xc.head<3>()).transpose() * frame_.earthRate();
   if (J_h_xc) {
-    J_h_xc->setZero(3, kStates);
+    J_h_xc->setZero(3, dims().nc);
     J_h_xc->leftCols<3>() = hat(w);
+    if (gyroBiasWalks()) J_h_xc->middleCols<3>(kGyroWalk).setIdentity();
   }
   if (J_h_xb) {
     J_h_xb->setZero(3, kConstants);
     J_h_xb->middleCols<3>(kGyroBias).setIdentity();
   }
+  if (gyroBiasWalks()) return xb.segment<3>(kGyroBias) + xc.segment<3>(kGyroWalk) + w;
   return xb.segment<3>(kGyroBias) + w;
 }
 
@@ -262,6 +284,8 @@ std::vector<ParamSpec> insParams() {
       real("prior", "delay_sd", "prior σ of the IMU's time delay at the start (s, added to its stamps), mean 0"),
       real("prior", "clock_rate_sd", "prior σ of the IMU clock's rate error (s/s: the delay grows by it), mean 0"),
       real("model", "clock_wander_sd", "the IMU clock's wander beyond its constant rate (s/√s)"),
+      learnable(real("model", "gyro_bias_walk",
+                     "the gyro bias's random walk beyond its constant part (rad/s/√s; 0: a constant bias)")),
       real("prior", "gyro_scale_sd", "prior σ of each gyro axis's scale factor error (1 = 100 %), mean 0"),
       real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error, mean 0")};
   return p;
@@ -345,7 +369,7 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
                             {"gnss_sd", &p.gnss_sd}, {"nhc_sd", &p.nhc_sd}, {"nhc_down_sd", &p.nhc_down_sd},
                             {"zupt_sd", &p.zupt_sd}, {"zaru_sd", &p.zaru_sd},
-                            {"clock_wander_sd", &p.clock_wander_sd}})
+                            {"clock_wander_sd", &p.clock_wander_sd}, {"gyro_bias_walk", &p.gyro_bias_walk}})
     *value = in.real("model", key, *value);
   if (in.has("prior", "lever")) p.lever = in.vector("prior", "lever", 3);
   const bool from_data = in.has("prior", "start") && in.text("prior", "start") == "data";
@@ -376,7 +400,7 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   for (auto [key, value] : {std::pair{"gyro_sd", p.gyro_sd}, {"accel_sd", p.accel_sd}, {"gnss_sd", p.gnss_sd},
                             {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
                             {"zupt_sd", p.zupt_sd}, {"zaru_sd", p.zaru_sd},
-                            {"clock_wander_sd", p.clock_wander_sd}})
+                            {"clock_wander_sd", p.clock_wander_sd}, {"gyro_bias_walk", p.gyro_bias_walk}})
     out.real("model", key, value);
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);
   out.vector("prior", "start_velocity", p.start_velocity);

@@ -12,7 +12,7 @@ namespace gssm::models {
 
 namespace {
 constexpr double kDegPerRad = 180.0 / M_PI;  // rad → deg
-constexpr int kNc = StrapdownIns::kStates, kTheta = 0, kVel = 3;
+constexpr int kTheta = 0, kVel = 3;
 }  // namespace
 
 std::vector<std::string> StrapdownIns::reportNames() const {
@@ -25,8 +25,9 @@ std::vector<std::string> StrapdownIns::reportNames() const {
 // Rows of J (outputs × stacked tangent) and values, in reportNames' order.
 void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance, Eigen::VectorXd& value,
                           Eigen::VectorXd& sd) const {
-  const Eigen::VectorXd xc = mean.head(kNc), xb = mean.tail(kConstants);
-  const int n = kNc + kConstants, b = kNc;  // b: where x_b starts in the stacked state
+  const int nc = dims().nc;
+  const Eigen::VectorXd xc = mean.head(nc), xb = mean.tail(kConstants);
+  const int n = nc + kConstants, b = nc;  // b: where x_b starts in the stacked state
   constexpr int kOut = 29;
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(kOut, n);
   value.resize(kOut);
@@ -37,7 +38,7 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   const Eigen::Vector3d to_geo(kDegPerRad / (geodesy::meridianRadius(g.lat) + g.height),
                                kDegPerRad / ((geodesy::transverseRadius(g.lat) + g.height) * std::cos(g.lat)), -1.0);
   value.head<3>() << g.lat * kDegPerRad, g.lon * kDegPerRad, g.height;
-  J.block(0, 0, 3, kNc) = to_geo.asDiagonal() * J_xc;
+  J.block(0, 0, 3, nc) = to_geo.asDiagonal() * J_xc;
   J.block(0, b, 3, kConstants) = to_geo.asDiagonal() * J_xb;
   value.segment<3>(3) = xc.segment<3>(kVel);
   J.block<3, 3>(3, kVel).setIdentity();
@@ -49,6 +50,10 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   J.block<3, 3>(6, b + kMount) = -kDegPerRad * J_rpy * R_vb * E;
   value.segment<6>(9) = xb.segment<6>(kGyroBias);
   J.block<6, 6>(9, b + kGyroBias).setIdentity();
+  if (gyroBiasWalks()) {  // the gyro bias now: b_g + β_g
+    value.segment<3>(9) += xc.segment<3>(kGyroWalk);
+    J.block<3, 3>(9, kGyroWalk).setIdentity();
+  }
   // The lever arm in vehicle axes, R_vb·ℓ.
   const Eigen::Vector3d lever = xb.segment<3>(kLever);
   value.segment<3>(15) = R_vb * lever;

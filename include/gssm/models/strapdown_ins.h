@@ -6,7 +6,9 @@
 // constants are single nodes, each only in the factors that involve it:
 //
 //   x_c = [θ (IMU → NED, rotation block), v (m/s, NED), p (m, NED),
-//          c (the IMU clock's time since the start, s: f adds dt)]
+//          c (the IMU clock's time since the start, s: f adds dt),
+//          β_g (with gyro_bias_walk > 0: the gyro bias's slowly varying
+//            part, a random walk from 0; the bias is then b_g + β_g)]
 //   x_b = [b_g (rad/s), b_a (m/s²), ℓ (IMU → antenna in the IMU's axes, m:
 //            GNSS sees it so, whatever the mounting; in vehicle axes,
 //            R_vb·ℓ, it would bend with the weakly seen mounting roll and
@@ -65,6 +67,9 @@ class StrapdownIns final : public Model {
     double accel_scale_sd = 0.01;              ///< prior σ of the accelerometer's scale factor errors, mean 0
     double clock_rate_sd = 1e-3;               ///< prior σ of ρ (s/s), mean 0
     double clock_wander_sd = 1e-4;             ///< the clock's random walk beyond ρ (s/√s)
+    /// The gyro bias's random walk beyond the constant b_g (rad/s/√s); 0:
+    /// the bias is constant (x_c has no β_g)
+    double gyro_bias_walk = 0;
   };
 
   explicit StrapdownIns(const Params& p);
@@ -97,7 +102,10 @@ class StrapdownIns final : public Model {
   // Where each part of x_b starts.
   static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kGyroScale = 13,
                        kAccelScale = 16, kClockRate = 19, kConstants = 20;
-  static constexpr int kClock = 9, kStates = 10;  // in x_c
+  // In x_c: the navigation states (kStates of them), then β_g when the
+  // gyro bias walks (dims().nc = kStates + 3).
+  static constexpr int kClock = 9, kStates = 10, kGyroWalk = 10;
+  bool gyroBiasWalks() const { return p_.gyro_bias_walk > 0; }
   enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2, kZaru = 3 };
 
  private:
