@@ -47,7 +47,7 @@ void expectSameEstimates(const Model& declared, const SimulatedRun& run) {
     for (std::size_t i = 0; i < a.rows.size(); ++i) {
       const Eigen::ArrayXd scale = b.rows[i].mean.array().abs() + 1e-3;
       worst = std::max(worst, ((a.rows[i].mean - b.rows[i].mean).array().abs() / scale).maxCoeff());
-      const Eigen::ArrayXd cov_scale = b.rows[i].covariance.array().abs() + 1e-12;
+      const Eigen::ArrayXXd cov_scale = b.rows[i].covariance.array().abs() + 1e-12;
       worst = std::max(worst, ((a.rows[i].covariance - b.rows[i].covariance).array().abs() / cov_scale).maxCoeff());
     }
     EXPECT_LE(worst, 1e-12) << methodName(method) << ": the largest relative difference over every row";

@@ -999,39 +999,9 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   return S;
 }
 
-// One clique, the root (the constants, checked after every update): Σ =
-// R⁻¹R⁻ᵀ of its own conditional, densely, without assembling a sparse
-// system (8k instructions per fixed-lag update before) or even listing the
-// path. Y = R⁻ᵀ by forward substitution, column by column; Σ = YᵀY is
-// symmetric as computed (entry (i, j) and (j, i) sum the same products).
-void BayesTreeEngine::marginalSd(const Key& k, Eigen::VectorXd& out) const {
-  const Var* v = vars_.find(k);
-  if (!v) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
-  const Clique& c = cliques_[static_cast<std::size_t>(v->clique)];
-  if (c.parent >= 0 || rotationsOf(k).blocks) {
-    out = pathMarginalCovariance({k}).diagonal().cwiseSqrt();
-    return;
-  }
-  // rootCovariance's Y = R⁻¹ and its diagonal Σ(i, i) = Σ_k≥i Y(k, i)², the same loops.
-  const auto R = conditional(c).leftCols(c.dv);
-  const Eigen::Index n = R.rows();
-  Eigen::MatrixXd& Y = scratch_.stacked;
-  Y.setIdentity(n, n);
-  for (Eigen::Index col = 0; col < n; ++col)
-    for (Eigen::Index i = col; i < n; ++i) {
-      double y = Y(i, col);
-      for (Eigen::Index j = col; j < i; ++j) y -= R(j, i) * Y(j, col);
-      Y(i, col) = y / R(i, i);
-    }
-  out.resize(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    double s = 0;
-    for (Eigen::Index j = i; j < n; ++j) s += Y(j, i) * Y(j, i);
-    out[i] = std::sqrt(s);
-  }
-}
-
-Eigen::MatrixXd BayesTreeEngine::rootCovariance(const Clique& root) const {
+// Y with Yᵀ = R⁻¹ of the root clique's conditional (lower triangular), by
+// forward substitution column by column, in scratch_.stacked.
+const Eigen::MatrixXd& BayesTreeEngine::rootInverse(const Clique& root) const {
   const auto R = conditional(root).leftCols(root.dv);
   const Eigen::Index n = R.rows();
   Eigen::MatrixXd& Y = scratch_.stacked;
@@ -1042,6 +1012,36 @@ Eigen::MatrixXd BayesTreeEngine::rootCovariance(const Clique& root) const {
       for (Eigen::Index k = c; k < i; ++k) v -= R(k, i) * Y(k, c);
       Y(i, c) = v / R(i, i);
     }
+  return Y;
+}
+
+void BayesTreeEngine::marginalSd(const Key& k, Eigen::VectorXd& out) const {
+  const Var* v = vars_.find(k);
+  if (!v) throw InvalidArgument("no variable " + k.toString() + " in the smoother");
+  const Clique& c = cliques_[static_cast<std::size_t>(v->clique)];
+  if (c.parent >= 0 || rotationsOf(k).blocks) {
+    out = pathMarginalCovariance({k}).diagonal().cwiseSqrt();
+    return;
+  }
+  // rootCovariance's diagonal, Σ(i, i) = Σ_k≥i Y(k, i)², by its loops (the same bits).
+  const Eigen::MatrixXd& Y = rootInverse(c);
+  const Eigen::Index n = Y.rows();
+  out.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double s = 0;
+    for (Eigen::Index j = i; j < n; ++j) s += Y(j, i) * Y(j, i);
+    out[i] = std::sqrt(s);
+  }
+}
+
+// One clique, the root (the constants, checked after every update): Σ =
+// R⁻¹R⁻ᵀ of its own conditional, densely, without assembling a sparse
+// system (8k instructions per fixed-lag update before) or even listing the
+// path. Σ = YᵀY (rootInverse) is symmetric as computed (entry (i, j) and
+// (j, i) sum the same products).
+Eigen::MatrixXd BayesTreeEngine::rootCovariance(const Clique& root) const {
+  const Eigen::MatrixXd& Y = rootInverse(root);
+  const Eigen::Index n = Y.rows();
   Eigen::MatrixXd S(n, n);
   for (Eigen::Index j = 0; j < n; ++j)
     for (Eigen::Index i = 0; i < n; ++i) {

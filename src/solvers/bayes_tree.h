@@ -429,6 +429,7 @@ class BayesTreeEngine {
   [[noreturn]] static void throwRankDeficient(const Key& v, Eigen::Index component, const std::vector<Key>& sep);
   void commit(UpdatePlan& plan, EngineCounts& counts);
   // pathMarginalCovariance's two cases (bayes_tree.cpp).
+  const Eigen::MatrixXd& rootInverse(const Clique& root) const;
   Eigen::MatrixXd rootCovariance(const Clique& root) const;
   Eigen::MatrixXd bayesNetCovariance(const std::vector<Key>& keys) const;
   // Paths up to this many columns are solved densely (UWB: 6 + 25).
