@@ -224,14 +224,6 @@ void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen:
     if (ib >= 0) (*J_h_xb)(0, ib) = 1.0;
     if (i_scale_ >= 0) (*J_h_xb)(0, i_scale_) = rho;
   }
-  // The anchor in the body frame, seen from the tag: v = R(yaw)ᵀ(−d), β = atan2(v_y, v_x).
-  const Eigen::Vector2d v(-(c * d.x() + s * d.y()), -(-s * d.x() + c * d.y()));
-  const double vn2 = v.squaredNorm();
-  double dg_dbeta = 0, g = 0;
-  if (i_antenna_ >= 0 && vn2 > 0) {
-    const double vn = std::sqrt(vn2);
-    g = antennaDelay(t, v.x() / vn, v.y() / vn, xb, &dg_dbeta, J_h_xb);
-  }
   if (J_h_xc) {
     *J_h_xc = Eigen::MatrixXd::Zero(1, 6);
     if (rho > 0) {
@@ -239,22 +231,23 @@ void PlanarRigidBody::hInto(int channel, const Eigen::VectorXd& xc, const Eigen:
       (*J_h_xc)(0, 1) = scale * d.y() / rho;
       (*J_h_xc)(0, 2) = scale * (d.x() * -rl.y() + d.y() * rl.x()) / rho;  // R'(yaw) l = (−rl_y, rl_x)
     }
-    if (dg_dbeta != 0) {
-      // ∂β/∂v = (−v_y, v_x)/|v|²; ∂v/∂p = −Rᵀ; ∂v/∂yaw = ((v + l)_y, −(v + l)_x).
-      const Eigen::Vector2d db_dv = Eigen::Vector2d(-v.y(), v.x()) / vn2;
-      const Eigen::Vector2d vl = v + l.head<2>();
-      (*J_h_xc)(0, 0) += dg_dbeta * -(db_dv.x() * c - db_dv.y() * s);
-      (*J_h_xc)(0, 1) += dg_dbeta * -(db_dv.x() * s + db_dv.y() * c);
-      (*J_h_xc)(0, 2) += dg_dbeta * (db_dv.x() * vl.y() - db_dv.y() * vl.x());
-    }
   }
+  const double g = i_antenna_ >= 0 ? antennaDelay(t, c, s, d, xb, J_h_xc, J_h_xb) : 0.0;
   out.resize(1);
   out[0] = scale * rho + (ib >= 0 ? xb[ib] : 0.0) + g;
 }
 
-// g_t(β) = Σ_{k=2..K} a_k cos kβ + b_k sin kβ, cos kβ and sin kβ by the angle-sum recurrence.
-double PlanarRigidBody::antennaDelay(std::size_t t, double cos_b, double sin_b, const Eigen::VectorXd& xb,
-                                     double* dg_dbeta, Eigen::MatrixXd* J_h_xb) const {
+// The anchor in the body frame, seen from the tag: v = R(yaw)ᵀ(−d), β =
+// atan2(v_y, v_x); g_t(β) = Σ_{k=2..K} a_k cos kβ + b_k sin kβ, cos kβ and
+// sin kβ by the angle-sum recurrence. ∂β/∂v = (−v_y, v_x)/|v|²; ∂v/∂p =
+// −Rᵀ; ∂v/∂yaw = ((v + l)_y, −(v + l)_x).
+double PlanarRigidBody::antennaDelay(std::size_t t, double c, double s, const Eigen::Vector2d& d,
+                                     const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
+                                     Eigen::MatrixXd* J_h_xb) const {
+  const Eigen::Vector2d v(-(c * d.x() + s * d.y()), -(-s * d.x() + c * d.y()));
+  const double vn2 = v.squaredNorm();
+  if (!(vn2 > 0)) return 0.0;  // the anchor straight above the tag: no bearing
+  const double vn = std::sqrt(vn2), cos_b = v.x() / vn, sin_b = v.y() / vn;
   const int i0 = i_antenna_ + static_cast<int>(t) * antennaTermsPerTag(p_);
   double ck = cos_b * cos_b - sin_b * sin_b, sk = 2 * sin_b * cos_b, g = 0, dg = 0;  // k = 2
   for (int k = 2; k <= p_.antenna_harmonics; ++k) {
@@ -266,7 +259,13 @@ double PlanarRigidBody::antennaDelay(std::size_t t, double cos_b, double sin_b, 
     sk = sk * cos_b + ck * sin_b;
     ck = next_c;
   }
-  *dg_dbeta = dg;
+  if (J_h_xc && dg != 0) {
+    const Eigen::Vector2d db_dv = Eigen::Vector2d(-v.y(), v.x()) / vn2;
+    const Eigen::Vector2d vl = v + p_.tags[t].head<2>();
+    (*J_h_xc)(0, 0) += dg * -(db_dv.x() * c - db_dv.y() * s);
+    (*J_h_xc)(0, 1) += dg * -(db_dv.x() * s + db_dv.y() * c);
+    (*J_h_xc)(0, 2) += dg * (db_dv.x() * vl.y() - db_dv.y() * vl.x());
+  }
   return g;
 }
 

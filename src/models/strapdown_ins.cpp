@@ -60,11 +60,11 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   n.R = Eigen::Matrix3d::Identity() * p.gnss_sd * p.gnss_sd;
   const int nc = insStates(p);
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(nc), sd(nc);
-  mean.head<10>() << so3::Log(so3::fromRollPitchYaw(p.start_rpy)), p.start_velocity, p.start_position, 0.0;
-  sd.head<10>() << Eigen::Vector3d::Constant(p.attitude_sd), Eigen::Vector3d::Constant(p.velocity_sd),
+  mean.head<StrapdownIns::kStates>() << so3::Log(so3::fromRollPitchYaw(p.start_rpy)), p.start_velocity, p.start_position, 0.0;
+  sd.head<StrapdownIns::kStates>() << Eigen::Vector3d::Constant(p.attitude_sd), Eigen::Vector3d::Constant(p.velocity_sd),
       Eigen::Vector3d::Constant(p.position_sd), p.clock_wander_sd * std::sqrt(p.T);  // the clock starts at 0
   // β_g starts at 0 (b_g holds the bias at the start), as firmly as the clock.
-  if (nc > 10) sd.tail<3>().setConstant(p.gyro_bias_walk * std::sqrt(p.T));
+  if (nc > StrapdownIns::kStates) sd.tail<3>().setConstant(p.gyro_bias_walk * std::sqrt(p.T));
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
   bmean.segment<3>(StrapdownIns::kLever) = so3::fromRollPitchYaw(p.mount_rpy).transpose() * p.lever;  // IMU axes
@@ -127,11 +127,8 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
   const Eigen::Vector3d gyro_c = gyro - xb.segment<3>(kGyroScale).cwiseProduct(gyro);
   const Eigen::Vector3d accel_c = accel - xb.segment<3>(kAccelScale).cwiseProduct(accel);
   const int nc = dims().nc;
-  const Eigen::Vector3d gyro_bias =
-      gyroBiasWalks() ? Eigen::Vector3d(xb.segment<3>(kGyroBias) + xc.segment<3>(kGyroWalk))
-                      : Eigen::Vector3d(xb.segment<3>(kGyroBias));
-  const strapdown::NavState next = strapdown::step(x, gyro_c, accel_c, gyro_bias, xb.segment<3>(kAccelBias), dt,
-                                                   frame_, J_f_xc || J_f_xb ? &J : nullptr);
+  const strapdown::NavState next = strapdown::step(x, gyro_c, accel_c, gyroBias(xc, xb), xb.segment<3>(kAccelBias),
+                                                   dt, frame_, J_f_xc || J_f_xb ? &J : nullptr);
   if (J_f_xc) {
     J_f_xc->setZero(nc, nc);
     J_f_xc->topLeftCorner<9, 9>() = J.J_next_x;
@@ -149,7 +146,7 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
     J_f_xb->block<9, 3>(0, kAccelScale) = J.J_next_ba * accel.asDiagonal();
   }
   Eigen::VectorXd out(nc);
-  out.head<10>() << so3::Log(next.R), next.v, next.p, xc[kClock] + dt;
+  out.head<kStates>() << so3::Log(next.R), next.v, next.p, xc[kClock] + dt;
   if (gyroBiasWalks()) out.tail<3>() = xc.segment<3>(kGyroWalk);
   return out;
 }
@@ -236,8 +233,7 @@ Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen
     J_h_xb->setZero(3, kConstants);
     J_h_xb->middleCols<3>(kGyroBias).setIdentity();
   }
-  if (gyroBiasWalks()) return xb.segment<3>(kGyroBias) + xc.segment<3>(kGyroWalk) + w;
-  return xb.segment<3>(kGyroBias) + w;
+  return gyroBias(xc, xb) + w;
 }
 
 Eigen::MatrixXd StrapdownIns::processNoise(double dt) const { return insProcessNoise(p_, dt); }

@@ -48,12 +48,10 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   value.segment<3>(6) = so3::rollPitchYaw(R * R_vb.transpose(), &J_rpy) * kDegPerRad;
   J.block<3, 3>(6, kTheta) = kDegPerRad * J_rpy * R_vb;
   J.block<3, 3>(6, b + kMount) = -kDegPerRad * J_rpy * R_vb * E;
-  value.segment<6>(9) = xb.segment<6>(kGyroBias);
+  value.segment<3>(9) = gyroBias(xc, xb);  // the gyro bias now: b_g (+ β_g)
+  value.segment<3>(12) = xb.segment<3>(kAccelBias);
   J.block<6, 6>(9, b + kGyroBias).setIdentity();
-  if (gyroBiasWalks()) {  // the gyro bias now: b_g + β_g
-    value.segment<3>(9) += xc.segment<3>(kGyroWalk);
-    J.block<3, 3>(9, kGyroWalk).setIdentity();
-  }
+  if (gyroBiasWalks()) J.block<3, 3>(9, kGyroWalk).setIdentity();
   // The lever arm in vehicle axes, R_vb·ℓ.
   const Eigen::Vector3d lever = xb.segment<3>(kLever);
   value.segment<3>(15) = R_vb * lever;

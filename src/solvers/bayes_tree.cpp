@@ -897,17 +897,7 @@ void BayesTreeEngine::backSubstitute(int c) {
   Eigen::Index col = 0;
   for (const auto& k : separator(cl)) {
     const auto ds = vars_.at(k).delta();
-    if (n <= 8) {
-      // The product S_k·δ_k by columns, then the difference, in plain loops:
-      // at a state's size Eigen's product expression cost more than the
-      // arithmetic (its operands built on the stack, then reloaded).
-      const double* Sk = C.data() + (n + col) * n;
-      for (Eigen::Index i = 0; i < n; ++i) term[i] = 0;
-      for (Eigen::Index j = 0; j < ds.size(); ++j)
-        for (Eigen::Index i = 0; i < n; ++i) term[i] += Sk[i + j * n] * ds[j];
-    } else {
-      term.noalias() = S.middleCols(col, ds.size()) * ds;
-    }
+    term.noalias() = S.middleCols(col, ds.size()) * ds;  // the product, then the difference
     rhs -= term;
     col += ds.size();
   }

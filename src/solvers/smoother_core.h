@@ -1,6 +1,8 @@
 #pragma once
 // Internal: the relinearization policy and reporting shared by
 // IncrementalSmoother and FixedLagSmoother, over the Bayes tree engine.
+#include <chrono>
+
 #include "gssm/solvers/smoothers.h"
 #include "solvers/bayes_tree.h"
 
@@ -10,14 +12,19 @@ class SmootherCore {
  public:
   SmootherCore(const SmootherOptions& options, internal::OrderingMode mode);
 
-  /// One update: add, then relinearize the top (start-up), then a full check
-  /// when the constants moved, or iterate to convergence. Strong guarantee for
-  /// the add; a failed relinearization is skipped and noted in the report.
-  /// `timed` false leaves the report's seconds to the caller (the fixed lag
-  /// times the update and its marginalization with one pair of clock reads).
+  using Clock = std::chrono::steady_clock;
+  /// One update: apply(), then finish() (timed from the call).
   UpdateReport update(const std::vector<FactorPtr>& new_factors, const Values& new_values,
-                      const std::vector<int>& remove_slots = {}, bool timed = true);
-  void fillSizes(UpdateReport& r) const;
+                      const std::vector<int>& remove_slots = {});
+  /// The update's work: add, then relinearize the top (start-up), then a
+  /// full check when the constants moved, or iterate to convergence. Strong
+  /// guarantee for the add; a failed relinearization is skipped and noted in
+  /// the report. The caller may do more (the fixed lag marginalizes), then
+  /// finish().
+  UpdateReport apply(const std::vector<FactorPtr>& new_factors, const Values& new_values,
+                     const std::vector<int>& remove_slots = {});
+  /// The report's sizes and its time since `start`, kept as `last`.
+  const UpdateReport& finish(UpdateReport rep, Clock::time_point start);
   /// Checkpoint: the engine, the last report and the relinearization state.
   void save(internal::ByteWriter& out) const;
   void load(internal::ByteReader& in, const Model& model);

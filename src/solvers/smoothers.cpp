@@ -79,10 +79,19 @@ const SmootherOptions& validated(const SmootherOptions& o) {
 SmootherCore::SmootherCore(const SmootherOptions& o, internal::OrderingMode mode)
     : engine(mode, validated(o).wildfire_threshold), options(o) {}
 
-void SmootherCore::fillSizes(UpdateReport& r) const {
-  r.num_variables = engine.numVariables();
-  r.num_factors = engine.numFactors();
-  r.num_cliques = engine.numCliques();
+const UpdateReport& SmootherCore::finish(UpdateReport rep, Clock::time_point start) {
+  rep.num_variables = engine.numVariables();
+  rep.num_factors = engine.numFactors();
+  rep.num_cliques = engine.numCliques();
+  rep.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  last = std::move(rep);
+  return last;
+}
+
+UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, const Values& new_values,
+                                  const std::vector<int>& remove_slots) {
+  const auto start = Clock::now();
+  return finish(apply(new_factors, new_values, remove_slots), start);
 }
 
 void SmootherCore::relinearize(const std::vector<int>& candidates, double threshold,
@@ -255,9 +264,8 @@ void SmootherCore::checkAllWhenTheConstantsMoved(UpdateReport& rep, internal::En
   added_since_pass_ = 0;
 }
 
-UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, const Values& new_values,
-                                  const std::vector<int>& remove_slots, bool timed) {
-  const auto start = timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
+UpdateReport SmootherCore::apply(const std::vector<FactorPtr>& new_factors, const Values& new_values,
+                                 const std::vector<int>& remove_slots) {
   UpdateReport rep;
   rep.new_factors = static_cast<int>(new_factors.size());
   rep.new_variables = static_cast<int>(new_values.size());
@@ -294,9 +302,6 @@ UpdateReport SmootherCore::update(const std::vector<FactorPtr>& new_factors, con
   rep.orphans = counts.orphans;
   rep.factors_relinearized = counts.factors_relinearized;
   rep.variables_backsubstituted = counts.variables_backsubstituted;
-  fillSizes(rep);
-  if (timed) rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  last = rep;
   return rep;
 }
 
@@ -363,8 +368,8 @@ UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Val
       newest = std::max(newest, kv.first.step);
       if (oldest_ < 0) oldest = oldest < 0 ? kv.first.step : std::min(oldest, kv.first.step);
     }
-  const auto start = std::chrono::steady_clock::now();
-  UpdateReport rep = core_->update(f, v, {}, false);
+  const auto start = SmootherCore::Clock::now();  // the update and its marginalization, timed once
+  UpdateReport rep = core_->apply(f, v);
   newest_ = newest;
   oldest_ = oldest;
   while (oldest_ >= 0 && oldest_ < newest_ - options_.window + 1) {
@@ -381,10 +386,7 @@ UpdateReport FixedLagSmoother::update(const std::vector<FactorPtr>& f, const Val
     ++oldest_;
     ++rep.variables_marginalized;
   }
-  core_->fillSizes(rep);
-  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  core_->last = rep;
-  return rep;
+  return core_->finish(std::move(rep), start);
 }
 
 // ---- checkpoints ----------------------------------------------------------------

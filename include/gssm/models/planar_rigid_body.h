@@ -12,8 +12,9 @@
 // configuration: a bias b_ij per link (one node each, only in that link's
 // factors: bias_<i>_<j>), a common range scale s (1 when off), and each
 // tag's antenna delay as a function of the bearing β of the anchor in the
-// body frame, g_i(β) = Σ_{k=1..K} a_ik cos kβ + b_ik sin kβ (K harmonics,
-// antenna_<i>_c<k>, antenna_<i>_s<k>; only in tag i's factors):
+// body frame, g_i(β) = Σ_{k=2..K} a_ik cos kβ + b_ik sin kβ (the first
+// harmonic is a lever-arm error; antenna_<i>_c<k>, antenna_<i>_s<k>; only in
+// tag i's factors):
 //   range = s · ‖…‖ + b_ij + g_i(β_ij).
 #include <vector>
 
@@ -92,9 +93,11 @@ class PlanarRigidBody final : public Model {
   /// Each link's mean geometric distance along the truth's rows.
   Eigen::VectorXd meanTrueDistances(const Truth& truth) const;
   Params p_;
-  /// g_i(β) and ∂g/∂β of tag t at bearing (cos β, sin β); 0 without harmonics.
-  double antennaDelay(std::size_t t, double cos_b, double sin_b, const Eigen::VectorXd& xb, double* dg_dbeta,
-                      Eigen::MatrixXd* J_h_xb) const;
+  /// g_t(β) of tag t for the tag-to-anchor offset d (world, horizontal) at
+  /// yaw (cos, sin) c, s; its derivatives added to J_h_xc's row and written
+  /// into J_h_xb.
+  double antennaDelay(std::size_t t, double c, double s, const Eigen::Vector2d& d, const Eigen::VectorXd& xb,
+                      Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const;
   int i_bias_ = -1, i_scale_ = -1, i_antenna_ = -1;
 };
 

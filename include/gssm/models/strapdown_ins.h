@@ -106,6 +106,12 @@ class StrapdownIns final : public Model {
   // gyro bias walks (dims().nc = kStates + 3).
   static constexpr int kClock = 9, kStates = 10, kGyroWalk = 10;
   bool gyroBiasWalks() const { return p_.gyro_bias_walk > 0; }
+  /// The gyro bias at state x_c: b_g (+ β_g when it walks).
+  Eigen::Vector3d gyroBias(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) const {
+    Eigen::Vector3d b = xb.segment<3>(kGyroBias);
+    if (gyroBiasWalks()) b += xc.segment<3>(kGyroWalk);
+    return b;
+  }
   enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2, kZaru = 3 };
 
  private:
