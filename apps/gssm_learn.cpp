@@ -1,7 +1,9 @@
 // gssm-learn: learns a dataset's noise from its own log (docs/DESIGN.md
 // §10) and writes the learnt scenario.ini, learn.json and the
 // log-likelihood figure.
+#include <algorithm>
 #include <iostream>
+#include <thread>
 
 #include "cli.h"
 #include "gssm/io/learn_config.h"
@@ -17,14 +19,15 @@ int main(int argc, char** argv) {
     cli.option("out", "OUTDIR", "output folder (not the dataset's)");
     cli.option("config", "FILE", "INI file to use instead of DIR/scenario.ini ([learn] gives the options)");
     cli.option("start", "SIGMA", "every σ starts here (overrides [learn] start; 0: the [model] values)");
+    cli.option("threads", "N", "filter passes run at once (default: one per core)");
     cli.parse(argc, argv);
     gssm::apps::PlotLibrary plot;  // loads while the noise is learnt
     const std::string data = cli.require("data"), out = cli.require("out");
-    std::optional<gssm::NoiseLearningOptions> options;
-    if (cli.given("start")) {
-      options = gssm::io::learnSettings(gssm::io::readScenario(data, cli.get("config"))).options;
-      options->start = cli.getDouble("start", 0, 1e12);
-    }
+    gssm::NoiseLearningOptions options = gssm::io::learnSettings(gssm::io::readScenario(data, cli.get("config"))).options;
+    if (cli.given("start")) options.start = cli.getDouble("start", 0, 1e12);
+    options.threads = cli.given("threads") ? static_cast<int>(cli.getInt("threads", 1, 256))
+                                           : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    options.batch.threads = options.threads;
     const gssm::io::LearnResult r = gssm::io::learnDataset(data, out, cli.get("config"), options);
     std::cout << r.report.toString();
     const std::string label = r.config.getString("scenario", "name", data);

@@ -29,7 +29,7 @@ Figure learningFigure(const NoiseLearningReport& r, const std::string& label) {
     return traceFigure(label + ": the constants' prior learnt by EM, expected log prior per E-step",
                        "E-step (batch solve)", "E[log p(x_b | sigma)] after the M-step", r.prior_expected_log_prior,
                        "learnt", "at the start sigma", r.prior_start_expected_log_prior);
-  return traceFigure(label + ": noise learnt from the log, log-likelihood per iteration", "Nelder-Mead iteration",
+  return traceFigure(label + ": noise learnt from the log, log-likelihood per iteration", (r.optimizer.empty() ? std::string("nelder-mead") : r.optimizer) + " iteration",
                      "log-likelihood (EKF prediction errors)", r.log_likelihood, "learnt (best so far)",
                      "at the INI's given values", r.given_log_likelihood);
 }

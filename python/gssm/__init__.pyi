@@ -221,6 +221,7 @@ class LearnReport:
     start_log_likelihood: float
     final_log_likelihood: float
     evaluations: int
+    optimizer: str
     iterations: int
     restarts: int
     converged: bool
@@ -255,13 +256,14 @@ def process(data: str, out: str, *, method: Union[MethodLike, Sequence[MethodLik
 @overload
 def learn(model_or_folder: Model, data: Dataset, *, parameters: Optional[Sequence[str]] = None,
           start: float = 0.0, search_range: float = 1e4, max_evaluations: int = 4000, tolerance: float = 1e-7,
-          max_restarts: int = 6, standard_errors: bool = True) -> LearnReport: ...
+          max_restarts: int = 6, standard_errors: bool = True, optimizer: str = "nelder-mead",
+          threads: int = 1) -> LearnReport: ...
 @overload
 def learn(model_or_folder: str, *, out: str, config: Optional[str] = None) -> LearnReport: ...
 @overload
 def learn(model_or_folder: Callable[..., Model], data: Dataset, *, sigmas: Dict[str, float], start: float = 0.0,
           search_range: float = 1e4, max_evaluations: int = 4000, tolerance: float = 1e-7, max_restarts: int = 6,
-          standard_errors: bool = True) -> LearnReport: ...
+          standard_errors: bool = True, optimizer: str = "nelder-mead", threads: int = 1) -> LearnReport: ...
 def restore(model: Model, source: Union[bytes, bytearray, memoryview, str]) -> Estimator: ...
 def checkpoint_info(model: Model, data: bytes) -> Dict[str, object]: ...
 def simulate(scenario: Union[str, Model] = "paper", seed: int = 1, steps: int = 400, *,

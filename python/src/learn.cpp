@@ -33,6 +33,7 @@ void bindReport(py::module_& m) {
       .def_readonly("start_log_likelihood", &NoiseLearningReport::start_log_likelihood)
       .def_readonly("final_log_likelihood", &NoiseLearningReport::final_log_likelihood)
       .def_readonly("evaluations", &NoiseLearningReport::evaluations, "EKF passes")
+      .def_readonly("optimizer", &NoiseLearningReport::optimizer, "'nelder-mead' or 'scoring'")
       .def_readonly("iterations", &NoiseLearningReport::iterations)
       .def_readonly("restarts", &NoiseLearningReport::restarts)
       .def_readonly("converged", &NoiseLearningReport::converged)
@@ -48,10 +49,12 @@ void bindReport(py::module_& m) {
 }
 
 NoiseLearningOptions learnOptions(const std::vector<std::string>& parameters, double start, double search_range,
-                                  int max_evaluations, double tolerance, int max_restarts, bool standard_errors) {
+                                  int max_evaluations, double tolerance, int max_restarts, bool standard_errors,
+                                  const std::string& optimizer) {
   NoiseLearningOptions o;
   o.parameters = parameters, o.start = start, o.search_range = search_range, o.max_evaluations = max_evaluations;
   o.tolerance = tolerance, o.max_restarts = max_restarts, o.standard_errors = standard_errors;
+  o.optimizer = optimizer;
   return o;
 }
 }  // namespace
@@ -62,19 +65,21 @@ void bindLearn(py::module_& m) {
       "_learn_model",
       [](const std::shared_ptr<Model>& model, const PyDataset& d, const std::vector<std::string>& parameters,
          double start, double search_range, int max_evaluations, double tolerance, int max_restarts,
-         bool standard_errors) {
-        const NoiseLearningOptions o =
-            learnOptions(parameters, start, search_range, max_evaluations, tolerance, max_restarts, standard_errors);
+         bool standard_errors, const std::string& optimizer, int threads) {
+        NoiseLearningOptions o = learnOptions(parameters, start, search_range, max_evaluations, tolerance,
+                                              max_restarts, standard_errors, optimizer);
+        o.threads = o.batch.threads = threads;
         py::gil_scoped_release release;  // registered models are C++ (a Python model has no registered type)
         return learnNoise(*model, d.data.measurements, d.data.inputs, d.data.t0, o);
       },
       py::arg("model"), py::arg("data"), py::arg("parameters"), py::arg("start"), py::arg("search_range"),
-      py::arg("max_evaluations"), py::arg("tolerance"), py::arg("max_restarts"), py::arg("standard_errors"));
+      py::arg("max_evaluations"), py::arg("tolerance"), py::arg("max_restarts"), py::arg("standard_errors"),
+      py::arg("optimizer"), py::arg("threads"));
   m.def(
       "_learn_family",
       [](const py::function& make, const std::vector<std::string>& names, const Eigen::VectorXd& given,
          const PyDataset& d, double start, double search_range, int max_evaluations, double tolerance,
-         int max_restarts, bool standard_errors) {
+         int max_restarts, bool standard_errors, const std::string& optimizer, int /*threads*/) {
         NoiseFamily family;
         family.names = names;
         family.given = given;
@@ -84,12 +89,14 @@ void bindLearn(py::module_& m) {
           if (!model) throw InvalidArgument("gssm.learn: the model factory returned None");
           return model;
         };
-        const NoiseLearningOptions o =
-            learnOptions({}, start, search_range, max_evaluations, tolerance, max_restarts, standard_errors);
+        // one pass at a time: the factory and the models' f and h take the GIL
+        const NoiseLearningOptions o = learnOptions({}, start, search_range, max_evaluations, tolerance, max_restarts,
+                                                    standard_errors, optimizer);
         return learnNoise(family, d.data.measurements, d.data.inputs, d.data.t0, o);
       },
       py::arg("make"), py::arg("names"), py::arg("given"), py::arg("data"), py::arg("start"), py::arg("search_range"),
-      py::arg("max_evaluations"), py::arg("tolerance"), py::arg("max_restarts"), py::arg("standard_errors"));
+      py::arg("max_evaluations"), py::arg("tolerance"), py::arg("max_restarts"), py::arg("standard_errors"),
+      py::arg("optimizer"), py::arg("threads"));
   m.def(
       "_learn_folder",
       [](const std::string& data, const std::string& out, const std::string& config) {

@@ -32,6 +32,24 @@ def test_learn_from_a_model_and_data_recovers_the_noise_it_was_drawn_with():
     assert run.mean.shape[0] == len(data.t)
 
 
+def test_scoring_reaches_nelder_meads_maximum_in_fewer_passes_on_any_number_of_threads():
+    def linear(q, r):
+        return gssm.models.Linear(A_c=[[0, 1], [0, 0]], C_c=[[1, 0]], Q=np.diag(q), R=[[r]], T=1.0,
+                                  prior_state_mean=[0, 1], prior_state_cov=np.diag([4.0, 1.0]))
+    data = gssm.simulate(linear([0.25, 0.01], 0.25), seed=6, steps=600)
+    nm = gssm.learn(linear([1, 1], 1), data, start=1.0, tolerance=1e-10, standard_errors=False)
+    one = gssm.learn(linear([1, 1], 1), data, start=1.0, tolerance=1e-10, standard_errors=False, optimizer="scoring")
+    two = gssm.learn(linear([1, 1], 1), data, start=1.0, tolerance=1e-10, standard_errors=False, optimizer="scoring",
+                     threads=2)
+    assert one.converged and one.evaluations * 3 < nm.evaluations, (one.evaluations, nm.evaluations)
+    assert one.final_log_likelihood == pytest.approx(nm.final_log_likelihood, abs=1e-6)
+    for a, b in zip(one.parameters, nm.parameters):
+        assert a.value == pytest.approx(b.value, rel=1e-3), a.name
+    assert [p.value for p in two.parameters] == [p.value for p in one.parameters]
+    with pytest.raises(gssm.InvalidArgument, match="optimizer 'bfgs'"):
+        gssm.learn(linear([1, 1], 1), data, optimizer="bfgs")
+
+
 def test_learn_names_what_it_cannot_learn():
     model = gssm.models.Radar2D()
     data = gssm.simulate("paper", seed=1, steps=20)

@@ -24,7 +24,8 @@ std::vector<IniKey> learnIniKeyDocs() {
       {"search_range", "number", number(o.search_range), "each σ is searched within this factor of its start"},
       {"outliers", "flag", "false", "then learn again with each measurement an outlier with a learnt probability"},
       {"max_evaluations", "integer", std::to_string(o.max_evaluations), "likelihood evaluations (EKF passes) in all"},
-      {"tolerance", "number", number(o.tolerance), "converged when a restart gains less than this, relative"},
+      {"optimizer", "word", o.optimizer, "scoring (gradient and score outer product) or nelder-mead"},
+      {"tolerance", "number", number(o.tolerance), "converged when the next step would gain less than this, relative"},
       {"max_restarts", "integer", std::to_string(o.max_restarts), "Nelder–Mead restarts from the best point"},
       {"standard_errors", "flag", "true", "standard errors from the likelihood's curvature (2p² more passes)"},
       {"prior_iterations", "integer", std::to_string(o.prior_iterations), "EM E-steps for the constants' prior σs"},
@@ -47,6 +48,7 @@ LearnSettings learnSettings(const IniDocument& ini) {
   o.search_range = ini.getDouble("learn", "search_range", o.search_range);
   o.outliers = ini.getBool("learn", "outliers", o.outliers);
   o.max_evaluations = static_cast<int>(ini.getInt("learn", "max_evaluations", o.max_evaluations));
+  o.optimizer = ini.getString("learn", "optimizer", o.optimizer);
   o.tolerance = ini.getDouble("learn", "tolerance", o.tolerance);
   o.max_restarts = static_cast<int>(ini.getInt("learn", "max_restarts", o.max_restarts));
   o.standard_errors = ini.getBool("learn", "standard_errors", o.standard_errors);
@@ -132,7 +134,8 @@ std::string learnReportJson(const NoiseLearningReport& r, const std::string& dat
   std::ostringstream os;
   os << "{\n  \"dataset\": " << jsonQuoted(dataset) << ",\n  \"method\": \"prediction-error maximum likelihood (EKF)\""
      << ",\n  \"measurements\": " << r.measurements << ",\n  \"converged\": " << (r.converged ? "true" : "false")
-     << ",\n  \"evaluations\": " << r.evaluations << ",\n  \"iterations\": " << r.iterations
+     << ",\n  \"optimizer\": " << jsonQuoted(r.optimizer) << ",\n  \"evaluations\": " << r.evaluations
+     << ",\n  \"iterations\": " << r.iterations
      << ",\n  \"restarts\": " << r.restarts << ",\n  \"seconds\": " << jsonNumber(r.seconds)
      << ",\n  \"log_likelihood\": {\"given\": " << jsonNumber(r.given_log_likelihood)
      << ", \"start\": " << jsonNumber(r.start_log_likelihood) << ", \"final\": " << jsonNumber(r.final_log_likelihood)

@@ -208,7 +208,8 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   const std::vector<Method> methods = methodsToRun(o, *model, r.config);
   readData(o, *model, r, cb);
   if (LearnSettings learn = learnSettings(r.config); o.learn.value_or(learn.enabled)) {
-    learn.options.batch.threads = static_cast<int>(o.threads);  // learning runs alone: its batch solves may use them all
+    // learning runs alone: its passes and batch solves may use every thread
+    learn.options.threads = learn.options.batch.threads = static_cast<int>(o.threads);
     LearnResult learnt = learnAndWrite(*model, r.config, r.dataset, o.out_dir, learn.options);
     r.config = std::move(learnt.config);
     model = r.model = learnt.report.model;

@@ -9,10 +9,12 @@
 #include <sstream>
 
 #include "gssm/core/error.h"
+#include "gssm/core/parallel.h"
 #include "gssm/factors/problem.h"
 #include "gssm/model/registry.h"
 #include "learn/constants_prior.h"
 #include "learn/nelder_mead.h"
+#include "learn/scoring.h"
 
 namespace gssm {
 
@@ -30,6 +32,9 @@ bool NoiseLearningOptions::validate(std::string* why) const {
   if (max_evaluations < 10) return fail("max_evaluations must be at least 10");
   if (!(tolerance > 0) || tolerance >= 1) return fail("tolerance must be in (0, 1)");
   if (max_restarts < 0) return fail("max_restarts must be >= 0");
+  if (optimizer != "scoring" && optimizer != "nelder-mead")
+    return fail("optimizer '" + optimizer + "': expected scoring or nelder-mead");
+  if (threads < 1 || threads > 256) return fail("threads must be in 1..256");
   if (!(search_range > 1) || !std::isfinite(search_range)) return fail("search_range must be a factor > 1");
   if (prior_iterations < 1) return fail("prior_iterations must be >= 1");
   if (!(prior_tolerance > 0) || prior_tolerance >= 1) return fail("prior_tolerance must be in (0, 1)");
@@ -39,19 +44,25 @@ bool NoiseLearningOptions::validate(std::string* why) const {
 
 namespace {
 // The likelihood over a schedule computed once (learning evaluates hundreds).
-double logLikelihoodAlong(const Model& model, const std::vector<ScheduledStep>& schedule,
-                          const std::vector<Measurement>& measurements, const std::vector<Input>& inputs, double t0,
-                          ExtendedKalmanFilterOptions ekf) {
+internal::LikelihoodTerms logLikelihoodAlong(const Model& model, const std::vector<ScheduledStep>& schedule,
+                                             const std::vector<Measurement>& measurements,
+                                             const std::vector<Input>& inputs, double t0,
+                                             ExtendedKalmanFilterOptions ekf) {
   ekf.use_gates = false;
   ExtendedKalmanFilter filter(model, ekf, t0);
   filterAlong(filter, schedule, measurements, inputs);
-  return filter.logLikelihood();
+  internal::LikelihoodTerms out;
+  out.total = filter.logLikelihood();
+  const std::vector<double>& terms = filter.logLikelihoodTerms();
+  out.terms = Eigen::Map<const Eigen::VectorXd>(terms.data(), static_cast<Eigen::Index>(terms.size()));
+  return out;
 }
 }  // namespace
 
 double predictionErrorLogLikelihood(const Model& model, const std::vector<Measurement>& measurements,
                                     const std::vector<Input>& inputs, double t0, ExtendedKalmanFilterOptions ekf) {
-  return logLikelihoodAlong(model, stepSchedule(measurements, inputs, t0), measurements, inputs, t0, std::move(ekf));
+  return logLikelihoodAlong(model, stepSchedule(measurements, inputs, t0), measurements, inputs, t0, std::move(ekf))
+      .total;
 }
 
 namespace {
@@ -131,23 +142,40 @@ struct Objective {
   /// channels' uniform log densities.
   bool mixture = false;
   std::vector<double> outlier_log_density;
+  int threads = 1;
   int evaluations = 0;
 
-  // The log-likelihood at θ = log σ; −∞ outside the domain or where the filter fails.
-  double logLikelihood(const Eigen::VectorXd& theta) {
-    ++evaluations;
-    if (!theta.allFinite()) return -std::numeric_limits<double>::infinity();
+  // The pass at θ = log σ: total −∞ (no terms) outside the domain or where
+  // the filter fails; the terms kept when asked (scoring's).
+  internal::LikelihoodTerms pass(const Eigen::VectorXd& theta, bool keep_terms) const {
+    internal::LikelihoodTerms failed{-std::numeric_limits<double>::infinity(), {}};
+    if (!theta.allFinite()) return failed;
     try {  // beyond the search range: the value at its end (flat)
       const Eigen::VectorXd clamped = theta.cwiseMax(lo).cwiseMin(hi);
       const auto n = static_cast<Eigen::Index>(family.names.size());
       const auto model = family.make(clamped.head(n).array().exp().matrix());
       ExtendedKalmanFilterOptions e = ekf;
+      e.keep_log_likelihood_terms = keep_terms;
       if (mixture) e.outlier_probability = 1.0 / (1.0 + std::exp(-clamped[n])), e.outlier_log_density = outlier_log_density;
-      const double l = logLikelihoodAlong(*model, schedule, measurements, inputs, t0, e);
-      return std::isfinite(l) ? l : -std::numeric_limits<double>::infinity();
+      internal::LikelihoodTerms l = logLikelihoodAlong(*model, schedule, measurements, inputs, t0, e);
+      return std::isfinite(l.total) ? l : failed;
     } catch (const NumericalError&) {
-      return -std::numeric_limits<double>::infinity();
+      return failed;
     }
+  }
+  double logLikelihood(const Eigen::VectorXd& theta) {
+    ++evaluations;
+    return pass(theta, false).total;
+  }
+  // The passes at several θ, `threads` at a time.
+  std::vector<internal::LikelihoodTerms> passes(const std::vector<Eigen::VectorXd>& thetas, bool keep_terms) {
+    std::vector<internal::LikelihoodTerms> out(thetas.size());
+    const auto errors = runJobs(thetas.size(), static_cast<std::size_t>(threads),
+                                [&](std::size_t k) { out[k] = pass(thetas[k], keep_terms); });
+    for (const auto& e : errors)
+      if (e) std::rethrow_exception(e);
+    evaluations += static_cast<int>(thetas.size());
+    return out;
   }
 };
 
@@ -155,8 +183,8 @@ struct Objective {
 // until a restart gains less than the tolerance (a collapsed simplex is not
 // proof of a maximum). A σ that reaches the end of its search range is held
 // there for the restarts that follow (the simplex then spans the others).
-Eigen::VectorXd maximize(Objective& obj, const Eigen::VectorXd& theta0, const NoiseLearningOptions& o,
-                         NoiseLearningReport& r) {
+Eigen::VectorXd maximizeByNelderMead(Objective& obj, const Eigen::VectorXd& theta0, const NoiseLearningOptions& o,
+                                     NoiseLearningReport& r) {
   Eigen::VectorXd theta = theta0;
   std::vector<Eigen::Index> free(static_cast<std::size_t>(theta.size()));
   std::iota(free.begin(), free.end(), Eigen::Index{0});
@@ -188,23 +216,51 @@ Eigen::VectorXd maximize(Objective& obj, const Eigen::VectorXd& theta0, const No
   return theta.cwiseMax(obj.lo).cwiseMin(obj.hi);
 }
 
+// Scoring from θ0 within the search range (learn/scoring.h).
+Eigen::VectorXd maximizeByScoring(Objective& obj, const Eigen::VectorXd& theta0, const NoiseLearningOptions& o,
+                                  NoiseLearningReport& r) {
+  internal::ScoringOptions so;
+  so.lo = obj.lo, so.hi = obj.hi;
+  so.max_evaluations = o.max_evaluations - obj.evaluations;
+  so.tolerance = o.tolerance;
+  const auto at = [&obj](const std::vector<Eigen::VectorXd>& thetas) { return obj.passes(thetas, true); };
+  const auto res = internal::maximizeByScoring(at, theta0, so, [&r](double l) { r.log_likelihood.push_back(l); });
+  r.iterations += res.iterations;
+  r.converged = res.converged;
+  r.final_log_likelihood = res.value;
+  return res.x;
+}
+
+Eigen::VectorXd maximize(Objective& obj, const Eigen::VectorXd& theta0, const NoiseLearningOptions& o,
+                         NoiseLearningReport& r) {
+  return o.optimizer == "scoring" ? maximizeByScoring(obj, theta0, o, r) : maximizeByNelderMead(obj, theta0, o, r);
+}
+
 // −∂²ℓ/∂θ² over the free parameters (those inside their search range) by
 // central differences of the log-likelihood at the maximum.
 Eigen::MatrixXd observedInformation(Objective& obj, const Eigen::VectorXd& theta, double l0,
                                     const std::vector<Eigen::Index>& free) {
   const auto n = static_cast<Eigen::Index>(free.size());
   const double h = 1e-2;  // in log σ: 1%
-  Eigen::MatrixXd I(n, n);
-  auto at = [&](Eigen::Index i, double si, Eigen::Index j, double sj) {
+  std::vector<Eigen::VectorXd> points;  // (i, ±), then (i, j) for j < i at (±, ±): one batch of passes
+  auto add = [&](Eigen::Index i, double si, Eigen::Index j, double sj) {
     Eigen::VectorXd t = theta;
     t[free[static_cast<std::size_t>(i)]] += si * h;
     t[free[static_cast<std::size_t>(j)]] += sj * h;
-    return obj.logLikelihood(t);
+    points.push_back(t);
   };
   for (Eigen::Index i = 0; i < n; ++i) {
-    I(i, i) = -(at(i, 1, i, 0) - 2 * l0 + at(i, -1, i, 0)) / (h * h);
-    for (Eigen::Index j = 0; j < i; ++j)
-      I(i, j) = I(j, i) = -(at(i, 1, j, 1) - at(i, 1, j, -1) - at(i, -1, j, 1) + at(i, -1, j, -1)) / (4 * h * h);
+    add(i, 1, i, 0), add(i, -1, i, 0);
+    for (Eigen::Index j = 0; j < i; ++j) add(i, 1, j, 1), add(i, 1, j, -1), add(i, -1, j, 1), add(i, -1, j, -1);
+  }
+  const std::vector<internal::LikelihoodTerms> l = obj.passes(points, false);
+  Eigen::MatrixXd I(n, n);
+  std::size_t k = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    I(i, i) = -(l[k].total - 2 * l0 + l[k + 1].total) / (h * h);
+    k += 2;
+    for (Eigen::Index j = 0; j < i; ++j, k += 4)
+      I(i, j) = I(j, i) = -(l[k].total - l[k + 1].total - l[k + 2].total + l[k + 3].total) / (4 * h * h);
   }
   return I;
 }
@@ -325,8 +381,9 @@ NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Meas
     r.parameters.push_back(p);
   }
   r.measurements = measurements.size();
+  r.optimizer = o.optimizer;
   const std::vector<ScheduledStep> schedule = stepSchedule(measurements, inputs, t0);
-  Objective obj{family, schedule, measurements, inputs, t0, o.ekf, {}, {}, false, {}};
+  Objective obj{family, schedule, measurements, inputs, t0, o.ekf, {}, {}, false, {}, o.threads};
   const auto n = static_cast<Eigen::Index>(family.names.size());
   Eigen::VectorXd theta(n);
   for (Eigen::Index i = 0; i < n; ++i) theta[i] = std::log(r.parameters[static_cast<std::size_t>(i)].start);
@@ -398,7 +455,7 @@ std::string NoiseLearningReport::toString() const {
   if (evaluations > 0)
     os << "noise learnt by prediction-error maximum likelihood from " << measurements << " measurements: log-likelihood "
        << start_log_likelihood << " -> " << final_log_likelihood << " (at the given values " << given_log_likelihood
-       << "), " << evaluations << " EKF passes, " << restarts << " restarts, "
+       << "), " << optimizer << ", " << evaluations << " EKF passes, " << restarts << " restarts, "
        << (converged ? "converged" : "NOT converged") << ", " << seconds << " s\n";
   if (prior_iterations > 0)
     os << "constants' prior learnt by EM on the factor graph: " << prior_iterations << " E-steps (batch solves), "

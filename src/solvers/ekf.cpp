@@ -142,7 +142,10 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   const auto [log_p, w] = mixture(log_normal, options_.outlier_probability, outlierLogDensity(m.channel));
   commitUpdate(w);
   nis_ = nis;
-  if (counted_.empty() || counted_[static_cast<std::size_t>(m.channel)]) log_likelihood_ += log_p;
+  if (counted_.empty() || counted_[static_cast<std::size_t>(m.channel)]) {
+    log_likelihood_ += log_p;
+    if (options_.keep_log_likelihood_terms) log_likelihood_terms_.push_back(log_p);
+  }
   return true;
 }
 

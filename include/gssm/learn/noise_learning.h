@@ -4,7 +4,7 @@
 // and R) fitted by maximum likelihood from the measurements and inputs
 // alone, no truth. The likelihood is the prediction-error decomposition of
 // an ungated EKF pass, Σ_k log N(e_k; 0, S_k) (exact for a linear model),
-// maximized over log σ by Nelder–Mead with restarts; standard errors come
+// maximized over log σ by scoring (or Nelder–Mead); standard errors come
 // from the curvature of the log-likelihood at the maximum.
 //
 //   gssm::NoiseLearningOptions o;
@@ -62,10 +62,22 @@ struct NoiseLearningOptions {
   /// start/search_range, and is flagged.
   double search_range = 1e4;
   int max_evaluations = 4000;  ///< likelihood evaluations (EKF passes) in all
-  /// Converged when a Nelder–Mead restart from the best point gains less
-  /// than tolerance·(1 + |log-likelihood|).
+  /// How the likelihood is maximized over log σ. "nelder-mead":
+  /// derivative-free, with restarts; its large first simplex explores, so
+  /// from a generic start it can pass a lesser local maximum. "scoring":
+  /// quasi-Newton from forward differences of every measurement's term
+  /// (the outer product of their gradients as the first curvature, then
+  /// BFGS), p + 1 or 2 passes an iteration: several times fewer passes, but
+  /// it climbs to the nearest maximum (docs/DESIGN.md §10).
+  std::string optimizer = "nelder-mead";
+  /// Converged when a Nelder–Mead restart from the best point (scoring:
+  /// the next quasi-Newton step, predicted) gains less than
+  /// tolerance·(1 + |log-likelihood|).
   double tolerance = 1e-7;
-  int max_restarts = 6;
+  int max_restarts = 6;  ///< Nelder–Mead's
+  /// Filter passes run at once (scoring's differences, the curvature's):
+  /// a family whose models call into Python takes 1.
+  int threads = 1;
   /// After the Gaussian maximum, learn again with each measurement an
   /// outlier (uniform over its channel's span) with a learnt probability ε:
   /// a bounded likelihood that gross errors do not inflate the σs with.
@@ -87,7 +99,7 @@ struct NoiseLearningOptions {
 
 struct NoiseLearningReport {
   std::vector<LearntParameter> parameters;
-  /// The best log-likelihood after each Nelder–Mead iteration (never
+  /// The best log-likelihood after each iteration of the optimizer (never
   /// decreasing within a stage; the outlier stage's is another likelihood).
   std::vector<double> log_likelihood;
   double given_log_likelihood = 0;  ///< at the model's own values
@@ -98,6 +110,7 @@ struct NoiseLearningReport {
   double outlier_probability = 0;
   std::size_t mixture_from = 0;
   int evaluations = 0;  ///< EKF passes
+  std::string optimizer;  ///< the options' ("nelder-mead", "scoring")
   int iterations = 0;
   int restarts = 0;
   bool converged = false;  ///< false: stopped at max_evaluations

@@ -42,6 +42,9 @@ struct ExtendedKalmanFilterOptions {
   /// that of the counted channels given the rest (e.g. GNSS fixes given the
   /// vehicle constraints' pseudo-measurements).
   std::vector<int> likelihood_channels;
+  /// Keep each counted update's log N(e; 0, S) (not an INI key; noise
+  /// learning's scoring takes the gradient of every term).
+  bool keep_log_likelihood_terms = false;
   bool validate(int nb, std::string* why = nullptr) const;
 };
 
@@ -74,6 +77,9 @@ class ExtendedKalmanFilter {
   /// prediction-error decomposition of the log-likelihood of the data
   /// (docs/DESIGN.md §10; not checkpointed).
   double logLikelihood() const { return log_likelihood_; }
+  /// The terms of logLikelihood() in the order taken (with
+  /// keep_log_likelihood_terms; empty otherwise).
+  const std::vector<double>& logLikelihoodTerms() const { return log_likelihood_terms_; }
   /// Measurements rejected by their channel's gate so far.
   std::int64_t rejected() const { return rejected_; }
   const Model& model() const { return *model_; }
@@ -106,6 +112,7 @@ class ExtendedKalmanFilter {
   Eigen::MatrixXd P_;
   double nis_ = 0.0;
   double log_likelihood_ = 0.0;
+  std::vector<double> log_likelihood_terms_;
   std::vector<char> counted_;  // per channel, from likelihood_channels (empty: all)
   std::int64_t rejected_ = 0;
   UpdateBuffers u_;
