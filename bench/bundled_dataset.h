@@ -1,8 +1,10 @@
 #pragma once
 // A bundled dataset as gssm-process reads it: its model, data and estimator
 // options from its own scenario.ini (the benches on real logs load this way).
+#include <array>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "gssm/estimator/estimator.h"
 #include "gssm/io/config.h"
@@ -16,11 +18,14 @@ struct BundledDataset {
   EstimatorOptions options;  ///< from the scenario.ini, t0 the data's
 };
 
-/// datasets/<name> of this source tree (GSSM_SOURCE_DIR).
-inline BundledDataset loadBundledDataset(const std::string& name) {
+/// datasets/<name> of this source tree (GSSM_SOURCE_DIR), with `changes`
+/// ({section, key, value}) made to its scenario.ini.
+inline BundledDataset loadBundledDataset(const std::string& name,
+                                         const std::vector<std::array<std::string, 3>>& changes = {}) {
   BundledDataset d;
   const std::string dir = std::string(GSSM_SOURCE_DIR) + "/datasets/" + name;
-  const io::IniDocument ini = io::readScenario(dir);
+  io::IniDocument ini = io::readScenario(dir);
+  for (const auto& [section, key, value] : changes) ini.set(section, key, value);
   d.model = io::makeModel(ini, dir);
   io::readDatasetData(dir, *d.model, d.data, io::BadRows::Throw, &ini);
   d.options = io::estimatorOptions(ini, *d.model);

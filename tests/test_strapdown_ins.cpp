@@ -10,6 +10,8 @@
 #include "gssm/analysis/offline.h"
 #include "gssm/core/rotation_blocks.h"
 #include "gssm/core/so3.h"
+#include "gssm/core/time.h"
+#include "gssm/factors/problem.h"
 #include "gssm/io/config.h"
 #include "gssm/io/dataset.h"
 #include "gssm/io/ini.h"
@@ -224,10 +226,25 @@ TEST(StrapdownIns, ReadsTheDrivesImuAndGnssWithItsOutages) {
 // fix (checked against the IMU rows themselves); non-holonomic zeros at 10 Hz.
 TEST(StrapdownIns, StandingFixesGiveZeroVelocityAndTheGyrosMeanReading) {
   const std::string dir = GSSM_SOURCE_DIR "/datasets/gnss-ins-drive";
-  const io::IniDocument ini = io::readScenario(dir);
+  io::IniDocument ini = io::readScenario(dir);
+  ini.set("model", "imu_per_state", "1");  // the raw readings, one input each
   const auto model = io::makeModel(ini, dir);
   io::Dataset ds;
   io::readDatasetData(dir, *model, ds, io::BadRows::Throw, &ini);
+  // Packed into the scenario's steps the measurements are the same, each at a step.
+  const io::IniDocument shipped = io::readScenario(dir);
+  const auto packed_model = io::makeModel(shipped, dir);
+  ASSERT_GT(packed_model->readingsPerStep(), 1);
+  io::Dataset packed;
+  io::readDatasetData(dir, *packed_model, packed, io::BadRows::Throw, &shipped);
+  ASSERT_EQ(packed.measurements.size(), ds.measurements.size());
+  for (std::size_t i = 0; i < ds.measurements.size(); ++i) {
+    EXPECT_EQ(packed.measurements[i].t, ds.measurements[i].t);
+    EXPECT_EQ(packed.measurements[i].y, ds.measurements[i].y);
+  }
+  for (const auto& step : stepSchedule(packed.measurements, packed.inputs, packed.t0))
+    EXPECT_TRUE(step.measurements.empty() || sameTime(packed.measurements[step.measurements.front()].t, step.t));
+  EXPECT_LT(packed.inputs.size(), ds.inputs.size() / 4);
   std::size_t zupt = 0, zaru = 0, nhc = 0;
   double previous_fix = ds.t0, this_fix = ds.t0;
   for (const Measurement& m : ds.measurements) {

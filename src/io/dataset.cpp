@@ -8,6 +8,7 @@
 
 #include "gssm/core/angles.h"
 #include "gssm/core/error.h"
+#include "gssm/model/packed_inputs.h"
 #include "gssm/io/config.h"
 #include "gssm/core/time.h"
 #include "gssm/io/csv.h"
@@ -229,15 +230,23 @@ void readStartAndRows(const IniDocument& ini, Dataset& out) {
 
 // Inputs: rates held from each row's time, or increments over the interval
 // ending at each row (held from the previous row's time, t0 for the first).
+// The size of one raw input row: the model's input, or one reading of a
+// packed one (packed_inputs.h: [dt, reading] per slot).
+int rawInputSize(const Model& model) {
+  const int n = model.readingsPerStep();
+  return n == 1 ? model.dims().nu : model.dims().nu / n - 1;
+}
+
 void readInputs(const std::string& path, const IniDocument& ini, const Model& model, Dataset& out) {
   const CsvTable in = readCsv(path);
   const int tc = requireColumn(in, "t", "the time");
   std::vector<int> cols;
   for (const auto& n : words(ini.getString("dataset", "input_columns")))
     cols.push_back(requireColumn(in, n, "[dataset] input_columns"));
-  if (static_cast<int>(cols.size()) != model.dims().nu)
+  const int width = rawInputSize(model);
+  if (static_cast<int>(cols.size()) != width)
     throw InputError(ini.source() + ": [dataset] input_columns names " + std::to_string(cols.size()) +
-                     " columns; model '" + model.name() + "' has " + std::to_string(model.dims().nu) + " inputs");
+                     " columns; model '" + model.name() + "' has " + std::to_string(width) + " inputs");
   const std::string kind = ini.getString("dataset", "input_kind", "rates");
   if (kind != "rates" && kind != "increments")
     throw InputError(ini.source() + ": [dataset] input_kind = '" + kind + "': expected rates or increments");
@@ -259,7 +268,7 @@ void readInputs(const std::string& path, const IniDocument& ini, const Model& mo
   for (std::size_t r = first; r < in.rows.size(); ++r) {
     const double t = in.rows[r][static_cast<std::size_t>(tc)];
     if (r > first || kind == "increments" || t < prev) requireIncreasing(in, r, prev, t);
-    Eigen::VectorXd u(model.dims().nu);
+    Eigen::VectorXd u(width);
     for (std::size_t i = 0; i < cols.size(); ++i) u[static_cast<Eigen::Index>(i)] = in.rows[r][static_cast<std::size_t>(cols[i])];
     if (kind == "increments") {
       out.inputs.push_back({prev, u / (t - prev)});
@@ -269,7 +278,17 @@ void readInputs(const std::string& path, const IniDocument& ini, const Model& mo
     prev = t;
   }
   // Increments: a last zero input makes the state at the last row's time.
-  if (kind == "increments" && !out.inputs.empty()) out.inputs.push_back({prev, Eigen::VectorXd::Zero(model.dims().nu)});
+  if (kind == "increments" && !out.inputs.empty()) out.inputs.push_back({prev, Eigen::VectorXd::Zero(width)});
+}
+
+// A model taking packed inputs: the raw rows packed into its steps, one
+// ending at every measurement the estimators see (the scores carry a state
+// to a withheld fix's time by f, over the first part of a pack).
+void packModelInputs(const Model& model, Dataset& out) {
+  if (model.readingsPerStep() == 1 || out.inputs.empty()) return;
+  std::vector<double> cuts;
+  for (const auto& m : out.measurements) cuts.push_back(m.t);
+  out.inputs = packInputs(out.inputs, std::move(cuts), model.readingsPerStep(), out.t0);
 }
 
 // How a measurement row names its channel: [dataset] channel_column,
@@ -481,6 +500,7 @@ void readStreams(const std::string& dir, const IniDocument& ini, const Model& mo
   if (std::isinf(out.t0))  // start_time = first
     out.t0 = out.measurements.empty() ? 0.0 : out.measurements.front().t - model.nominalStep();
   if (ini.has("dataset", "zero_channels")) addZeroMeasurements(ini, model, out);
+  packModelInputs(model, out);
   if (out.truth && ini.getBool("dataset", "truth_interpolate", false)) interpolateTruth(model, out);
 }
 }  // namespace

@@ -135,6 +135,11 @@ class Model {
   /// overrides it returns true from processNoiseDependsOnInput().
   virtual Eigen::MatrixXd processNoiseOf(double dt, const Eigen::VectorXd& u) const;
   virtual bool processNoiseDependsOnInput() const { return false; }
+  /// > 1: a step's input packs up to this many raw readings, each with its
+  /// duration (packed_inputs.h: an INS whose states are not at every IMU
+  /// sample); a dataset packs its raw input rows so, with a step ending at
+  /// every measurement. 1 (default): one input row per step.
+  virtual int readingsPerStep() const { return 1; }
 
   /// True when f is affine in (x_c, x_b) for every u and dt and x_c has no
   /// rotation block: a process factor's linearization is then exact

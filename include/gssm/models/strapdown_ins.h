@@ -1,7 +1,7 @@
 #pragma once
 // Strapdown GNSS/INS (issue #37; docs/DESIGN.md §12): one state per IMU
-// sample, the IMU's rates and specific forces as inputs held over each
-// interval, attitude on SO(3) (a rotation block), velocity and position in
+// sample (or every imu_per_state samples and at every measurement), the
+// IMU's rates and specific forces as inputs held over each interval, attitude on SO(3) (a rotation block), velocity and position in
 // a NED frame fixed to the Earth at an anchor (strapdown.h). The sensor's
 // constants are single nodes, each only in the factors that involve it:
 //
@@ -24,7 +24,8 @@
 //          ρ (the IMU clock's rate error: its delay at clock time c is
 //            d + ρ·c; a logger mapping a millisecond counter linearly onto
 //            GPS time leaves one of order 1e-4)]
-//   u   = [ω̃ (rad/s), f̃ (m/s²)] in the IMU's axes
+//   u   = [ω̃ (rad/s), f̃ (m/s²)] in the IMU's axes (imu_per_state = N > 1:
+//          N of them, each after its duration, integrated in turn)
 //
 // Channels: `gnss` (the antenna's NED position at the fix's time,
 // p + R_nb·ℓ − (d + ρ·c)·v), `nhc`
@@ -70,6 +71,11 @@ class StrapdownIns final : public Model {
     /// The gyro bias's random walk beyond the constant b_g (rad/s/√s); 0:
     /// the bias is constant (x_c has no β_g)
     double gyro_bias_walk = 0;
+    /// IMU readings per state (1: a state at every sample; N > 1: the input
+    /// packs N readings with their durations, packed_inputs.h, and f
+    /// integrates them in turn: a state every N samples and at each
+    /// measurement)
+    int imu_per_state = 1;
   };
 
   explicit StrapdownIns(const Params& p);
@@ -87,6 +93,7 @@ class StrapdownIns final : public Model {
   Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
   Eigen::MatrixXd processNoise(double dt) const override;
+  int readingsPerStep() const override { return p_.imu_per_state; }
   /// lat, lon (deg), height (m) of the antenna; vn, ve, vd (m/s); the
   /// vehicle's roll, pitch, yaw w.r.t. NED (deg); the biases; the lever arm
   /// in vehicle axes (m); imu_delay (s); the mounting R_vb as roll, pitch,
@@ -115,6 +122,9 @@ class StrapdownIns final : public Model {
   enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2, kZaru = 3 };
 
  private:
+  // One strapdown step under one reading u = [ω̃, f̃] (the f of N = 1).
+  Eigen::VectorXd step(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::Ref<const Eigen::VectorXd>& u,
+                       double dt, Eigen::MatrixXd* J_f_xc, Eigen::MatrixXd* J_f_xb) const;
   Eigen::VectorXd antenna(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                           Eigen::MatrixXd* J_h_xb) const;
   Eigen::VectorXd restingGyro(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
