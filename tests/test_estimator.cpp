@@ -4,7 +4,10 @@
 #include <random>
 
 #include "gssm/solvers/batch_solver.h"
+#include "gssm/checkpoint/checkpoint.h"
 #include "gssm/core/error.h"
+#include "gssm/io/config.h"
+#include "gssm/io/dataset.h"
 #include "gssm/factors/problem.h"
 #include "gssm/estimator/estimator.h"
 #include "gssm/models/linear.h"
@@ -217,4 +220,44 @@ TEST(Estimator, ReportSaysWhatWasUsed) {
   EXPECT_EQ(inc->report().ordering, EliminationOrdering::ConstrainedColamd);
   o.method = Method::Ekf;
   EXPECT_FALSE(makeEstimator(radar, o)->report().ordering.has_value());
+}
+
+// [fixed_lag] constants_check_sigmas: the fixed lag's own relinearization
+// policy, in place of [smoother]'s, for it alone; a checkpoint carries it.
+TEST(Estimator, TheFixedLagsOwnConstantsCheckIsItsAloneAndCheckpointed) {
+  // The paper's radar run (its prior far from the truth: the constants move).
+  const std::string dir = GSSM_SOURCE_DIR "/datasets/radar-paper";
+  const io::IniDocument ini = io::readScenario(dir);
+  const auto model = io::makeModel(ini, dir);
+  const Model& radar = *model;
+  io::Dataset run;
+  io::readDatasetData(dir, radar, run, io::BadRows::Throw, &ini);
+  auto means = [&](EstimatorOptions o, std::size_t resume_at = 0) {
+    std::vector<Eigen::VectorXd> out;
+    o.t0 = run.t0;
+    auto est = makeEstimator(radar, o);
+    for (std::size_t k = 0; k < run.measurements.size(); ++k) {
+      if (k == resume_at && k > 0) est = restoreCheckpointBytes(radar, checkpointBytes(*est));
+      est->addMeasurement(run.measurements[k].t, run.measurements[k].y);
+      out.push_back(est->current().mean);
+    }
+    return out;
+  };
+  EstimatorOptions shared(Method::FixedLag), own(Method::FixedLag), plain(Method::FixedLag);
+  shared.smoother.constants_check_sigmas = 1e9;
+  own.fixed_lag.constants_check_sigmas = 1e9;
+  const auto a = means(shared), b = means(own), c = means(plain), d = means(own, 200);
+  ASSERT_EQ(a.size(), b.size());
+  double moved = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k], b[k]) << "step " << k;
+    EXPECT_EQ(b[k], d[k]) << "step " << k << " (resumed at 200)";
+    moved = std::max(moved, (c[k] - b[k]).cwiseAbs().maxCoeff());
+  }
+  EXPECT_GT(moved, 1e-3) << "the radar's fixed lag relinearizes when its constants move: the option must show";
+  own.method = plain.method = Method::Incremental;  // not the incremental smoother's
+  EXPECT_EQ(means(own).back(), means(plain).back());
+  own.method = Method::FixedLag;
+  own.fixed_lag.constants_check_sigmas = 0;
+  expectThrowsNaming([&] { makeEstimator(radar, own); }, "fixed_lag.constants_check_sigmas must be > 0");
 }

@@ -29,6 +29,8 @@ bool EstimatorOptions::validate(const Model& model, std::string* why) const {
   if (!std::isfinite(t0)) return fail("t0 must be finite");
   if ((reads & kFixedLagOptions) && fixed_lag.window < 1)
     return fail("fixed_lag.window must be >= 1, got " + std::to_string(fixed_lag.window));
+  if ((reads & kFixedLagOptions) && !std::isnan(fixed_lag.constants_check_sigmas) && !(fixed_lag.constants_check_sigmas > 0))
+    return fail("fixed_lag.constants_check_sigmas must be > 0 (or NaN: [smoother]'s)");
   if ((reads & kPaperWindowOptions) && paper_window.window < 1)
     return fail("paper_window.window must be >= 1, got " + std::to_string(paper_window.window));
   if ((reads & kEkfOptions) && !ekf.validate(model.dims().nb, why)) return false;
@@ -792,11 +794,15 @@ std::unique_ptr<Estimator> makeEstimator(const Model& model, const EstimatorOpti
       e = std::make_unique<SmootherEstimator<IncrementalSmoother>>(model, options, 0, options.smoother,
                                                                    options.incremental.ordering);
       break;
-    case Method::FixedLag:
+    case Method::FixedLag: {
+      EstimatorOptions own = options;  // the fixed lag's relinearization (saved so in a checkpoint)
+      if (!std::isnan(own.fixed_lag.constants_check_sigmas))
+        own.smoother.constants_check_sigmas = own.fixed_lag.constants_check_sigmas;
       e = std::make_unique<SmootherEstimator<FixedLagSmoother>>(
-          model, options, static_cast<std::size_t>(options.fixed_lag.window),
-          FixedLagSmootherOptions{options.fixed_lag.window, options.smoother});
+          model, own, static_cast<std::size_t>(own.fixed_lag.window),
+          FixedLagSmootherOptions{own.fixed_lag.window, own.smoother});
       break;
+    }
     case Method::PaperWindow:
       e = std::make_unique<PaperWindowEstimator>(model, options);
       break;

@@ -87,6 +87,8 @@ ExtendedKalmanFilterOptions ekfOptions(const IniDocument& ini, const Model& mode
 
 // [smoother]'s key beyond SmootherOptions': the incremental smoother's ordering.
 const std::vector<std::string> kSmootherOwnKeys{"ordering"};
+// [fixed_lag]: its window, and its own relinearization check of the constants.
+const std::vector<std::string> kFixedLagKeys{"window", "constants_check_sigmas"};
 
 // [smoother]: the relinearization policy both smoothers share, and the
 // incremental smoother's ordering.
@@ -103,7 +105,8 @@ void readSmoother(const IniDocument& ini, EstimatorOptions& eo) {
 }
 
 int readWindow(const IniDocument& ini, const std::string& section, int fallback) {
-  ini.requireOnlyKeys(section, {"window"});
+  if (section == sectionOf(Method::FixedLag)) ini.requireOnlyKeys(section, kFixedLagKeys);
+  else ini.requireOnlyKeys(section, {"window"});
   const long long w = ini.getInt(section, "window", fallback);
   if (w < 1 || w > 10000000)
     throw InputError(ini.source() + ": [" + section + "] window = " + std::to_string(w) + ": expected >= 1");
@@ -134,6 +137,8 @@ EstimatorOptions estimatorOptions(const IniDocument& ini, const Model& model, Me
   o.ekf = ekfOptions(ini, model);
   readSmoother(ini, o);
   o.fixed_lag.window = readWindow(ini, sectionOf(Method::FixedLag), o.fixed_lag.window);
+  o.fixed_lag.constants_check_sigmas =
+      ini.getDouble(sectionOf(Method::FixedLag), "constants_check_sigmas", o.fixed_lag.constants_check_sigmas);
   o.paper_window.window = readWindow(ini, sectionOf(Method::PaperWindow), o.paper_window.window);
   readBatch(ini, o.batch);
   return o;
@@ -147,6 +152,8 @@ void writeEstimatorOptions(const EstimatorOptions& options, IniDocument& ini) {
   optionKeys(smoother, o.smoother);
   ini.set(sectionOf(Method::Incremental), "ordering", orderingName(o.incremental.ordering));
   ini.set(sectionOf(Method::FixedLag), "window", std::to_string(o.fixed_lag.window));
+  if (!std::isnan(o.fixed_lag.constants_check_sigmas))
+    ini.set(sectionOf(Method::FixedLag), "constants_check_sigmas", formatDouble(o.fixed_lag.constants_check_sigmas));
   ini.set(sectionOf(Method::PaperWindow), "window", std::to_string(o.paper_window.window));
   optionKeys(batch, o.batch);
 }
@@ -156,7 +163,7 @@ std::vector<std::pair<std::string, std::vector<std::string>>> estimatorIniKeys()
   smoother.insert(smoother.end(), kSmootherOwnKeys.begin(), kSmootherOwnKeys.end());
   return {{sectionOf(Method::Ekf), optionKeyNames<ExtendedKalmanFilterOptions>()},
           {sectionOf(Method::Incremental), smoother},
-          {sectionOf(Method::FixedLag), {"window"}},
+          {sectionOf(Method::FixedLag), kFixedLagKeys},
           {sectionOf(Method::PaperWindow), {"window"}},
           {sectionOf(Method::Batch), optionKeyNames<BatchSolverOptions>()}};
 }

@@ -68,7 +68,13 @@ std::vector<IniSection> estimatorSections() {
   return {{section(Method::Ekf), "the extended Kalman filter", optionDocs<ExtendedKalmanFilterOptions>()},
           {section(Method::Incremental), "both smoothers' relinearization, and the incremental smoother's ordering",
            smoother},
-          {section(Method::FixedLag), "the fixed-lag smoother", window(defaults.fixed_lag.window)},
+          {section(Method::FixedLag), "the fixed-lag smoother", [&] {
+             std::vector<IniKey> keys = window(defaults.fixed_lag.window);
+             keys.push_back({"constants_check_sigmas", "number", "([smoother]'s)",
+                             "the fixed lag's own: a large value (1e9) keeps the window's factors at the constants "
+                             "they were added with, as its marginal prior does"});
+             return keys;
+           }()},
           {section(Method::PaperWindow), "the paper's sliding window", window(defaults.paper_window.window)},
           {section(Method::Batch), "the batch solver (and noise learning's E-steps)", optionDocs<BatchSolverOptions>()}};
 }

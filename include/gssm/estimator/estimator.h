@@ -83,7 +83,16 @@ struct EstimatorOptions {
   struct Window {
     int window = 10;                ///< states x_c kept (the newest), ≥ 1; the paper window solves one more, then drops the oldest
   };
-  Window fixed_lag;                 ///< [fixed_lag] window; always time-ordered
+  struct FixedLag : Window {
+    /// [fixed_lag] constants_check_sigmas: the fixed lag's own, in place of
+    /// [smoother]'s (NaN: that one). Its marginal prior holds the constants
+    /// linearized where each state left the window; relinearizing the
+    /// window's factors at newer constants makes the two disagree (a large
+    /// value, 1e9: the window's factors keep the constants they were added
+    /// with, only the newest are checked). docs/DESIGN.md §12.
+    double constants_check_sigmas = std::numeric_limits<double>::quiet_NaN();
+  };
+  FixedLag fixed_lag;               ///< [fixed_lag] window, constants_check_sigmas; always time-ordered
   Window paper_window;              ///< [paper_window] window
   BatchSolverOptions batch;         ///< batch  [batch]
 
