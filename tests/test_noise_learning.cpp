@@ -13,6 +13,7 @@
 #include "gssm/model/registry.h"
 #include "gssm/models/linear.h"
 #include "gssm/models/range_beacon2d.h"
+#include "learn/scoring.h"
 #include "reference_kalman.h"
 #include "track_with_bias.h"
 
@@ -371,6 +372,46 @@ TEST(NoiseLearning, AnUnknownOptimizerIsRefused) {
   std::string why;
   EXPECT_FALSE(o.validate(&why));
   EXPECT_NE(why.find("optimizer 'newton'"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace gssm
+
+namespace gssm {
+namespace {
+
+// Scoring on a likelihood known in closed form: terms −½(y_k − θ)², whose
+// maximum is the mean of y; and where passes fail beyond θ = 0.5 (a filter
+// that diverges there), it stops below without crashing, converged or not.
+TEST(Scoring, ReachesAClosedFormMaximumAndStopsWherePassesFail) {
+  const Eigen::VectorXd y = (Eigen::VectorXd(5) << 0.9, 1.3, 0.7, 1.1, 1.5).finished();
+  auto at = [&](double fail_above) {
+    return [&y, fail_above](const std::vector<Eigen::VectorXd>& thetas) {
+      std::vector<internal::LikelihoodTerms> out;
+      for (const auto& th : thetas) {
+        internal::LikelihoodTerms t;
+        if (th[0] > fail_above) {
+          t.total = -std::numeric_limits<double>::infinity();
+        } else {
+          t.terms = -0.5 * (y.array() - th[0]).square().matrix();
+          t.total = t.terms.sum();
+        }
+        out.push_back(t);
+      }
+      return out;
+    };
+  };
+  internal::ScoringOptions o;
+  o.lo = Eigen::VectorXd::Constant(1, -10), o.hi = Eigen::VectorXd::Constant(1, 10);
+  o.tolerance = 1e-12;
+  const auto r = internal::maximizeByScoring(at(1e9), Eigen::VectorXd::Zero(1), o);
+  EXPECT_TRUE(r.converged);
+  // Forward differences put the top half a step (step/2 = 5e-6) below it.
+  EXPECT_NEAR(r.x[0], y.mean() - 0.5 * o.step, 1e-9);
+  const auto cut = internal::maximizeByScoring(at(0.5), Eigen::VectorXd::Zero(1), o);
+  EXPECT_LE(cut.x[0], 0.5);
+  EXPECT_TRUE(std::isfinite(cut.value));
+  EXPECT_GT(cut.value, at(1e9)({Eigen::VectorXd::Zero(1)}).front().total);
 }
 
 }  // namespace

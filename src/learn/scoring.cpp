@@ -129,8 +129,8 @@ ScoringResult maximizeByScoring(const LikelihoodTermsAt& at, const Eigen::Vector
       continue;
     }
     Slope at_next = slopeAt(at, next, here, o, s.central, r.evaluations);
-    updateCurvature(H, next - r.x, at_next.g - s.g, at_next.B);
-    r.x = next, s = std::move(at_next);
+    if (at_next.ok) updateCurvature(H, next - r.x, at_next.g - s.g, at_next.B);
+    r.x = next, s = std::move(at_next);  // not ok: a pass failed a step away, the search ends here
   }
   r.value = here.total;
   return r;

@@ -30,7 +30,10 @@ struct ScoringOptions {
   /// Converged when the undamped step's predicted gain ½ gᵀB⁻¹g (its Newton
   /// decrement) is under tolerance·(1 + |ℓ|).
   double tolerance = 1e-7;
-  double step = 1e-5;  ///< forward-difference step in θ
+  /// Forward-difference step in θ. Their slope vanishes half a step from
+  /// the top (−ℓ''·step/2 is their error), so the maximum found lies within
+  /// step/2 of the true one: 5e-6 in log σ, far inside any standard error.
+  double step = 1e-5;
   double max_step = 2;  ///< largest move of one θ per iteration (a factor e² in σ)
 };
 
