@@ -61,6 +61,7 @@ class EstimatorOptions:
     batch: BatchOptions
     ordering: str
     fixed_lag_window: int
+    fixed_lag_constants_check_sigmas: float
     paper_window_window: int
     @property
     def window(self) -> int: ...

@@ -157,7 +157,7 @@ void bindOptionGroups(py::module_& m) {
 py::tuple pickledOptions(const EstimatorOptions& o) {
   return py::make_tuple(std::string(methodName(o.method)), o.t0, o.compute_nis, optionDict(o.ekf), optionDict(o.smoother),
                         orderingName(o.incremental.ordering), o.fixed_lag.window, o.paper_window.window,
-                        optionDict(o.batch), o.drop_late);
+                        optionDict(o.batch), o.drop_late, o.fixed_lag.constants_check_sigmas);
 }
 
 EstimatorOptions unpickledOptions(const py::tuple& t) {
@@ -171,6 +171,7 @@ EstimatorOptions unpickledOptions(const py::tuple& t) {
   o.paper_window.window = t[7].cast<int>();
   setOptions(o.batch, t[8]);
   if (t.size() > 9) o.drop_late = t[9].cast<bool>();
+  if (t.size() > 10) o.fixed_lag.constants_check_sigmas = t[10].cast<double>();
   return o;
 }
 
@@ -197,6 +198,11 @@ void bindEstimatorOptions(py::module_& m) {
       .def_property(
           "fixed_lag_window", [](const EstimatorOptions& o) { return o.fixed_lag.window; },
           [](EstimatorOptions& o, int w) { o.fixed_lag.window = w; })
+      .def_property(
+          "fixed_lag_constants_check_sigmas",
+          [](const EstimatorOptions& o) { return o.fixed_lag.constants_check_sigmas; },
+          [](EstimatorOptions& o, double v) { o.fixed_lag.constants_check_sigmas = v; },
+          "[fixed_lag] constants_check_sigmas: the fixed lag's own, in place of smoother's (NaN: that one)")
       .def_property(
           "paper_window_window", [](const EstimatorOptions& o) { return o.paper_window.window; },
           [](EstimatorOptions& o, int w) { o.paper_window.window = w; })

@@ -1,6 +1,8 @@
 """Datasets round-trip through NumPy and back to the bytes gssm-simulate
 writes; the analysis arrays equal what gssm-process reports."""
 import filecmp
+import math
+import pickle
 import json
 import os
 
@@ -107,9 +109,12 @@ def test_options_objects_have_the_ini_keys_and_the_cpp_defaults():
     # [smoother] ordering is the incremental smoother's: EstimatorOptions.ordering.
     assert set(keys["smoother"]) == public(gssm.SmootherOptions()) | {"ordering"}
     assert set(keys["batch"]) == public(gssm.BatchOptions())
-    assert keys["fixed_lag"] == ["window"] and keys["paper_window"] == ["window"]
+    assert keys["fixed_lag"] == ["window", "constants_check_sigmas"] and keys["paper_window"] == ["window"]
     o = gssm.EstimatorOptions("fixed-lag")
-    assert {"ordering", "fixed_lag_window", "paper_window_window"} <= public(o)
+    assert {"ordering", "fixed_lag_window", "fixed_lag_constants_check_sigmas", "paper_window_window"} <= public(o)
+    assert math.isnan(o.fixed_lag_constants_check_sigmas)  # the fixed lag follows [smoother]'s
+    o.fixed_lag_constants_check_sigmas = 1e9
+    assert pickle.loads(pickle.dumps(o)).fixed_lag_constants_check_sigmas == 1e9
     # Defaults are the C++ structs' (the INI a default EstimatorOptions would write).
     assert gssm.BatchOptions().algorithm == "levenberg-marquardt" and gssm.BatchOptions().initial_lambda == 1e-8
     with pytest.raises(gssm.InvalidArgument, match="algorithm.*levenberg-marquardt or gauss-newton"):
