@@ -18,6 +18,7 @@
 #include "gssm/estimator/estimator.h"
 #include "gssm/io/config.h"
 #include "gssm/io/dataset.h"
+#include "gssm/model/packed_inputs.h"
 #include "bundled_dataset.h"
 
 namespace {
@@ -36,9 +37,7 @@ double readingsBefore(const Drive& d, double end) {
   const int per = d.model->readingsPerStep();
   for (const auto& in : d.data.inputs) {
     if (in.t >= end) break;
-    if (per == 1) n += 1;
-    else
-      for (int j = 0; j < per; ++j) n += in.u[j * (in.u.size() / per)] > 0 ? 1 : 0;
+    n += per == 1 ? 1 : gssm::packedReadings(in.u, per);
   }
   return n;
 }

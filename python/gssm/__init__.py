@@ -161,8 +161,9 @@ def learn(model_or_folder, data=None, *, out=None, config=None, parameters=None,
             raise InvalidArgument("gssm.learn(factory, data, sigmas={name: given σ, ...}): name the σs it takes")
         names = list(sigmas)
         factory = model_or_folder
+        # one pass at a time (options without threads): the factory and its model's f and h are Python
         return _gssm._learn_family(lambda s: factory(**dict(zip(names, (float(v) for v in s)))), names,
-                                   [float(sigmas[n]) for n in names], data, *options)
+                                   [float(sigmas[n]) for n in names], data, *options[:-1])
     if isinstance(model_or_folder, (str, os.PathLike)):
         if data is not None or out is None:
             raise InvalidArgument("gssm.learn(folder, out=DIR): a dataset folder takes out=, not data")

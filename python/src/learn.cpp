@@ -79,7 +79,7 @@ void bindLearn(py::module_& m) {
       "_learn_family",
       [](const py::function& make, const std::vector<std::string>& names, const Eigen::VectorXd& given,
          const PyDataset& d, double start, double search_range, int max_evaluations, double tolerance,
-         int max_restarts, bool standard_errors, const std::string& optimizer, int /*threads*/) {
+         int max_restarts, bool standard_errors, const std::string& optimizer) {
         NoiseFamily family;
         family.names = names;
         family.given = given;
@@ -96,7 +96,7 @@ void bindLearn(py::module_& m) {
       },
       py::arg("make"), py::arg("names"), py::arg("given"), py::arg("data"), py::arg("start"), py::arg("search_range"),
       py::arg("max_evaluations"), py::arg("tolerance"), py::arg("max_restarts"), py::arg("standard_errors"),
-      py::arg("optimizer"), py::arg("threads"));
+      py::arg("optimizer"));
   m.def(
       "_learn_folder",
       [](const std::string& data, const std::string& out, const std::string& config) {

@@ -104,9 +104,9 @@ void readSmoother(const IniDocument& ini, EstimatorOptions& eo) {
   if (!eo.smoother.validate(&why)) throw InputError(ini.source() + ": [" + smoother + "] " + why);
 }
 
-int readWindow(const IniDocument& ini, const std::string& section, int fallback) {
-  if (section == sectionOf(Method::FixedLag)) ini.requireOnlyKeys(section, kFixedLagKeys);
-  else ini.requireOnlyKeys(section, {"window"});
+int readWindow(const IniDocument& ini, const std::string& section, int fallback,
+               const std::vector<std::string>& keys) {
+  ini.requireOnlyKeys(section, keys);
   const long long w = ini.getInt(section, "window", fallback);
   if (w < 1 || w > 10000000)
     throw InputError(ini.source() + ": [" + section + "] window = " + std::to_string(w) + ": expected >= 1");
@@ -136,10 +136,10 @@ EstimatorOptions estimatorOptions(const IniDocument& ini, const Model& model, Me
   EstimatorOptions o(method);
   o.ekf = ekfOptions(ini, model);
   readSmoother(ini, o);
-  o.fixed_lag.window = readWindow(ini, sectionOf(Method::FixedLag), o.fixed_lag.window);
+  o.fixed_lag.window = readWindow(ini, sectionOf(Method::FixedLag), o.fixed_lag.window, kFixedLagKeys);
   o.fixed_lag.constants_check_sigmas =
       ini.getDouble(sectionOf(Method::FixedLag), "constants_check_sigmas", o.fixed_lag.constants_check_sigmas);
-  o.paper_window.window = readWindow(ini, sectionOf(Method::PaperWindow), o.paper_window.window);
+  o.paper_window.window = readWindow(ini, sectionOf(Method::PaperWindow), o.paper_window.window, {"window"});
   readBatch(ini, o.batch);
   return o;
 }

@@ -234,7 +234,7 @@ void readStartAndRows(const IniDocument& ini, Dataset& out) {
 // packed one (packed_inputs.h: [dt, reading] per slot).
 int rawInputSize(const Model& model) {
   const int n = model.readingsPerStep();
-  return n == 1 ? model.dims().nu : model.dims().nu / n - 1;
+  return n == 1 ? model.dims().nu : static_cast<int>(packedReadingSize(model.dims().nu, n));
 }
 
 void readInputs(const std::string& path, const IniDocument& ini, const Model& model, Dataset& out) {

@@ -8,8 +8,6 @@
 namespace gssm::internal {
 
 namespace {
-constexpr double kMinusInf = -std::numeric_limits<double>::infinity();
-
 // The gradient g = Σ_k ∇ℓ_k and the outer-product information B = Σ_k
 // ∇ℓ_k ∇ℓ_kᵀ from differences of every term: forward (backward at the
 // box's upper end; p passes beside the one at x) or, once those no longer

@@ -5,9 +5,9 @@
 // a martingale difference's score, so the outer product of the terms'
 // gradients estimates the information (Berndt, Hall, Hall & Hausman, Ann.
 // Econ. Soc. Meas. 3(4), 1974). Forward differences of every term give the
-// gradient and that matrix from the same p + 1 filter passes, and a damped
-// Newton step on them (Levenberg) reaches the maximum in a few iterations
-// where Nelder–Mead takes hundreds of passes.
+// gradient and that matrix from the same p + 1 filter passes; quasi-Newton
+// steps from it (then BFGS's secant updates) reach the maximum in a few
+// iterations where Nelder–Mead takes hundreds of passes.
 #include <Eigen/Core>
 #include <functional>
 #include <vector>
@@ -27,8 +27,8 @@ using LikelihoodTermsAt = std::function<std::vector<LikelihoodTerms>(const std::
 struct ScoringOptions {
   Eigen::VectorXd lo, hi;  ///< the box θ stays in
   int max_evaluations = 4000;
-  /// Converged when the undamped step's predicted gain ½ gᵀB⁻¹g (its Newton
-  /// decrement) is under tolerance·(1 + |ℓ|).
+  /// Converged when the next quasi-Newton step's predicted gain ½ gᵀH⁻¹g
+  /// (H: the curvature, B then BFGS) is under tolerance·(1 + |ℓ|).
   double tolerance = 1e-7;
   /// Forward-difference step in θ. Their slope vanishes half a step from
   /// the top (−ℓ''·step/2 is their error), so the maximum found lies within

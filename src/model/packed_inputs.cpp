@@ -38,9 +38,13 @@ std::vector<Input> packInputs(const std::vector<Input>& raw, std::vector<double>
   const Eigen::VectorXd none = Eigen::VectorXd::Zero(width);
   const Eigen::VectorXd* held = &none;  // the reading in force
   std::size_t ri = 0, ci = 0;
-  for (; ri < raw.size() && (raw[ri].t <= t0 || sameTime(raw[ri].t, t0)); ++ri) held = &raw[ri].u;
-  for (; ci < cuts.size() && (cuts[ci] <= t0 || sameTime(cuts[ci], t0)); ++ci) {
-  }
+  const auto atOrBefore = [](double a, double t) { return a <= t || sameTime(a, t); };
+  // Past the events at or before t: the reading then in force is held.
+  const auto passTo = [&](double t) {
+    for (; ri < raw.size() && atOrBefore(raw[ri].t, t); ++ri) held = &raw[ri].u;
+    while (ci < cuts.size() && atOrBefore(cuts[ci], t)) ++ci;
+  };
+  passTo(t0);
   std::vector<Input> out;
   Pack pack{t0, {}};
   double now = t0;
@@ -49,16 +53,14 @@ std::vector<Input> packInputs(const std::vector<Input>& raw, std::vector<double>
     const double t = std::min(tr, tc);
     const bool cut = ci < cuts.size() && (tc <= tr || sameTime(tc, tr));
     if (t > now && !sameTime(t, now)) pack.slots.emplace_back(t - now, held), now = t;
-    for (; ri < raw.size() && (raw[ri].t <= t || sameTime(raw[ri].t, t)); ++ri) held = &raw[ri].u;
-    for (; ci < cuts.size() && (cuts[ci] <= t || sameTime(cuts[ci], t)); ++ci) {
-    }
+    passTo(t);
     if (!cut && static_cast<int>(pack.slots.size()) < per_step) continue;
     if (pack.slots.empty()) continue;  // an event at the step's own start
     out.push_back(pack.close(per_step, width, *held));
     pack = Pack{now, {}};
   }
-  if (!pack.slots.empty()) out.push_back(pack.close(per_step, width, *held)), pack = Pack{now, {}};
-  out.push_back(pack.close(per_step, width, *held));  // the last state's: holds the reading in force there
+  if (!pack.slots.empty()) out.push_back(pack.close(per_step, width, *held));
+  out.push_back(Pack{now, {}}.close(per_step, width, *held));  // the last state's: holds the reading in force there
   return out;
 }
 

@@ -153,13 +153,23 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
     const Eigen::Matrix<double, 9, 9> Jx_next = J.J_next_x.lazyProduct(Jx);
     Jb = Jb_next, Jx = Jx_next;
   });
+  return stepResult(xc, x, dt, Jx, Jb, J_f_xc, J_f_xb);
+}
+
+// x_c after a step to the navigation state `next` over dt (the clock adds dt,
+// β_g stays), and f's Jacobians from those of the nine navigation rows: Jx
+// on them, Jb on [b_g, b_a, s_g, s_a] (β_g enters as b_g does).
+Eigen::VectorXd StrapdownIns::stepResult(const Eigen::VectorXd& xc, const strapdown::NavState& next, double dt,
+                                         const Eigen::Matrix<double, 9, 9>& Jx,
+                                         const Eigen::Matrix<double, 9, 12>& Jb, Eigen::MatrixXd* J_f_xc,
+                                         Eigen::MatrixXd* J_f_xb) const {
   const int nc = dims().nc;
   if (J_f_xc) {
     J_f_xc->setZero(nc, nc);
     J_f_xc->topLeftCorner<9, 9>() = Jx;
     (*J_f_xc)(kClock, kClock) = 1;
     if (gyroBiasWalks()) {
-      J_f_xc->block<9, 3>(0, kGyroWalk) = Jb.leftCols<3>();  // β_g enters as b_g does
+      J_f_xc->block<9, 3>(0, kGyroWalk) = Jb.leftCols<3>();
       J_f_xc->block<3, 3>(kGyroWalk, kGyroWalk).setIdentity();
     }
   }
@@ -169,7 +179,7 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
     J_f_xb->block<9, 6>(0, kGyroScale) = Jb.rightCols<6>();  // s_g then s_a
   }
   Eigen::VectorXd out(nc);
-  out.head<kStates>() << so3::Log(x.R), x.v, x.p, xc[kClock] + dt;
+  out.head<kStates>() << so3::Log(next.R), next.v, next.p, xc[kClock] + dt;
   if (gyroBiasWalks()) out.tail<3>() = xc.segment<3>(kGyroWalk);
   return out;
 }
@@ -186,29 +196,12 @@ Eigen::VectorXd StrapdownIns::step(const Eigen::VectorXd& xc, const Eigen::Vecto
   const Eigen::Vector3d gyro = u.head<3>(), accel = u.tail<3>();
   const Eigen::Vector3d gyro_c = gyro - xb.segment<3>(kGyroScale).cwiseProduct(gyro);
   const Eigen::Vector3d accel_c = accel - xb.segment<3>(kAccelScale).cwiseProduct(accel);
-  const int nc = dims().nc;
+  const bool jac = J_f_xc || J_f_xb;
   const strapdown::NavState next = strapdown::step(x, gyro_c, accel_c, gyroBias(xc, xb), xb.segment<3>(kAccelBias),
-                                                   dt, frame_, J_f_xc || J_f_xb ? &J : nullptr);
-  if (J_f_xc) {
-    J_f_xc->setZero(nc, nc);
-    J_f_xc->topLeftCorner<9, 9>() = J.J_next_x;
-    (*J_f_xc)(kClock, kClock) = 1;
-    if (gyroBiasWalks()) {
-      J_f_xc->block<9, 3>(0, kGyroWalk) = J.J_next_bg;  // β_g enters as b_g does
-      J_f_xc->block<3, 3>(kGyroWalk, kGyroWalk).setIdentity();
-    }
-  }
-  if (J_f_xb) {
-    J_f_xb->setZero(nc, kConstants);
-    J_f_xb->block<9, 3>(0, kGyroBias) = J.J_next_bg;
-    J_f_xb->block<9, 3>(0, kAccelBias) = J.J_next_ba;
-    J_f_xb->block<9, 3>(0, kGyroScale) = J.J_next_bg * gyro.asDiagonal();
-    J_f_xb->block<9, 3>(0, kAccelScale) = J.J_next_ba * accel.asDiagonal();
-  }
-  Eigen::VectorXd out(nc);
-  out.head<kStates>() << so3::Log(next.R), next.v, next.p, xc[kClock] + dt;
-  if (gyroBiasWalks()) out.tail<3>() = xc.segment<3>(kGyroWalk);
-  return out;
+                                                   dt, frame_, jac ? &J : nullptr);
+  Eigen::Matrix<double, 9, 12> jb;  // b_g, b_a, s_g, s_a
+  if (jac) jb << J.J_next_bg, J.J_next_ba, J.J_next_bg * gyro.asDiagonal(), J.J_next_ba * accel.asDiagonal();
+  return stepResult(xc, next, dt, J.J_next_x, jb, J_f_xc, J_f_xb);
 }
 
 Eigen::VectorXd StrapdownIns::h(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,

@@ -25,12 +25,24 @@ namespace gssm {
 /// inputs of different sizes or out of order.
 std::vector<Input> packInputs(const std::vector<Input>& raw, std::vector<double> cuts, int per_step, double t0);
 
+/// The size of one raw reading in a packed input of `packed_size` entries
+/// and `per_step` slots ([dt, reading] each).
+inline Eigen::Index packedReadingSize(Eigen::Index packed_size, int per_step) { return packed_size / per_step - 1; }
+
+/// The readings a packed input holds (its slots with a duration).
+inline int packedReadings(const Eigen::VectorXd& u, int per_step) {
+  const Eigen::Index width = u.size() / per_step;
+  int n = 0;
+  for (int j = 0; j < per_step; ++j) n += u[j * width] > 0 ? 1 : 0;
+  return n;
+}
+
 /// The raw readings of a packed input u of `per_step` slots (raw size
 /// u.size() / per_step − 1) with their durations, as f integrates them over dt:
 /// calls step(reading, duration) in order until dt is used up.
 template <class Step>
 void forEachPackedReading(const Eigen::VectorXd& u, int per_step, double dt, Step&& step) {
-  const Eigen::Index width = u.size() / per_step, raw = width - 1;
+  const Eigen::Index raw = packedReadingSize(u.size(), per_step), width = raw + 1;
   double left = dt;
   for (int j = 0; j < per_step && left > 0; ++j) {
     const double dj = u[j * width];

@@ -125,6 +125,9 @@ class StrapdownIns final : public Model {
   // One strapdown step under one reading u = [ω̃, f̃] (the f of N = 1).
   Eigen::VectorXd step(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::Ref<const Eigen::VectorXd>& u,
                        double dt, Eigen::MatrixXd* J_f_xc, Eigen::MatrixXd* J_f_xb) const;
+  Eigen::VectorXd stepResult(const Eigen::VectorXd& xc, const strapdown::NavState& next, double dt,
+                             const Eigen::Matrix<double, 9, 9>& Jx, const Eigen::Matrix<double, 9, 12>& Jb,
+                             Eigen::MatrixXd* J_f_xc, Eigen::MatrixXd* J_f_xb) const;
   Eigen::VectorXd antenna(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                           Eigen::MatrixXd* J_h_xb) const;
   Eigen::VectorXd restingGyro(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
