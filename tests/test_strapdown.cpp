@@ -66,6 +66,32 @@ TEST(Strapdown, StepJacobiansMatchDifferences) {
     }
 }
 
+// Chaining a pack of readings multiplies by each step's J_next_x through its
+// block structure (StepJacobians::leftMultiply): the dense product's result,
+// at attitudes from level to gimbal lock, short and long steps.
+TEST(Strapdown, StructuredLeftMultiplyIsTheDenseProduct) {
+  const strapdown::NavFrame frame(kAnchor);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n01;
+  for (const Vector3& rpy : {Vector3(0, 0, 0), Vector3(0.2, M_PI / 2, 1.0), Vector3(-0.3, 0.4, -M_PI + 1e-9)})
+    for (double dt : {0.01, 0.25}) {
+      NavState x;
+      x.R = so3::fromRollPitchYaw(rpy);
+      x.v = Vector3(8.7, -3.0, 0.4);
+      x.p = Vector3(350, -1200, 24);
+      strapdown::StepJacobians J;
+      strapdown::step(x, Vector3(0.02, -0.15, 0.3), Vector3(1.2, -0.4, -9.6), Vector3::Zero(), Vector3::Zero(), dt,
+                      frame, &J);
+      Eigen::Matrix<double, 9, 12> M;
+      for (Eigen::Index i = 0; i < M.size(); ++i) M(i) = n01(rng);
+      const Eigen::Matrix<double, 9, 12> dense = J.J_next_x * M, structured = J.leftMultiply(M);
+      EXPECT_LT((structured - dense).cwiseAbs().maxCoeff(), 1e-12 * (1 + dense.cwiseAbs().maxCoeff()))
+          << "rpy " << rpy.transpose() << " dt " << dt;
+      const Eigen::Matrix<double, 9, 9> I = Eigen::Matrix<double, 9, 9>::Identity();
+      EXPECT_LT((J.leftMultiply(I) - J.J_next_x).cwiseAbs().maxCoeff(), 1e-14) << "rpy " << rpy.transpose();
+    }
+}
+
 TEST(Strapdown, AnImuAtRestStaysWhereItIs) {
   // At rest the gyros sense the Earth's rotation and the accelerometers the
   // reaction to gravity, in body axes; 100 s at 100 Hz must not move it.

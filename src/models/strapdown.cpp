@@ -34,6 +34,7 @@ NavState step(const NavState& x, const so3::Vector3& gyro, const so3::Vector3& a
     // ∂a/∂θ = −R·hat(a_body), ∂a/∂v = −2·hat(ω_ie), ∂a/∂p = ∂g/∂p, ∂a/∂b_a = −R.
     const Matrix3 a_theta = -x.R * so3::hat(a_body), a_v = -2 * so3::hat(w_ie);
     const Matrix3 I = Matrix3::Identity();
+    J->dt = dt;
     J->J_next_x.setZero();
     J->J_next_x.block<3, 3>(0, 0) = dR.transpose();
     J->J_next_x.block<3, 3>(3, 0) = a_theta * dt;

@@ -103,6 +103,11 @@ class ExtendedKalmanFilter {
     std::vector<Eigen::Index> nonzero;  // H's nonzero columns
     Eigen::LLT<Eigen::MatrixXd> llt;
   };
+  // A prediction's: f's Jacobians, A = [F_c F_cb], T = A P and the new P_cc.
+  struct PredictBuffers {
+    Eigen::MatrixXd J_f_xc, J_f_xb, A, T, Pcc;
+    Eigen::VectorXd constants_var;  // P_bb's diagonal plus the constants' own process noise
+  };
   void innovationCovariance(const Eigen::MatrixXd& R);
   bool josephUpdate();
   const Model* model_;
@@ -116,6 +121,7 @@ class ExtendedKalmanFilter {
   std::vector<char> counted_;  // per channel, from likelihood_channels (empty: all)
   std::int64_t rejected_ = 0;
   UpdateBuffers u_;
+  PredictBuffers p_;
 };
 
 /// Runs `filter` over a step schedule (stepSchedule's): predicts to each
