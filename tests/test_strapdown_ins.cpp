@@ -4,6 +4,7 @@
 // solve of the same graph for the incremental smoother.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <iostream>
 
@@ -167,6 +168,35 @@ TEST(StrapdownIns, RoundTripsThroughItsIniForm) {
   const auto& p = dynamic_cast<const StrapdownIns&>(*again).params();
   EXPECT_NEAR(p.anchor.lat, model.params().anchor.lat, 1e-15);
   EXPECT_LT((p.mount_rpy - model.params().mount_rpy).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+// [prior] heading_sd adds variance to the start attitude along a turn about
+// the frame's vertical only: that tangent direction changes the yaw and not
+// the roll or pitch (at a tilted attitude, where body z is not the
+// vertical), and the prior's variance along it grows by heading_sd²; it
+// round-trips through the INI form.
+TEST(StrapdownIns, HeadingSdWidensTheStartAttitudeAboutTheVerticalOnly) {
+  StrapdownIns::Params p = driveParams(0.01);
+  p.start_rpy = Eigen::Vector3d(0.3, -0.2, 1.0);
+  const StrapdownIns plain(p);
+  p.start_heading_sd = 0.2;
+  const StrapdownIns widened(p);
+  const Eigen::Matrix3d extra =
+      widened.priorState().covariance.topLeftCorner<3, 3>() - plain.priorState().covariance.topLeftCorner<3, 3>();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(extra);
+  EXPECT_NEAR(eig.eigenvalues()[2], 0.04, 1e-12);
+  EXPECT_NEAR(eig.eigenvalues()[1], 0.0, 1e-12);
+  const Eigen::Vector3d direction = eig.eigenvectors().col(2);
+  const Eigen::Matrix3d R = so3::fromRollPitchYaw(p.start_rpy);
+  const double eps = 1e-6;
+  const Eigen::Vector3d turned = so3::rollPitchYaw(R * so3::Exp(Eigen::Vector3d(eps * direction)));
+  const Eigen::Vector3d change = (turned - p.start_rpy) / eps;
+  EXPECT_NEAR(std::abs(change.z()), 1.0, 1e-5) << change.transpose();
+  EXPECT_LT(change.head<2>().norm(), 1e-5) << change.transpose();
+  io::IniDocument ini;
+  io::writeModel(widened, ini);
+  const auto again = io::makeModel(io::IniDocument::parse(ini.toString(), "ins.ini"));
+  EXPECT_LT((again->priorState().covariance - widened.priorState().covariance).cwiseAbs().maxCoeff(), 1e-15);
 }
 
 // The frame's anchor from the log itself: the first fix of its .pos.

@@ -63,6 +63,8 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
   if (p.imu_per_state < 1 || p.imu_per_state > 1000)
     throw InvalidArgument("StrapdownIns: imu_per_state = " + std::to_string(p.imu_per_state) + ": expected 1..1000");
+  if (!(p.start_heading_sd >= 0) || !std::isfinite(p.start_heading_sd))
+    throw InvalidArgument("StrapdownIns: start_heading_sd must be >= 0");
   if (!(p.gyro_bias_walk >= 0) || !std::isfinite(p.gyro_bias_walk))
     throw InvalidArgument("StrapdownIns: gyro_bias_walk must be >= 0 (0: a constant gyro bias)");
   ModelNoise n;
@@ -77,6 +79,11 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   // β_g starts at 0 (b_g holds the bias at the start), as firmly as the clock.
   if (nc > StrapdownIns::kStates) sd.tail<3>().setConstant(p.gyro_bias_walk * std::sqrt(p.T));
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
+  // The heading's further variance on the tangent δθ (R ⊕ δθ = R·Exp(δθ)):
+  // a turn ψ about the frame's down is δθ = ψ·Rᵀe_d.
+  const Eigen::Vector3d down_in_body = so3::fromRollPitchYaw(p.start_rpy).transpose() * Eigen::Vector3d::UnitZ();
+  n.prior_state.covariance.topLeftCorner<3, 3>() +=
+      p.start_heading_sd * p.start_heading_sd * down_in_body * down_in_body.transpose();
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
   bmean.segment<3>(StrapdownIns::kLever) = so3::fromRollPitchYaw(p.mount_rpy).transpose() * p.lever;  // IMU axes
   bsd << Eigen::Vector3d::Constant(p.gyro_bias_sd), Eigen::Vector3d::Constant(p.accel_bias_sd),
@@ -325,6 +332,9 @@ std::vector<ParamSpec> insParams() {
       vector("prior", "start_velocity", "prior mean of v(0), NED (m/s)"),
       vector("prior", "start_position", "prior mean of p(0), NED (m)"),
       real("prior", "attitude_sd", "prior σ of the attitude (deg)"),
+      real("prior", "heading_sd",
+           "a further prior σ of the start attitude about the vertical (deg, default 0; with start = data the "
+           "track's heading holds the IMU's only through the mounting: mount_sd accounts for that)"),
       real("prior", "velocity_sd", "prior σ of v(0) (m/s)"),
       real("prior", "position_sd", "prior σ of p(0) (m)"),
       real("prior", "gyro_bias_sd", "prior σ of the gyro bias (rad/s), mean 0"),
@@ -440,6 +450,7 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   if (in.has("prior", "start_position")) p.start_position = in.vector("prior", "start_position", 3);
   p.attitude_sd = in.real("prior", "attitude_sd", p.attitude_sd / kDeg) * kDeg;
   p.mount_sd = in.real("prior", "mount_sd", p.mount_sd / kDeg) * kDeg;
+  p.start_heading_sd = in.real("prior", "heading_sd", p.start_heading_sd / kDeg) * kDeg;
   for (auto [key, value] : {std::pair{"velocity_sd", &p.velocity_sd}, {"position_sd", &p.position_sd},
                             {"gyro_bias_sd", &p.gyro_bias_sd}, {"accel_bias_sd", &p.accel_bias_sd},
                             {"lever_sd", &p.lever_sd}, {"delay_sd", &p.delay_sd},
@@ -463,7 +474,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("prior", "start_velocity", p.start_velocity);
   out.vector("prior", "start_position", p.start_position);
   out.vector("prior", "lever", p.lever);
-  for (auto [key, value] : {std::pair{"attitude_sd", p.attitude_sd / kDeg}, {"velocity_sd", p.velocity_sd},
+  for (auto [key, value] : {std::pair{"attitude_sd", p.attitude_sd / kDeg},
+                            {"heading_sd", p.start_heading_sd / kDeg}, {"velocity_sd", p.velocity_sd},
                             {"position_sd", p.position_sd}, {"gyro_bias_sd", p.gyro_bias_sd},
                             {"accel_bias_sd", p.accel_bias_sd}, {"lever_sd", p.lever_sd}, {"mount_sd", p.mount_sd / kDeg},
                             {"delay_sd", p.delay_sd}, {"gyro_scale_sd", p.gyro_scale_sd},

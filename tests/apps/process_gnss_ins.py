@@ -37,12 +37,13 @@ for name, m in methods.items():
     check(outside <= 0.02, "%s outside the outages %.4f m RMS <= 0.02 m (target)" % (name, outside))
 batch = methods["batch"]["withheld"]["horizontal_rms_m"]
 check(batch <= 0.13, "batch inside the outages %.3f m RMS <= 0.13 m (target)" % batch)
-# Not met yet (issue #37): online 1.3 m. Guarded at today's level (1.47-1.57 m,
-# the noise learnt by the GNSS fixes' likelihood given the constraints) so
-# that a change for the worse fails.
-for name in ("incremental", "fixed-lag", "ekf"):
+# Not met yet (issue #37): online 1.3 m. Guarded at today's level (smoothers
+# 1.37 m, EKF 1.56 m, the noise learnt by the GNSS fixes' likelihood given
+# the constraints) so that a change for the worse fails.
+for name, level in (("incremental", 1.45), ("fixed-lag", 1.45), ("ekf", 1.65)):
     e = methods[name]["withheld"]["horizontal_rms_m"]
-    check(e <= 1.8, "%s inside the outages %.2f m RMS (target 1.3 m not met; today's level <= 1.8 m)" % (name, e))
+    check(e <= level, "%s inside the outages %.2f m RMS (target 1.3 m not met; today's level <= %.2f m)"
+          % (name, e, level))
 
 with open(os.path.join(out, "estimates-batch.csv"), newline="") as f:
     rows = list(csv.DictReader(f))

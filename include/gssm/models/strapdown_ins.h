@@ -58,6 +58,11 @@ class StrapdownIns final : public Model {
     Eigen::Vector3d start_velocity{0, 0, 0};   ///< prior mean of v(0) (m/s, NED)
     Eigen::Vector3d start_position{0, 0, 0};   ///< prior mean of p(0) (m, NED)
     double attitude_sd = 0.1, velocity_sd = 1.0, position_sd = 1.0;  ///< their σ (rad, m/s, m)
+    /// A further σ of the start attitude about the vertical (rad): a start
+    /// heading from the car's track holds the IMU's heading only through the
+    /// nominal mounting, whose yaw is uncertain by mount_sd ([prior]
+    /// heading_sd; docs/DESIGN.md §12).
+    double start_heading_sd = 0;
     double gyro_bias_sd = 0.01;                ///< prior σ of b_g (rad/s), mean 0
     double accel_bias_sd = 0.1;                ///< prior σ of b_a (m/s²), mean 0
     Eigen::Vector3d lever{0, 0, 0};            ///< prior mean of the lever arm in vehicle axes (m; x_b holds R_vb0ᵀ·it)
