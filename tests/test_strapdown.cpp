@@ -38,6 +38,15 @@ Space<NavState> navStates() {
           },
           9};
 }
+
+// A car-like state at attitude rpy: 8.7 m/s, 1.3 km from the anchor.
+NavState movingAt(const Vector3& rpy) {
+  NavState x;
+  x.R = so3::fromRollPitchYaw(rpy);
+  x.v = Vector3(8.7, -3.0, 0.4);
+  x.p = Vector3(350, -1200, 24);
+  return x;
+}
 }  // namespace
 
 TEST(Strapdown, StepJacobiansMatchDifferences) {
@@ -47,10 +56,7 @@ TEST(Strapdown, StepJacobiansMatchDifferences) {
   for (const Vector3& rpy : {Vector3(0, 0, 0), Vector3(0.1, -0.12, 2.0), Vector3(3.0, -0.12, 3.1415),
                              Vector3(0.2, M_PI / 2, 1.0), Vector3(-0.3, 0.4, -M_PI + 1e-9)})
     for (double dt : {0.01, 0.25}) {
-      NavState x;
-      x.R = so3::fromRollPitchYaw(rpy);
-      x.v = Vector3(8.7, -3.0, 0.4);
-      x.p = Vector3(350, -1200, 24);
+      const NavState x = movingAt(rpy);
       strapdown::StepJacobians J;
       strapdown::step(x, gyro, accel, bg, ba, dt, frame, &J);
       const std::string at = " at point " + std::to_string(i++);
@@ -75,10 +81,7 @@ TEST(Strapdown, StructuredLeftMultiplyIsTheDenseProduct) {
   std::normal_distribution<double> n01;
   for (const Vector3& rpy : {Vector3(0, 0, 0), Vector3(0.2, M_PI / 2, 1.0), Vector3(-0.3, 0.4, -M_PI + 1e-9)})
     for (double dt : {0.01, 0.25}) {
-      NavState x;
-      x.R = so3::fromRollPitchYaw(rpy);
-      x.v = Vector3(8.7, -3.0, 0.4);
-      x.p = Vector3(350, -1200, 24);
+      const NavState x = movingAt(rpy);
       strapdown::StepJacobians J;
       strapdown::step(x, Vector3(0.02, -0.15, 0.3), Vector3(1.2, -0.4, -9.6), Vector3::Zero(), Vector3::Zero(), dt,
                       frame, &J);
