@@ -1,5 +1,6 @@
 #include "gssm/plot/ticks.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -36,7 +37,10 @@ std::string formatTick(double v, double step) {
   char buf[32];
   const double a = std::abs(v);
   if (a != 0 && (a >= 1e6 || a < 1e-4)) {
-    std::snprintf(buf, sizeof buf, "%.3g", v);
+    // As many significant digits as tell one tick from the next (GPS
+    // seconds, ~1.4e9 a step of 50 apart, need ten; 3 at least).
+    const int digits = static_cast<int>(std::floor(std::log10(a)) - std::floor(std::log10(std::abs(step)))) + 2;
+    std::snprintf(buf, sizeof buf, "%.*g", std::clamp(digits, 3, 15), v);
     return buf;
   }
   int decimals = 0;

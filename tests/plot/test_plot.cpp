@@ -38,6 +38,12 @@ TEST(Ticks, RoundNumbersCoveringTheRange) {
   EXPECT_EQ(formatTick(1000, 5), "1000");
   EXPECT_EQ(formatTick(0.05, 0.05), "0.05");
   EXPECT_EQ(formatTick(0, 0.5), "0.0");
+  // Large values keep the digits that tell ticks apart (GPS seconds), small
+  // steps on them too; a large step on a large value stays short.
+  EXPECT_EQ(formatTick(1436038500, 50), "1436038500");
+  EXPECT_NE(formatTick(1436038500, 50), formatTick(1436038550, 50));
+  EXPECT_EQ(formatTick(2e6, 1e6), "2e+06");
+  EXPECT_EQ(formatTick(5e-5, 1e-5), "5e-05");
 }
 
 TEST(Figure, WritesAPngOfTheRequestedSizeThatIsNotBlank) {
