@@ -113,6 +113,16 @@ TEST(NoiseLearning, LikelihoodOfTheCountedChannelsGivenTheRest) {
   EXPECT_THROW(predictionErrorLogLikelihood(two, both, {}, 0.0, counted), InvalidArgument);
 }
 
+// The linear run the EM comparisons learn from, from σ = 1: the learner's
+// options, and EM's maximum from the same start.
+struct EmCase {
+  SimulatedRun run = simulateRun(cvWithBias(0.04, 0.01, 1.0), 400, 11);
+  EmResult em = shumwayStofferEm(run.measurements, Eigen::Vector2d(1, 1), 1.0);
+  NoiseLearningReport learn(const NoiseLearningOptions& o) const {
+    return learnNoise(cvWithBias(1, 1, 1), run.measurements, {}, 0.0, o);
+  }
+};
+
 // The learnt Q and R are EM's (1e-4), Q still diagonal.
 void expectAtTheEmMaximum(const NoiseLearningReport& r, const EmResult& em) {
   ASSERT_TRUE(r.converged) << r.toString();
@@ -125,15 +135,14 @@ void expectAtTheEmMaximum(const NoiseLearningReport& r, const EmResult& em) {
 }
 
 TEST(NoiseLearning, EqualsShumwayStofferEmOnALinearModel) {
-  const SimulatedRun run = simulateRun(cvWithBias(0.04, 0.01, 1.0), 400, 11);
-  const EmResult em = shumwayStofferEm(run.measurements, Eigen::Vector2d(1, 1), 1.0);
+  const EmCase c;
   NoiseLearningOptions o;
   o.start = 1.0;
   o.tolerance = 1e-13;
-  const NoiseLearningReport r = learnNoise(cvWithBias(1, 1, 1), run.measurements, {}, 0.0, o);
-  expectAtTheEmMaximum(r, em);
+  const NoiseLearningReport r = c.learn(o);
+  expectAtTheEmMaximum(r, c.em);
   // The learnt model's likelihood is the maximum the report says.
-  EXPECT_NEAR(predictionErrorLogLikelihood(*r.model, run.measurements, {}, 0.0), r.final_log_likelihood, 1e-9);
+  EXPECT_NEAR(predictionErrorLogLikelihood(*r.model, c.run.measurements, {}, 0.0), r.final_log_likelihood, 1e-9);
 }
 
 TEST(NoiseLearning, LogLikelihoodNeverDecreasesAndBeatsTheStart) {
@@ -316,22 +325,21 @@ TEST(NoiseLearning, TheFiltersLikelihoodTermsSumToItsTotal) {
 // product) climbs to the maximum Shumway–Stoffer's EM converges to, in far
 // fewer filter passes than Nelder–Mead, and the same on two threads.
 TEST(NoiseLearning, ScoringReachesTheEmMaximumInFewerPasses) {
-  const SimulatedRun run = simulateRun(cvWithBias(0.04, 0.01, 1.0), 400, 11);
-  const EmResult em = shumwayStofferEm(run.measurements, Eigen::Vector2d(1, 1), 1.0);
+  const EmCase c;
   NoiseLearningOptions o;
   o.start = 1.0;
   o.tolerance = 1e-10;
   o.standard_errors = false;
-  const NoiseLearningReport nm = learnNoise(cvWithBias(1, 1, 1), run.measurements, {}, 0.0, o);
+  const NoiseLearningReport nm = c.learn(o);
   o.optimizer = "scoring";
-  const NoiseLearningReport r = learnNoise(cvWithBias(1, 1, 1), run.measurements, {}, 0.0, o);
-  expectAtTheEmMaximum(r, em);
+  const NoiseLearningReport r = c.learn(o);
+  expectAtTheEmMaximum(r, c.em);
   EXPECT_NEAR(r.final_log_likelihood, nm.final_log_likelihood, 1e-8 * std::abs(nm.final_log_likelihood));
   EXPECT_LT(3 * r.evaluations, nm.evaluations) << "scoring " << r.evaluations << ", Nelder–Mead " << nm.evaluations;
   for (std::size_t i = 1; i < r.log_likelihood.size(); ++i) EXPECT_GT(r.log_likelihood[i], r.log_likelihood[i - 1]);
   std::cout << "filter passes: scoring " << r.evaluations << ", Nelder–Mead " << nm.evaluations << "\n";
   o.threads = 2;
-  const NoiseLearningReport two = learnNoise(cvWithBias(1, 1, 1), run.measurements, {}, 0.0, o);
+  const NoiseLearningReport two = c.learn(o);
   ASSERT_EQ(two.parameters.size(), r.parameters.size());
   for (std::size_t i = 0; i < r.parameters.size(); ++i) EXPECT_EQ(two.parameters[i].value, r.parameters[i].value);
   EXPECT_EQ(two.evaluations, r.evaluations);

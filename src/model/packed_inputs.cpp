@@ -51,7 +51,7 @@ std::vector<Input> packInputs(const std::vector<Input>& raw, std::vector<double>
   while (ri < raw.size() || ci < cuts.size()) {
     const double tr = ri < raw.size() ? raw[ri].t : INFINITY, tc = ci < cuts.size() ? cuts[ci] : INFINITY;
     const double t = std::min(tr, tc);
-    const bool cut = ci < cuts.size() && (tc <= tr || sameTime(tc, tr));
+    const bool cut = ci < cuts.size() && atOrBefore(tc, tr);
     if (t > now && !sameTime(t, now)) pack.slots.emplace_back(t - now, held), now = t;
     passTo(t);
     if (!cut && static_cast<int>(pack.slots.size()) < per_step) continue;

@@ -73,7 +73,8 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   n.R = Eigen::Matrix3d::Identity() * p.gnss_sd * p.gnss_sd;
   const int nc = insStates(p);
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(nc), sd(nc);
-  mean.head<StrapdownIns::kStates>() << so3::Log(so3::fromRollPitchYaw(p.start_rpy)), p.start_velocity, p.start_position, 0.0;
+  const Eigen::Matrix3d R0 = so3::fromRollPitchYaw(p.start_rpy);
+  mean.head<StrapdownIns::kStates>() << so3::Log(R0), p.start_velocity, p.start_position, 0.0;
   sd.head<StrapdownIns::kStates>() << Eigen::Vector3d::Constant(p.attitude_sd), Eigen::Vector3d::Constant(p.velocity_sd),
       Eigen::Vector3d::Constant(p.position_sd), p.clock_wander_sd * std::sqrt(p.T);  // the clock starts at 0
   // β_g starts at 0 (b_g holds the bias at the start), as firmly as the clock.
@@ -81,7 +82,7 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   n.prior_state = {mean, Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal())};
   // The heading's further variance on the tangent δθ (R ⊕ δθ = R·Exp(δθ)):
   // a turn ψ about the frame's down is δθ = ψ·Rᵀe_d.
-  const Eigen::Vector3d down_in_body = so3::fromRollPitchYaw(p.start_rpy).transpose() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d down_in_body = R0.transpose() * Eigen::Vector3d::UnitZ();
   n.prior_state.covariance.topLeftCorner<3, 3>() +=
       p.start_heading_sd * p.start_heading_sd * down_in_body * down_in_body.transpose();
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
