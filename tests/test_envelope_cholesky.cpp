@@ -159,3 +159,13 @@ TEST(EnvelopeCholesky, ReportsTheFirstConstantThatIsNotPositiveDefiniteInAWidePa
   fill(c, H, first);
   EXPECT_EQ(c.factorize(), bad);
 }
+
+// Eigen's product blocking follows the cache sizes it is given, and the
+// blocking orders a large product's sums: the library fixes them when it
+// loads, so that no estimate depends on the CPU's caches (src/linear/
+// product_blocking.cpp; this machine's own, read by CPUID, differ on most).
+TEST(ProductBlocking, EigensCacheSizesArePinnedWhenTheLibraryLoads) {
+  EXPECT_EQ(Eigen::l1CacheSize(), 48 * 1024);
+  EXPECT_EQ(Eigen::l2CacheSize(), 1024 * 1024);
+  EXPECT_EQ(Eigen::l3CacheSize(), 32 * 1024 * 1024);
+}
