@@ -362,6 +362,16 @@ TEST(PlanarRigidBody, LinkBiasSpreadLearntByEmIsAStationaryPointOfTheExpectedLog
   EXPECT_NEAR(s, spread, 0.15 * spread);
   EXPECT_LT(std::abs(s - truth.bias_sd), 3 * r.parameters[0].standard_error)
       << s << " ± " << r.parameters[0].standard_error << ", drawn with " << truth.bias_sd;
+  // EM's standard error comes from the expected log prior, not from filter
+  // passes: given without the likelihood's curvature too, the same.
+  o.standard_errors = false;
+  PlanarRigidBody::Params from = truth;
+  from.bias_sd = 0.3;  // where the first learning started (`given` holds its answer now)
+  const NoiseLearningReport quick = learnNoise(PlanarRigidBody(from), run.measurements, {}, 0.0, o);
+  ASSERT_EQ(quick.parameters.size(), 1u);
+  EXPECT_GT(r.parameters[0].standard_error, 0.0);
+  EXPECT_EQ(quick.parameters[0].value, r.parameters[0].value);
+  EXPECT_EQ(quick.parameters[0].standard_error, r.parameters[0].standard_error);
 }
 
 // SmootherOptions::full_pass_growth = 2: full relinearization passes only

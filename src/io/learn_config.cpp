@@ -27,7 +27,7 @@ std::vector<IniKey> learnIniKeyDocs() {
       {"optimizer", "word", o.optimizer, "scoring (gradient and score outer product) or nelder-mead"},
       {"tolerance", "number", number(o.tolerance), "converged when the next step would gain less than this, relative"},
       {"max_restarts", "integer", std::to_string(o.max_restarts), "Nelder–Mead restarts from the best point"},
-      {"standard_errors", "flag", "true", "standard errors from the likelihood's curvature (2p² more passes)"},
+      {"standard_errors", "flag", "true", "standard errors from the likelihood's curvature (2p² more passes; EM's σs have theirs regardless)"},
       {"prior_iterations", "integer", std::to_string(o.prior_iterations), "EM E-steps for the constants' prior σs"},
       {"prior_tolerance", "number", number(o.prior_tolerance), "EM converged when no σ changes by more than this, relative"},
       {"likelihood_channels", "words", "(all)",

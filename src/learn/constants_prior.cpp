@@ -133,7 +133,7 @@ void learnConstantsPrior(const std::string& type_name, std::vector<LearntParamet
     p.value = std::exp(theta[i]);
     p.method = "em";
   }
-  if (o.standard_errors) standardErrorsOfQ(q, theta, params);
+  standardErrorsOfQ(q, theta, params);  // from Q's curvature: no filter pass, so always
   r.values = std::move(values);
   r.model = model;
   r.posterior = std::move(x);

@@ -82,7 +82,9 @@ struct NoiseLearningOptions {
   /// outlier (uniform over its channel's span) with a learnt probability ε:
   /// a bounded likelihood that gross errors do not inflate the σs with.
   bool outliers = false;
-  /// Curvature and standard errors at the maximum (2p² further passes).
+  /// The likelihood's curvature and standard errors at its maximum (2p²
+  /// further passes). The constants' prior σs learnt by EM have theirs
+  /// from the expected log prior's curvature whatever this says (no pass).
   bool standard_errors = true;
   /// EM for the σs of the constants' prior (ParamSpec::constants_prior):
   /// at most this many E-steps (batch solves); converged when no σ changes
