@@ -313,16 +313,17 @@ TEST(PlanarRigidBody, LinkBiasSpreadLearntByEmIsAStationaryPointOfTheExpectedLog
   truth.bias_sd = 0.06;
   truth.bias_common_sd = 0.2;
   const SimulatedRun run = layoutRun(PlanarRigidBody(truth), 11, 960);  // each link 40 times
-  PlanarRigidBody::Params given = truth;
-  given.bias_sd = 0.3;
+  PlanarRigidBody::Params start = truth;
+  start.bias_sd = 0.3;
   NoiseLearningOptions o;
   o.parameters = {"bias_sd"};
-  const NoiseLearningReport r = learnNoise(PlanarRigidBody(given), run.measurements, {}, 0.0, o);
+  const NoiseLearningReport r = learnNoise(PlanarRigidBody(start), run.measurements, {}, 0.0, o);
   ASSERT_EQ(r.parameters.size(), 1u);
   EXPECT_EQ(r.parameters[0].method, "em");
   EXPECT_TRUE(r.prior_converged);
   EXPECT_EQ(r.evaluations, 0);  // no likelihood stage: only the prior was asked for
   const double s = r.parameters[0].value;
+  PlanarRigidBody::Params given = start;
   given.bias_sd = s;
   const OfflineRun batch = runOffline(PlanarRigidBody(given), EstimatorOptions(Method::Batch), run.measurements);
   // Learning's last E-step starts the learnt model's batch nearly converged:
@@ -365,9 +366,7 @@ TEST(PlanarRigidBody, LinkBiasSpreadLearntByEmIsAStationaryPointOfTheExpectedLog
   // EM's standard error comes from the expected log prior, not from filter
   // passes: given without the likelihood's curvature too, the same.
   o.standard_errors = false;
-  PlanarRigidBody::Params from = truth;
-  from.bias_sd = 0.3;  // where the first learning started (`given` holds its answer now)
-  const NoiseLearningReport quick = learnNoise(PlanarRigidBody(from), run.measurements, {}, 0.0, o);
+  const NoiseLearningReport quick = learnNoise(PlanarRigidBody(start), run.measurements, {}, 0.0, o);
   ASSERT_EQ(quick.parameters.size(), 1u);
   EXPECT_GT(r.parameters[0].standard_error, 0.0);
   EXPECT_EQ(quick.parameters[0].value, r.parameters[0].value);
