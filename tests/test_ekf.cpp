@@ -79,3 +79,27 @@ TEST(ExtendedKalmanFilter, BadCallsThrowAndLeaveTheFilterUnchanged) {
   bad.constant_process_noise = Eigen::VectorXd::Constant(3, 0.0);
   EXPECT_THROW(ExtendedKalmanFilter(radar, bad), InvalidArgument);
 }
+
+// The batch's start: on a linear model the smoothed guess is the RTS
+// smoother of the stacked Kalman model (the batch's answer) at every step,
+// the constants at the filter's final estimate; the filtered guess is the
+// filter's estimate at every step.
+TEST(EkfInitialGuess, SmoothedIsTheRtsSmootherAndFilteredTheFilterOnALinearModel) {
+  std::mt19937 rng(8);
+  const models::LinearModel model(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1),
+                                  models::Discretization::Exact);
+  SimulationSpec spec;
+  spec.steps = 70;
+  const SimulatedRun run = simulate(model, spec, normalSampler(9));
+  const auto ref = gssm::testing::kalmanAndRts(gssm::testing::stack(model, 0.1), run.measurements);
+  const Values smoothed = ekfInitialGuess(model, {}, run.measurements);
+  const Values filtered = ekfInitialGuess(model, {}, run.measurements, {}, 0.0, false);
+  ASSERT_EQ(smoothed.size(), static_cast<std::size_t>(spec.steps + 2));
+  for (int k = 0; k <= spec.steps; ++k) {
+    EXPECT_LT(relativeError(smoothed.at(Key::state(k)), ref.zs[k].head(3)), 1e-9) << "step " << k;
+    EXPECT_LT(relativeError(filtered.at(Key::state(k)), ref.zf[k].head(3)), 1e-9) << "step " << k;
+  }
+  EXPECT_LT(relativeError(smoothed.at(Key::constants()), ref.zf.back().tail(2)), 1e-10);
+  EXPECT_LT(relativeError(smoothed.at(Key::constants()), ref.zs.front().tail(2)), 1e-8);
+  EXPECT_EQ(filtered.at(Key::constants()), smoothed.at(Key::constants()));
+}

@@ -247,25 +247,81 @@ bool ExtendedKalmanFilter::josephUpdate() {
 
 void filterAlong(ExtendedKalmanFilter& filter, const std::vector<ScheduledStep>& schedule,
                  const std::vector<Measurement>& measurements, const std::vector<Input>& inputs,
-                 const std::function<void()>& after) {
+                 const std::function<void()>& after, const std::function<void()>& predicted) {
   for (const ScheduledStep& step : schedule) {
     filter.predict(step.t, inputAt(filter.model(), inputs, filter.time()));
+    if (predicted) predicted();
     for (std::size_t i : step.measurements) filter.update(measurements[i]);
     if (after) after();
   }
 }
 
+namespace {
+// x_c's rows of the RTS gain G = P(k|k) Fᵀ P(k+1|k)⁻¹, F = [A; 0 I]: Gᵀ's
+// columns solve P(k+1|k) Gᵀ = F P(k|k)'s x_c columns. Zero (the filtered
+// state kept) where P(k+1|k) is not positive definite in rounding.
+Eigen::MatrixXd smootherGainRows(const Eigen::MatrixXd& P_filtered, const Eigen::MatrixXd& A,
+                                 const Eigen::MatrixXd& P_predicted) {
+  const Eigen::Index nc = A.rows(), n = A.cols();
+  Eigen::MatrixXd M(n, nc);
+  M.topRows(nc).noalias() = A * P_filtered.leftCols(nc);
+  M.bottomRows(n - nc) = P_filtered.bottomLeftCorner(n - nc, nc);
+  const Eigen::LLT<Eigen::MatrixXd> llt(P_predicted);
+  if (llt.info() != Eigen::Success) return Eigen::MatrixXd::Zero(nc, n);
+  const Eigen::MatrixXd Gt = llt.solve(M);
+  return Gt.allFinite() ? Eigen::MatrixXd(Gt.transpose()) : Eigen::MatrixXd::Zero(nc, n);
+}
+
+// The EKF pass's x_c(k|k), z(k+1|k) and gain rows G_k, then the RTS
+// smoother backwards: x_c(k|N) = x_c(k|k) ⊕ G_k (z(k+1|N) ⊖ z(k+1|k)), the
+// constants at the filter's final estimate throughout (they have no process
+// noise: their smoothed value is the final one at every k).
+std::vector<Eigen::VectorXd> smoothedStates(ExtendedKalmanFilter& ekf, const std::vector<ScheduledStep>& schedule,
+                                            const std::vector<Measurement>& measurements,
+                                            const std::vector<Input>& inputs) {
+  const Model& model = ekf.model();
+  const int nc = model.dims().nc;
+  std::vector<Eigen::VectorXd> states{ekf.mean().head(nc)}, predicted;
+  std::vector<Eigen::MatrixXd> gains;
+  Eigen::MatrixXd P_filtered = ekf.covariance();
+  filterAlong(
+      ekf, schedule, measurements, inputs,
+      [&] {
+        states.push_back(ekf.mean().head(nc));
+        P_filtered = ekf.covariance();
+      },
+      [&] {
+        predicted.push_back(ekf.mean());
+        gains.push_back(smootherGainRows(P_filtered, ekf.lastTransition(), ekf.covariance()));
+      });
+  Eigen::VectorXd next = ekf.mean(), d;
+  for (std::size_t k = predicted.size(); k-- > 0;) {
+    localBlocks(next, predicted[k], d, model.rotationBlocks());
+    wrapAngles(d, model.angleStates());
+    retractBlocks(states[k], gains[k] * d, model.rotationBlocks());
+    wrapAngles(states[k], model.angleStates());
+    next.head(nc) = states[k];
+  }
+  return states;
+}
+}  // namespace
+
 Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
                        const std::vector<Measurement>& measurements,
-                       const std::vector<Input>& inputs, double t0) {
-  // The same steps as buildProblem; x_c(k) from the filtered estimate.
+                       const std::vector<Input>& inputs, double t0, bool smoothed) {
+  // The same steps as buildProblem.
   const ModelDims& d = model.dims();
   ExtendedKalmanFilter ekf(model, options, t0);
+  const std::vector<ScheduledStep> schedule = stepSchedule(measurements, inputs, t0);
+  std::vector<Eigen::VectorXd> states;
+  if (smoothed) {
+    states = smoothedStates(ekf, schedule, measurements, inputs);
+  } else {
+    states.push_back(model.priorState().mean);
+    filterAlong(ekf, schedule, measurements, inputs, [&] { states.push_back(ekf.mean().head(d.nc)); });
+  }
   Values x;
-  x.insert(Key::state(0), model.priorState().mean);
-  std::int64_t k = 0;
-  filterAlong(ekf, stepSchedule(measurements, inputs, t0), measurements, inputs,
-              [&] { x.insert(Key::state(++k), ekf.mean().head(d.nc)); });
+  for (std::size_t k = 0; k < states.size(); ++k) x.insert(Key::state(static_cast<std::int64_t>(k)), states[k]);
   if (d.nb > 0) x.insert(Key::constants(), ekf.mean().tail(d.nb));
   return x;
 }

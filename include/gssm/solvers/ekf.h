@@ -83,6 +83,9 @@ class ExtendedKalmanFilter {
   /// Measurements rejected by their channel's gate so far.
   std::int64_t rejected() const { return rejected_; }
   const Model& model() const { return *model_; }
+  /// A = [F_c F_cb] of the last predict(): the rows of the stacked
+  /// transition F = [A; 0 I] that move (n_c × n; empty before any).
+  const Eigen::MatrixXd& lastTransition() const { return p_.A; }
 
   /// Checkpoint: time, mean, covariance, last NIS (the options are the
   /// owner's). load() checks the sizes against the model and changes
@@ -125,19 +128,25 @@ class ExtendedKalmanFilter {
 };
 
 /// Runs `filter` over a step schedule (stepSchedule's): predicts to each
-/// step's time under the input in force, updates with its measurements, then
-/// calls `after` (when given). The one filter loop of an offline pass.
+/// step's time under the input in force, calls `predicted` (when given),
+/// updates with the step's measurements, then calls `after` (when given).
+/// The one filter loop of an offline pass.
 void filterAlong(ExtendedKalmanFilter& filter, const std::vector<ScheduledStep>& schedule,
                  const std::vector<Measurement>& measurements, const std::vector<Input>& inputs,
-                 const std::function<void()>& after = {});
+                 const std::function<void()>& after = {}, const std::function<void()>& predicted = {});
 
-/// An initial guess for a batch solve from one EKF pass: x_c(k) from the
-/// filtered estimates, x_b from the filter's final estimate. From a poor
-/// prior, dead reckoning drifts without bound over a long run (e.g. x off by
-/// 5·10⁵ m after 10⁵ radar steps), which LM cannot recover from; the filter's
-/// estimates stay near the data.
+/// An initial guess for a batch solve from one EKF pass and, when
+/// `smoothed`, its Rauch–Tung–Striebel smoother over the stacked state
+/// (docs/DESIGN.md §4): x_b from the filter's final estimate, x_c(k) the
+/// smoothed x_c(k|N) (or the filtered x_c(k|k)). From a poor prior, dead
+/// reckoning drifts without bound over a long run (e.g. x off by 5·10⁵ m
+/// after 10⁵ radar steps), which LM cannot recover from; the filter's
+/// estimates stay near the data. The filtered states were linearized
+/// before the constants were known and jump at every update; the smoothed
+/// ones are the linearized MAP itself (on a linear model the batch's
+/// answer), so Gauss–Newton starts next to where it ends.
 Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
                        const std::vector<Measurement>& measurements,
-                       const std::vector<Input>& inputs = {}, double t0 = 0.0);
+                       const std::vector<Input>& inputs = {}, double t0 = 0.0, bool smoothed = true);
 
 }  // namespace gssm
