@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 
 #include "gssm/solvers/ekf.h"
@@ -14,17 +15,32 @@ using gssm::testing::relativeError;
 
 namespace {
 using gssm::testing::normalSampler;
+
+// A random linear model (3 states, 2 constants, exact discretization), a
+// simulated run of it and the textbook Kalman filter and RTS smoother on it.
+struct LinearCase {
+  std::unique_ptr<models::LinearModel> model;
+  SimulatedRun run;
+  gssm::testing::KalmanRun ref;
+};
+LinearCase linearCase(unsigned system_seed, int steps, unsigned noise_seed) {
+  std::mt19937 rng(system_seed);
+  LinearCase c;
+  c.model = std::make_unique<models::LinearModel>(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1),
+                                                  models::Discretization::Exact);
+  SimulationSpec spec;
+  spec.steps = steps;
+  c.run = simulate(*c.model, spec, normalSampler(noise_seed));
+  c.ref = gssm::testing::kalmanAndRts(gssm::testing::stack(*c.model, 0.1), c.run.measurements);
+  return c;
+}
 }  // namespace
 
 TEST(ExtendedKalmanFilter, EqualsLinearKalmanFilterOnLinearModel) {
-  std::mt19937 rng(21);
-  const models::LinearModel model(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1),
-                                  models::Discretization::Exact);
-  SimulationSpec spec;
-  spec.steps = 80;
-  const SimulatedRun run = simulate(model, spec, normalSampler(4));
-  const auto ref = gssm::testing::kalmanAndRts(gssm::testing::stack(model, 0.1), run.measurements);
-  ExtendedKalmanFilter ekf(model);
+  const LinearCase c = linearCase(21, 80, 4);
+  const SimulatedRun& run = c.run;
+  const auto& ref = c.ref;
+  ExtendedKalmanFilter ekf(*c.model);
   for (std::size_t i = 0; i < run.measurements.size(); ++i) {
     ekf.predict(run.measurements[i].t, Eigen::VectorXd(0));
     ekf.update(run.measurements[i].y);
@@ -85,17 +101,13 @@ TEST(ExtendedKalmanFilter, BadCallsThrowAndLeaveTheFilterUnchanged) {
 // the constants at the filter's final estimate; the filtered guess is the
 // filter's estimate at every step.
 TEST(EkfInitialGuess, SmoothedIsTheRtsSmootherAndFilteredTheFilterOnALinearModel) {
-  std::mt19937 rng(8);
-  const models::LinearModel model(gssm::testing::randomLinearSystem(rng, 3, 2, 2, 0.1),
-                                  models::Discretization::Exact);
-  SimulationSpec spec;
-  spec.steps = 70;
-  const SimulatedRun run = simulate(model, spec, normalSampler(9));
-  const auto ref = gssm::testing::kalmanAndRts(gssm::testing::stack(model, 0.1), run.measurements);
-  const Values smoothed = ekfInitialGuess(model, {}, run.measurements);
-  const Values filtered = ekfInitialGuess(model, {}, run.measurements, {}, 0.0, false);
-  ASSERT_EQ(smoothed.size(), static_cast<std::size_t>(spec.steps + 2));
-  for (int k = 0; k <= spec.steps; ++k) {
+  const int steps = 70;
+  const LinearCase c = linearCase(8, steps, 9);
+  const auto& ref = c.ref;
+  const Values smoothed = ekfInitialGuess(*c.model, {}, c.run.measurements);
+  const Values filtered = ekfInitialGuess(*c.model, {}, c.run.measurements, {}, 0.0, false);
+  ASSERT_EQ(smoothed.size(), static_cast<std::size_t>(steps + 2));
+  for (int k = 0; k <= steps; ++k) {
     EXPECT_LT(relativeError(smoothed.at(Key::state(k)), ref.zs[k].head(3)), 1e-9) << "step " << k;
     EXPECT_LT(relativeError(filtered.at(Key::state(k)), ref.zf[k].head(3)), 1e-9) << "step " << k;
   }
