@@ -1,6 +1,7 @@
 #include "gssm/solvers/ekf.h"
 
 #include <Eigen/Cholesky>
+#include <optional>
 #include <sstream>
 
 #include "core/byte_stream.h"
@@ -290,26 +291,14 @@ class SmootherRecord {
   std::vector<double> predicted_, gains_;
 };
 
-// The EKF pass's x_c(k|k) and its record, then the RTS smoother backwards:
-// x_c(k|N) = x_c(k|k) ⊕ G_k (z(k+1|N) ⊖ z(k+1|k)), the constants at the
-// filter's final estimate throughout (they have no process noise: their
-// smoothed value is the final one at every k).
-std::vector<Eigen::VectorXd> smoothedStates(ExtendedKalmanFilter& ekf, const std::vector<ScheduledStep>& schedule,
-                                            const std::vector<Measurement>& measurements,
-                                            const std::vector<Input>& inputs) {
-  const Model& model = ekf.model();
-  const int nc = model.dims().nc;
-  std::vector<Eigen::VectorXd> states{ekf.mean().head(nc)};
-  SmootherRecord record(nc, ekf.mean().size());
-  Eigen::MatrixXd P_filtered = ekf.covariance();
-  filterAlong(
-      ekf, schedule, measurements, inputs,
-      [&] {
-        states.push_back(ekf.mean().head(nc));
-        P_filtered = ekf.covariance();
-      },
-      [&] { record.add(P_filtered, ekf); });
-  Eigen::VectorXd next = ekf.mean(), d, step(nc);
+// The RTS smoother backwards over the filtered x_c(k|k) in `states`:
+// x_c(k|N) = x_c(k|k) ⊕ G_k (z(k+1|N) ⊖ z(k+1|k)), in place, from the
+// filter's final estimate `last`; the constants stay at it throughout (they
+// have no process noise: their smoothed value is the final one at every k).
+void smoothBackwards(const Model& model, const SmootherRecord& record, const Eigen::VectorXd& last,
+                     std::vector<Eigen::VectorXd>& states) {
+  const Eigen::Index nc = model.dims().nc;
+  Eigen::VectorXd next = last, d, step(nc);
   for (std::size_t k = record.size(); k-- > 0;) {
     localBlocks(next, record.predicted(k), d, model.rotationBlocks());
     wrapAngles(d, model.angleStates());
@@ -318,24 +307,33 @@ std::vector<Eigen::VectorXd> smoothedStates(ExtendedKalmanFilter& ekf, const std
     wrapAngles(states[k], model.angleStates());
     next.head(nc) = states[k];
   }
-  return states;
 }
 }  // namespace
 
 Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& options,
                        const std::vector<Measurement>& measurements,
                        const std::vector<Input>& inputs, double t0, bool smoothed) {
-  // The same steps as buildProblem.
+  // The same steps as buildProblem: x_c(k|k) after each, and with
+  // `smoothed` the record of each prediction for the smoother.
   const ModelDims& d = model.dims();
   ExtendedKalmanFilter ekf(model, options, t0);
-  const std::vector<ScheduledStep> schedule = stepSchedule(measurements, inputs, t0);
-  std::vector<Eigen::VectorXd> states;
+  std::vector<Eigen::VectorXd> states{model.priorState().mean};
+  std::optional<SmootherRecord> record;
+  Eigen::MatrixXd P_filtered;  // P(k|k) of the step before the prediction
   if (smoothed) {
-    states = smoothedStates(ekf, schedule, measurements, inputs);
-  } else {
-    states.push_back(model.priorState().mean);
-    filterAlong(ekf, schedule, measurements, inputs, [&] { states.push_back(ekf.mean().head(d.nc)); });
+    record.emplace(d.nc, d.nc + d.nb);
+    P_filtered = ekf.covariance();
   }
+  filterAlong(
+      ekf, stepSchedule(measurements, inputs, t0), measurements, inputs,
+      [&] {
+        states.push_back(ekf.mean().head(d.nc));
+        if (record) P_filtered = ekf.covariance();
+      },
+      [&] {
+        if (record) record->add(P_filtered, ekf);
+      });
+  if (record) smoothBackwards(model, *record, ekf.mean(), states);
   Values x;
   for (std::size_t k = 0; k < states.size(); ++k) x.insert(Key::state(static_cast<std::int64_t>(k)), states[k]);
   if (d.nb > 0) x.insert(Key::constants(), ekf.mean().tail(d.nb));

@@ -137,7 +137,7 @@ void filterAlong(ExtendedKalmanFilter& filter, const std::vector<ScheduledStep>&
 
 /// An initial guess for a batch solve from one EKF pass and, when
 /// `smoothed`, its Rauch–Tung–Striebel smoother over the stacked state
-/// (docs/DESIGN.md §4): x_b from the filter's final estimate, x_c(k) the
+/// (docs/DESIGN.md §5): x_b from the filter's final estimate, x_c(k) the
 /// smoothed x_c(k|N) (or the filtered x_c(k|k)). From a poor prior, dead
 /// reckoning drifts without bound over a long run (e.g. x off by 5·10⁵ m
 /// after 10⁵ radar steps), which LM cannot recover from; the filter's
