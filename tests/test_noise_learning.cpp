@@ -342,7 +342,9 @@ TEST(NoiseLearning, ScoringReachesTheEmMaximumInFewerPasses) {
   const NoiseLearningReport two = c.learn(o);
   ASSERT_EQ(two.parameters.size(), r.parameters.size());
   for (std::size_t i = 0; i < r.parameters.size(); ++i) EXPECT_EQ(two.parameters[i].value, r.parameters[i].value);
-  EXPECT_EQ(two.evaluations, r.evaluations);
+  EXPECT_EQ(two.log_likelihood, r.log_likelihood);  // the same path
+  // the trials after one that passes are extra
+  EXPECT_GE(two.evaluations, r.evaluations);
 }
 
 // A σ the log cannot tell from 0 (a process noise far below what the data
@@ -420,6 +422,19 @@ TEST(Scoring, ReachesAClosedFormMaximumAndStopsWherePassesFail) {
   EXPECT_LE(cut.x[0], 0.5);
   EXPECT_TRUE(std::isfinite(cut.value));
   EXPECT_GT(cut.value, at(1e9)({Eigen::VectorXd::Zero(1)}).front().total);
+  // Two line-search trials at a time (for passes run two at a time) take
+  // the step one at a time takes: the same path, only more passes where
+  // the first trial passes.
+  for (const double fail_above : {1e9, 0.5}) {
+    internal::ScoringOptions two = o;
+    two.parallel_passes = 2;
+    const auto serial = internal::maximizeByScoring(at(fail_above), Eigen::VectorXd::Zero(1), o);
+    const auto batched = internal::maximizeByScoring(at(fail_above), Eigen::VectorXd::Zero(1), two);
+    EXPECT_EQ(batched.x[0], serial.x[0]) << fail_above;
+    EXPECT_EQ(batched.value, serial.value) << fail_above;
+    EXPECT_EQ(batched.iterations, serial.iterations) << fail_above;
+    EXPECT_EQ(batched.converged, serial.converged) << fail_above;
+  }
 }
 
 }  // namespace

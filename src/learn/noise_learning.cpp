@@ -223,6 +223,7 @@ Eigen::VectorXd maximizeByScoring(Objective& obj, const Eigen::VectorXd& theta0,
   so.lo = obj.lo, so.hi = obj.hi;
   so.max_evaluations = o.max_evaluations - obj.evaluations;
   so.tolerance = o.tolerance;
+  so.parallel_passes = o.threads;
   const auto at = [&obj](const std::vector<Eigen::VectorXd>& thetas) { return obj.passes(thetas, true); };
   const auto res = internal::maximizeByScoring(at, theta0, so, [&r](double l) { r.log_likelihood.push_back(l); });
   r.iterations += res.iterations;

@@ -91,6 +91,28 @@ void updateCurvature(Eigen::MatrixXd& H, const Eigen::VectorXd& s, const Eigen::
   const Eigen::VectorXd Hs = H * s;
   H += y * y.transpose() / sy - Hs * Hs.transpose() / s.dot(Hs);
 }
+// Backtracking from x along d (α = 1, ¼, 1/16, …) until ℓ rises by a
+// tenth of the step's first-order gain; `parallel_passes` trials at a time,
+// the first that passes taken: the serial search's step, in fewer rounds
+// where it would have refused α = 1 (the later trials are then wasted).
+bool searchAlong(const LikelihoodTermsAt& at, const Eigen::VectorXd& x, const Eigen::VectorXd& d,
+                 const Eigen::VectorXd& g, LikelihoodTerms& here, Eigen::VectorXd& next, const ScoringOptions& o,
+                 int& evaluations) {
+  double alpha = 1;
+  while (alpha > 1e-3 && evaluations < o.max_evaluations) {
+    std::vector<Eigen::VectorXd> trials;
+    for (; alpha > 1e-3 && static_cast<int>(trials.size()) < std::max(o.parallel_passes, 1); alpha *= 0.25)
+      trials.push_back((x + alpha * d).cwiseMax(o.lo).cwiseMin(o.hi));
+    std::vector<LikelihoodTerms> there = at(trials);
+    evaluations += static_cast<int>(trials.size());
+    for (std::size_t k = 0; k < trials.size(); ++k)
+      if (std::isfinite(there[k].total) && there[k].total > here.total + 0.1 * g.dot(trials[k] - x)) {
+        here = std::move(there[k]), next = std::move(trials[k]);
+        return true;
+      }
+  }
+  return false;
+}
 }  // namespace
 
 ScoringResult maximizeByScoring(const LikelihoodTermsAt& at, const Eigen::VectorXd& x0, const ScoringOptions& o,
@@ -111,15 +133,8 @@ ScoringResult maximizeByScoring(const LikelihoodTermsAt& at, const Eigen::Vector
       r.converged = true;
       break;
     }
-    bool moved = false;  // backtracking until ℓ rises by a tenth of the step's first-order gain
     Eigen::VectorXd next;
-    for (double alpha = 1; alpha > 1e-3 && !moved && r.evaluations < o.max_evaluations; alpha *= 0.25) {
-      next = (r.x + alpha * d).cwiseMax(o.lo).cwiseMin(o.hi);
-      LikelihoodTerms there = at({next}).front();
-      ++r.evaluations;
-      if (std::isfinite(there.total) && there.total > here.total + 0.1 * s.g.dot(next - r.x))
-        here = std::move(there), moved = true;
-    }
+    const bool moved = searchAlong(at, r.x, d, s.g, here, next, o, r.evaluations);
     if (iteration) iteration(here.total);
     if (!moved && s.central) break;  // no step along the slope raises ℓ: as far as differences resolve it
     if (!moved) {  // forward differences' error may be all that is left of the slope
