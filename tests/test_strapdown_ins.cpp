@@ -12,6 +12,7 @@
 #include "gssm/core/rotation_blocks.h"
 #include "gssm/core/so3.h"
 #include "gssm/core/time.h"
+#include "gssm/factors/factors.h"
 #include "gssm/factors/problem.h"
 #include "gssm/io/config.h"
 #include "gssm/io/dataset.h"
@@ -170,6 +171,45 @@ TEST(StrapdownIns, RoundTripsThroughItsIniForm) {
   const auto& p = dynamic_cast<const StrapdownIns&>(*again).params();
   EXPECT_NEAR(p.anchor.lat, model.params().anchor.lat, 1e-15);
   EXPECT_LT((p.mount_rpy - model.params().mount_rpy).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+// [model] gnss_sd_scale scales the σs each fix reports (a measurement's own
+// R, times its square) and nothing else: the EKF's update, the smoothers'
+// factor and the estimators' NIS see a fix with R under the scale s as the
+// same fix with s²R under no scale; the channel's own R (fixes without
+// σs) is left as it is; it round-trips through the INI form.
+TEST(StrapdownIns, GnssSdScaleMultipliesTheSdsEachFixReports) {
+  StrapdownIns::Params p = driveParams(0.01);
+  p.gnss_sd_scale = 2.5;
+  const StrapdownIns scaled(p);
+  const StrapdownIns plain(driveParams(0.01));
+  const int gnss = scaled.channelIndex("gnss");
+  EXPECT_EQ(scaled.channel(gnss).own_R_scale, 6.25);
+  EXPECT_EQ(scaled.channel(gnss).R, plain.channel(gnss).R);
+  const Eigen::Matrix3d R = Eigen::Vector3d(0.01, 0.015, 0.03).cwiseAbs2().asDiagonal();
+  const Eigen::Vector3d y(0.3, -0.2, 0.1);
+  const Measurement fix(0.05, y, gnss, R), inflated(0.05, y, gnss, 6.25 * R);
+
+  ExtendedKalmanFilter a(scaled), b(plain), c(plain);
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(scaled.dims().nu);
+  for (auto* f : {&a, &b, &c}) f->predict(0.05, u);
+  a.update(fix), b.update(inflated), c.update(fix);
+  const double scale = b.covariance().cwiseAbs().maxCoeff();
+  EXPECT_LT((a.covariance() - b.covariance()).cwiseAbs().maxCoeff(), 1e-12 * scale);
+  EXPECT_LT((a.mean() - b.mean()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_GT((a.mean() - c.mean()).cwiseAbs().maxCoeff(), 1e-6);  // the scale acts
+
+  const MeasurementFactor fa(scaled, 3, fix), fb(plain, 3, inflated);
+  EXPECT_LT((fa.noise().covariance() - fb.noise().covariance()).cwiseAbs().maxCoeff(), 1e-18);
+  const MeasurementFactor own(scaled, 3, Measurement(0.05, y, gnss));  // no σs given: the channel's R
+  EXPECT_EQ(own.noise().covariance(), plain.channel(gnss).R);
+
+  io::IniDocument ini;
+  io::writeModel(scaled, ini);
+  const auto again = io::makeModel(io::IniDocument::parse(ini.toString(), "ins.ini"));
+  EXPECT_EQ(again->channel(gnss).own_R_scale, 6.25);
+  p.gnss_sd_scale = 0;
+  testing::expectThrowsNaming<InvalidArgument>([&] { StrapdownIns{p}; }, "must be > 0");
 }
 
 // [prior] heading_sd adds variance to the start attitude along a turn about

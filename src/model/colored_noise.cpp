@@ -142,6 +142,7 @@ class ColoredNoiseModel final : public Model {
     return blockDiagonal(inner_->processNoiseOf(dt, u), a_.count, driveVariance(noise_, dt));
   }
   bool processNoiseDependsOnInput() const override { return inner_->processNoiseDependsOnInput(); }
+  int readingsPerStep() const override { return inner_->readingsPerStep(); }
 
   std::vector<Eigen::Vector2d> landmarks() const override { return inner_->landmarks(); }
   std::vector<Eigen::Vector2d> bodyPoints(const Eigen::VectorXd& xc) const override {

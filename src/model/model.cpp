@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -112,6 +113,9 @@ void Model::setChannels(std::vector<MeasurementChannel> channels) {
       throw InvalidArgument("model: channel name '" + ch.name + "' is empty or used twice");
     requireNames(ch.components, ch.dim(), "channel '" + ch.name + "' component", components);
     requireCovariance(ch.R, ch.dim(), "model: noise R of channel '" + ch.name + "'");
+    if (!(ch.own_R_scale > 0) || !std::isfinite(ch.own_R_scale))
+      throw InvalidArgument("model: channel '" + ch.name + "': own_R_scale " + std::to_string(ch.own_R_scale) +
+                            " must be finite and > 0");
     for (int a : ch.angles)
       if (a < 0 || a >= ch.dim()) throw InvalidArgument("model: channel '" + ch.name + "': angle component out of range");
     for (std::size_t i = 0; i < ch.constants.size(); ++i)

@@ -57,7 +57,7 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
 }
 
 ModelNoise insNoise(const StrapdownIns::Params& p) {
-  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.zaru_sd, p.attitude_sd, p.velocity_sd,
+  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.gnss_sd_scale, p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.zaru_sd, p.attitude_sd, p.velocity_sd,
                    p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd,
                    p.gyro_scale_sd, p.accel_scale_sd, p.clock_rate_sd, p.clock_wander_sd})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
@@ -110,7 +110,10 @@ StrapdownIns::StrapdownIns(const Params& p)
       p_(p),
       frame_(p.anchor),
       mount0_(so3::fromRollPitchYaw(p.mount_rpy)) {
-  setChannels({channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay, kClockRate}),
+  MeasurementChannel gnss =
+      channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay, kClockRate});
+  gnss.own_R_scale = p.gnss_sd_scale * p.gnss_sd_scale;
+  setChannels({std::move(gnss),
                channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11}),
                channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, Eigen::Vector3d::Constant(p.zupt_sd), {}),
                channelOf("zaru", {"zaru_x", "zaru_y", "zaru_z"}, Eigen::Vector3d::Constant(p.zaru_sd), {0, 1, 2})});
@@ -319,6 +322,7 @@ std::vector<ParamSpec> insParams() {
       learnable(real("model", "gyro_sd", "gyro white noise, rad/s/√Hz")),
       learnable(real("model", "accel_sd", "accelerometer white noise, m/s²/√Hz")),
       learnable(real("model", "gnss_sd", "σ of each GNSS coordinate when a fix gives none (m)")),
+      learnable(real("model", "gnss_sd_scale", "factor on the σs each GNSS fix reports (1: as reported)")),
       learnable(real("model", "nhc_sd", "σ of the vehicle's sideways velocity at the IMU (m/s)")),
       learnable(real("model", "nhc_down_sd",
                      "σ of its vertical velocity (m/s; with one σ for both the constraint is blind to the mounting's "
@@ -429,7 +433,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   p.anchor = readAnchor(in);
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
   for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
-                            {"gnss_sd", &p.gnss_sd}, {"nhc_sd", &p.nhc_sd}, {"nhc_down_sd", &p.nhc_down_sd},
+                            {"gnss_sd", &p.gnss_sd}, {"gnss_sd_scale", &p.gnss_sd_scale}, {"nhc_sd", &p.nhc_sd},
+                            {"nhc_down_sd", &p.nhc_down_sd},
                             {"zupt_sd", &p.zupt_sd}, {"zaru_sd", &p.zaru_sd},
                             {"clock_wander_sd", &p.clock_wander_sd}, {"gyro_bias_walk", &p.gyro_bias_walk}})
     *value = in.real("model", key, *value);
@@ -467,7 +472,7 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("model", "anchor", Eigen::Vector3d(p.anchor.lat / kDeg, p.anchor.lon / kDeg, p.anchor.height));
   out.vector("model", "mount_rpy", p.mount_rpy / kDeg);
   for (auto [key, value] : {std::pair{"gyro_sd", p.gyro_sd}, {"accel_sd", p.accel_sd}, {"gnss_sd", p.gnss_sd},
-                            {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
+                            {"gnss_sd_scale", p.gnss_sd_scale}, {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
                             {"zupt_sd", p.zupt_sd}, {"zaru_sd", p.zaru_sd},
                             {"clock_wander_sd", p.clock_wander_sd}, {"gyro_bias_walk", p.gyro_bias_walk}})
     out.real("model", key, value);

@@ -122,7 +122,8 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   model_->hInto(m.channel, b.xc, b.xb, b.yhat, &b.J_h_xc, &b.J_h_xb);
   b.H.resize(ch.dim(), d.nc + d.nb);
   b.H << b.J_h_xc, b.J_h_xb;
-  innovationCovariance(m.R.size() ? m.R : ch.R);
+  if (m.R.size()) innovationCovariance(m.R, ch.own_R_scale);
+  else innovationCovariance(ch.R, 1.0);
   b.llt.compute(b.S);
   if (b.llt.info() != Eigen::Success || !b.S.allFinite())
     throw NumericalError("ExtendedKalmanFilter::update at t = " + std::to_string(t_) +
@@ -166,9 +167,9 @@ double ExtendedKalmanFilter::outlierLogDensity(int channel) const {
 // filter's columns, so P Hᵀ reads 5 columns of P, not 31. Several rows take
 // the blocked products (row by row, a 64-state filter's update was 1.5×
 // slower).
-void ExtendedKalmanFilter::innovationCovariance(const Eigen::MatrixXd& R) {
+void ExtendedKalmanFilter::innovationCovariance(const Eigen::MatrixXd& R, double scale) {
   UpdateBuffers& b = u_;
-  b.S = R;
+  b.S = scale * R;
   if (b.H.rows() > 1) {
     b.PHt.noalias() = P_ * b.H.transpose();
     b.S.noalias() += b.H * b.PHt;

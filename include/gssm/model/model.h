@@ -37,6 +37,12 @@ struct MeasurementChannel {
   /// point, so the batch solver reads only these (a link's range: its own
   /// bias and the scale, 2 of 25); the Jacobian tests check the claim.
   std::vector<int> constants;
+  /// A measurement that brings its own covariance (Measurement::R: a GNSS
+  /// fix's reported sds) is used with it times this variance factor — the
+  /// reported sds scaled by a number the log can teach (learnable where a
+  /// model exposes it, e.g. strapdown_ins's gnss_sd_scale). The channel's
+  /// own R is not scaled.
+  double own_R_scale = 1;
   int dim() const { return static_cast<int>(components.size()); }
 };
 

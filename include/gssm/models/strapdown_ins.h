@@ -50,6 +50,7 @@ class StrapdownIns final : public Model {
     double gyro_sd = 1e-3;                     ///< gyro white noise, rad/s/√Hz
     double accel_sd = 1e-2;                    ///< accelerometer white noise, m/s²/√Hz
     double gnss_sd = 0.02;                     ///< σ of each GNSS coordinate (m) unless a fix gives its own
+    double gnss_sd_scale = 1;                  ///< factor on the σs a fix gives (learnable: the receiver's honesty)
     double nhc_sd = 0.1;                       ///< σ of the vehicle's sideways velocity at the IMU (m/s)
     double nhc_down_sd = 0.1;                  ///< σ of its vertical velocity (m/s)
     double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)

@@ -111,7 +111,7 @@ class ExtendedKalmanFilter {
     Eigen::MatrixXd J_f_xc, J_f_xb, A, T, Pcc;
     Eigen::VectorXd constants_var;  // P_bb's diagonal plus the constants' own process noise
   };
-  void innovationCovariance(const Eigen::MatrixXd& R);
+  void innovationCovariance(const Eigen::MatrixXd& R, double scale);
   bool josephUpdate();
   const Model* model_;
   ExtendedKalmanFilterOptions options_;
