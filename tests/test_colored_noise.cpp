@@ -15,6 +15,7 @@
 #include "gssm/io/ini.h"
 #include "gssm/learn/noise_learning.h"
 #include "gssm/model/colored_noise.h"
+#include "gssm/models/strapdown_ins.h"
 #include "gssm/model/param_values.h"
 #include "gssm/model/registry.h"
 #include "gssm/model/simulation.h"
@@ -83,6 +84,15 @@ TEST(ColoredNoise, ReadsAndWritesItsIniSectionForEveryModelType) {
   const ParamValues white = ParamValues::of(withoutColoredNoise(*m));
   EXPECT_FALSE(white.has("colored_noise", "channels"));
   EXPECT_EQ(coloredNoiseOf(*white.build("linear")), nullptr);
+  // What the wrapper forwards: an INS integrating several IMU readings a
+  // state keeps its packed inputs (the dataset reads them by this count).
+  models::StrapdownIns::Params p;
+  p.imu_per_state = 10;
+  ColoredNoise gnss;
+  gnss.channels = {"gnss"};
+  const auto ins = withColoredNoise(std::make_unique<models::StrapdownIns>(p), gnss);
+  EXPECT_EQ(ins->readingsPerStep(), 10);
+  EXPECT_EQ(ins->dims().nu, models::StrapdownIns(p).dims().nu);
 }
 
 TEST(ColoredNoise, NamesAnUnknownChannelAndABadTimeConstant) {
