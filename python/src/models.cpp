@@ -151,6 +151,8 @@ void bindChannel(py::module_& models) {
       .def_property_readonly("loss_scale", [](const MeasurementChannel& c) { return c.loss.scale; })
       .def_readonly("angles", &MeasurementChannel::angles)
       .def_readonly("ekf_gate", &MeasurementChannel::ekf_gate)
+      .def_readonly("own_R_scale", &MeasurementChannel::own_R_scale,
+                    "variance factor on the covariance a measurement brings (R it gives times this)")
       .def_property_readonly("dim", &MeasurementChannel::dim)
       .def("__repr__", [](const MeasurementChannel& c) {
         return "Channel(name='" + c.name + "', dim=" + std::to_string(c.dim()) + ", loss='" +

@@ -114,6 +114,9 @@ def test_strapdown_ins_from_its_registration():
     assert m.constant_names[12] == "imu_delay" and m.constant_names[-1] == "clock_rate"
     assert [c.name for c in m.channels] == ["gnss", "nhc", "zupt", "zaru"]
     assert m.params["prior_delay_sd"] == 0.2
+    assert m.channels[0].own_R_scale == 1.0  # the fixes' own sds as reported
+    scaled = gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], gnss_sd_scale=2.0)
+    assert scaled.channels[0].own_R_scale == 4.0 and scaled.channels[1].own_R_scale == 1.0
     assert gssm.models.from_ini(m.to_ini()).to_ini() == m.to_ini()
     x, b = m.prior_state[0], m.prior_constants[0]
     np.testing.assert_allclose(np.linalg.norm(x[:3]), np.radians(30.0), atol=1e-12)  # yaw 30° as a rotation vector
