@@ -30,10 +30,10 @@ std::vector<Input> rawReadings(int n, double T) {
 
 // The raw reading in force at t (held from its time).
 Eigen::VectorXd inForce(const std::vector<Input>& raw, double t) {
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(raw.front().u.size());
+  const Input* last = nullptr;  // found first, copied once
   for (const auto& in : raw)
-    if (in.t <= t + 1e-12) u = in.u;
-  return u;
+    if (in.t <= t + 1e-12) last = &in;
+  return last ? last->u : Eigen::VectorXd::Zero(raw.front().u.size());
 }
 
 TEST(PackedInputs, StepsEndAtEveryCutAndHoldAtMostNReadings) {
