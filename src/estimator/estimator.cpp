@@ -187,7 +187,7 @@ double Estimator::innovationNis(double dt, const Eigen::VectorXd& u, const Measu
   wrapAngles(innovation, ch.angles);
   Eigen::MatrixXd H(ch.dim(), d.nc + d.nb);
   H << J_h_xc, J_h_xb;
-  const Eigen::MatrixXd S = H * P * H.transpose() + (m.R.size() ? (ch.own_R_scale * m.R).eval() : ch.R);
+  const Eigen::MatrixXd S = H * P * H.transpose() + ch.covarianceOf(m.R);
   return innovation.dot(S.ldlt().solve(innovation));
 }
 

@@ -224,7 +224,7 @@ namespace {
 GaussianNoise measurementNoise(const Model& model, std::int64_t k, const Measurement& m) {
   if (m.R.size() == 0) return model.channelNoiseModel(m.channel);
   const MeasurementChannel& ch = model.channel(m.channel);
-  return GaussianNoise(ch.own_R_scale * m.R, "noise of the measurement on channel '" + ch.name +
+  return GaussianNoise(ch.covarianceOf(m.R), "noise of the measurement on channel '" + ch.name +
                                 "' at step " + std::to_string(k));
 }
 }  // namespace

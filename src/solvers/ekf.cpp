@@ -122,7 +122,7 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   model_->hInto(m.channel, b.xc, b.xb, b.yhat, &b.J_h_xc, &b.J_h_xb);
   b.H.resize(ch.dim(), d.nc + d.nb);
   b.H << b.J_h_xc, b.J_h_xb;
-  if (m.R.size()) innovationCovariance(m.R, ch.own_R_scale);
+  if (m.R.size()) innovationCovariance(m.R, ch.own_R_scale);  // ch.covarianceOf(m.R), without a fresh matrix
   else innovationCovariance(ch.R, 1.0);
   b.llt.compute(b.S);
   if (b.llt.info() != Eigen::Success || !b.S.allFinite())
@@ -325,15 +325,13 @@ Values ekfInitialGuess(const Model& model, const ExtendedKalmanFilterOptions& op
     record.emplace(d.nc, d.nc + d.nb);
     P_filtered = ekf.covariance();
   }
-  filterAlong(
-      ekf, stepSchedule(measurements, inputs, t0), measurements, inputs,
-      [&] {
-        states.push_back(ekf.mean().head(d.nc));
-        if (record) P_filtered = ekf.covariance();
-      },
-      [&] {
-        if (record) record->add(P_filtered, ekf);
-      });
+  const auto filtered = [&] {
+    states.push_back(ekf.mean().head(d.nc));
+    if (record) P_filtered = ekf.covariance();
+  };
+  const auto predicted = [&] { record->add(P_filtered, ekf); };
+  filterAlong(ekf, stepSchedule(measurements, inputs, t0), measurements, inputs, filtered,
+              record ? std::function<void()>(predicted) : std::function<void()>{});
   if (record) smoothBackwards(model, *record, ekf.mean(), states);
   Values x;
   for (std::size_t k = 0; k < states.size(); ++k) x.insert(Key::state(static_cast<std::int64_t>(k)), states[k]);

@@ -44,6 +44,9 @@ struct MeasurementChannel {
   /// own R is not scaled.
   double own_R_scale = 1;
   int dim() const { return static_cast<int>(components.size()); }
+  /// The noise covariance of a measurement on this channel that brings
+  /// `own` (Measurement::R; empty: none): own_R_scale·own, else R.
+  Eigen::MatrixXd covarianceOf(const Eigen::MatrixXd& own) const { return own.size() ? own_R_scale * own : R; }
 };
 
 struct ModelDims {
