@@ -8,6 +8,7 @@
 #include <string>
 
 #include "gssm/core/error.h"
+#include "gssm/io/csv.h"
 #include "gssm/io/rtklib_pos.h"
 #include "expect_error.h"
 
@@ -111,6 +112,11 @@ TEST(RtklibPos, EveryUnusableInputIsNamed) {
   expectThrowsNaming<InputError>(parse(kHeader + "2025/13/08 19:34:18.499" + kLine1.substr(23)), "g.pos:4:1: date '2025/13/08'");
   expectThrowsNaming<InputError>(parse(kHeader), "g.pos: no solution lines");
   expectThrowsNaming<InputError>([] { io::readRtklibPos("/nonexistent/g.pos"); }, "/nonexistent/g.pos: cannot open");
+  // A directory (an INI value cut at "//", which starts a comment) is named,
+  // not read as a file whose end is at 2^63 − 1.
+  const std::string dir = ::testing::TempDir();
+  expectThrowsNaming<InputError>([&] { io::readRtklibPos(dir); }, dir + ": is a directory, not the file");
+  expectThrowsNaming<InputError>([&] { io::readCsv(dir); }, dir + ": is a directory");
 }
 
 TEST(RtklibPos, ReadsTheDrivesSolutionFile) {

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <iostream>
 
 #include "gssm/analysis/offline.h"
@@ -20,6 +22,7 @@
 #include "gssm/io/rtklib_pos.h"
 #include "gssm/io/track_pos.h"
 #include "expect_error.h"
+#include "factors/factor_io.h"
 #include "gssm/models/strapdown_ins.h"
 #include "gssm/solvers/batch_solver.h"
 #include "gssm/solvers/ekf.h"
@@ -212,6 +215,84 @@ TEST(StrapdownIns, GnssSdScaleMultipliesTheSdsEachFixReports) {
   testing::expectThrowsNaming<InvalidArgument>([&] { StrapdownIns{p}; }, "must be > 0");
 }
 
+// gnss_vel against the time derivative of the gnss channel's antenna along
+// the model's own motion (three steps of f under one reading, a one-sided
+// second-order difference): v + R·(ω×ℓ) − δ·a with ρ = 0. What the channel
+// leaves out (Coriolis and transport rate, ~1e-4 m/s here) is under the
+// tolerance; the two terms it adds (lever 0.27 m/s, delay 0.16 m/s) are not.
+TEST(StrapdownIns, GnssVelocityIsTheRateOfTheAntennasFixPosition) {
+  const StrapdownIns model(driveParams(0.01));
+  const int vel = model.channelIndex("gnss_vel");
+  ASSERT_EQ(vel, StrapdownIns::kGnssVelocity);
+  ASSERT_EQ(model.channel(vel).regressors, 6);
+  Eigen::VectorXd xc(model.dims().nc), xb = Eigen::VectorXd::Zero(StrapdownIns::kConstants), u(6);
+  xc << so3::Log(so3::fromRollPitchYaw(Eigen::Vector3d(0.1, -0.2, 2.5))), 10, -3, 0.5, 100, 50, -2, 30;
+  xb.segment<3>(StrapdownIns::kGyroBias) << 0.01, -0.02, 0.005;
+  xb.segment<3>(StrapdownIns::kAccelBias) << 0.1, -0.05, 0.2;
+  xb.segment<3>(StrapdownIns::kLever) << 0.5, -0.3, 0.8;
+  xb[StrapdownIns::kDelay] = -0.12;
+  xb.segment<3>(StrapdownIns::kGyroScale) << 0.01, -0.02, 0.03;
+  xb.segment<3>(StrapdownIns::kAccelScale) << -0.01, 0.02, 0.01;
+  u << 0.3, -0.4, 0.6, 1.5, -0.8, -9.0;
+  const double h = 1e-3;
+  std::vector<Eigen::Vector3d> antenna{model.h(StrapdownIns::kGnss, xc, xb)};
+  for (Eigen::VectorXd x = xc; antenna.size() < 3;) {
+    x = model.f(x, xb, u, h);
+    antenna.push_back(model.h(StrapdownIns::kGnss, x, xb));
+  }
+  const Eigen::Vector3d rate = (-3 * antenna[0] + 4 * antenna[1] - antenna[2]) / (2 * h);
+  const Eigen::Vector3d y = model.hWith(vel, u, xc, xb);
+  EXPECT_LT((y - rate).norm(), 2e-3) << "h " << y.transpose() << ", d/dt antenna " << rate.transpose();
+  Eigen::VectorXd still = xb;  // without the lever and the delay: the velocity, far from both
+  still.segment<3>(StrapdownIns::kLever).setZero();
+  still[StrapdownIns::kDelay] = 0;
+  EXPECT_LT((model.hWith(vel, u, xc, still) - xc.segment<3>(3)).norm(), 1e-12);
+  EXPECT_GT((y - xc.segment<3>(3)).norm(), 0.3);
+  testing::expectThrowsNaming<InvalidArgument>([&] { model.h(vel, xc, xb); }, "hWith");
+  testing::expectThrowsNaming<InvalidArgument>([&] { model.hWith(vel, Eigen::VectorXd(3), xc, xb); },
+                                               "channel 'gnss_vel' carries 3 known values");
+}
+
+// A velocity fix reaches the filter and the factor graph with its known
+// values: the EKF refuses one without them (naming the channel) and is left
+// as it was; a factor keeps them through a checkpoint's bytes; the factor's
+// whitened residual is that of h given them.
+TEST(StrapdownIns, GnssVelocityMeasurementsCarryTheirKnownValuesEverywhere) {
+  const StrapdownIns model(driveParams(0.01));
+  const int vel = StrapdownIns::kGnssVelocity;
+  const Eigen::Vector3d y(0.2, -0.1, 0.05);
+  Eigen::VectorXd known(6);
+  known << 0.02, -0.01, 0.3, 0.4, 0.1, -9.7;
+  const Eigen::Matrix3d R = Eigen::Vector3d(0.04, 0.05, 0.06).cwiseAbs2().asDiagonal();
+  ExtendedKalmanFilter ekf(model);
+  ekf.predict(0.05, Eigen::VectorXd::Zero(model.dims().nu));
+  const Eigen::VectorXd mean = ekf.mean();
+  testing::expectThrowsNaming<InvalidArgument>([&] { ekf.update(Measurement(0.05, y, vel, R)); }, "gnss_vel");
+  EXPECT_EQ(ekf.mean(), mean);
+  EXPECT_TRUE(ekf.update(Measurement(0.05, y, vel, R, known)));
+  EXPECT_GT((ekf.mean() - mean).norm(), 1e-6);
+
+  const MeasurementFactor f(model, 4, Measurement(0.05, y, vel, R, known));
+  EXPECT_EQ(f.regressors(), known);
+  internal::ByteWriter out;
+  internal::writeFactor(out, f);
+  internal::ByteReader in(out.bytes(), "factor");
+  const FactorPtr back = internal::readFactor(in, model, "factor");
+  const auto* g = dynamic_cast<const MeasurementFactor*>(back.get());
+  ASSERT_NE(g, nullptr);
+  EXPECT_EQ(g->regressors(), known);
+  Eigen::VectorXd xc = model.priorState().mean, xb = model.priorConstants().mean;
+  xc.segment<3>(3) << 3, 1, 0;
+  xb[StrapdownIns::kDelay] = -0.1;
+  const Eigen::VectorXd* x[] = {&xc, &xb};
+  Eigen::VectorXd r, r_back;
+  f.linearizeAt(x, r, nullptr);
+  g->linearizeAt(x, r_back, nullptr);
+  EXPECT_EQ(r, r_back);
+  const Eigen::Vector3d expected = R.diagonal().cwiseSqrt().cwiseInverse().asDiagonal() * (model.hWith(vel, known, xc, xb) - y);
+  EXPECT_LT((r - expected).norm(), 1e-12);
+}
+
 // [prior] heading_sd adds variance to the start attitude along a turn about
 // the frame's vertical only: that tangent direction changes the yaw and not
 // the roll or pitch (at a tilted attitude, where body z is not the
@@ -339,6 +420,59 @@ TEST(StrapdownIns, StandingFixesGiveZeroVelocityAndTheGyrosMeanReading) {
   EXPECT_GT(zupt, 150u);  // the first ~38 s standing, and two stops later
   EXPECT_EQ(zaru, zupt);
   EXPECT_NEAR(static_cast<double>(nhc), 271.1 * 10, 2);
+}
+
+// [dataset] gnss_velocity_channel: every used fix brings its own velocity
+// (NED, its σs) with the IMU's mean reading within ±window/2 of it,
+// checked against the .pos and the IMU rows themselves; without velocity
+// columns the key is refused, naming the file.
+TEST(StrapdownIns, GnssVelocityFixesCarryTheImusMeanReading) {
+  const std::string dir = GSSM_SOURCE_DIR "/datasets/gnss-ins-drive";
+  io::IniDocument ini = io::readScenario(dir);
+  ini.set("model", "imu_per_state", "1");  // the raw readings, one input each
+  ini.set("dataset", "gnss_velocity_channel", "gnss_vel");
+  ini.set("dataset", "gnss_velocity_window", "0.1");
+  const auto model = io::makeModel(ini, dir);
+  io::Dataset ds;
+  io::readDatasetData(dir, *model, ds, io::BadRows::Throw, &ini);
+  const io::GnssSolution pos = io::readRtklibPos(dir + "/gnss.pos");
+  std::size_t fixes = 0, velocities = 0;
+  for (const Measurement& m : ds.measurements) {
+    if (m.channel == StrapdownIns::kGnss) ++fixes;
+    if (m.channel != StrapdownIns::kGnssVelocity) continue;
+    ++velocities;
+    const auto fix = std::find_if(pos.fixes.begin(), pos.fixes.end(), [&](const io::GnssFix& f) { return f.t == m.t; });
+    ASSERT_NE(fix, pos.fixes.end());
+    EXPECT_EQ(m.y, Eigen::Vector3d(fix->vel_neu->x(), fix->vel_neu->y(), -fix->vel_neu->z()));
+    EXPECT_NEAR(m.R(2, 2), fix->vel_cov_neu(2, 2), 1e-15);
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(6);
+    int n = 0;
+    for (const Input& u : ds.inputs)
+      if (u.t >= m.t - 0.05 && u.t <= m.t + 0.05) sum += u.u, ++n;
+    ASSERT_GE(n, 9);
+    EXPECT_LT((m.regressors - sum / n).norm(), 1e-12) << "at t = " << m.t;
+  }
+  EXPECT_EQ(velocities, fixes);
+  EXPECT_GT(fixes, 700u);
+
+  const std::string no_velocity = ::testing::TempDir() + "no_velocity.pos";
+  {
+    std::ofstream out(no_velocity);
+    out << "%  GPST                      latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)  "
+           "sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n"
+        << "2015/07/08 19:34:21.749   40.0966267 -105.1474483  1601.4730   1  21   0.0099   0.0099   0.0100   0.0000"
+           "   0.0000   0.0000   0.00    0.0\n";
+  }
+  const io::IniDocument refused = io::IniDocument::parse(
+      "[model]\ntype = strapdown_ins\nanchor = first_fix\n"
+      "[dataset]\ninputs = imu.csv\ninput_columns = gx gy gz ax ay az\ngnss = " + no_velocity +
+          "\ngnss_velocity_channel = gnss_vel\n",
+      dir + "/scenario-test.ini");
+  const auto plain = io::makeModel(refused, dir);
+  io::Dataset none;
+  testing::expectThrowsNaming<InputError>(
+      [&] { io::readDatasetData(dir, *plain, none, io::BadRows::Throw, &refused); },
+      "no_velocity.pos: no velocity columns (vn ve vu), which [dataset] gnss_velocity_channel needs");
 }
 
 // Each constant of a simulated drive within 2 reported σ of its truth, in

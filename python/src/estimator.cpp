@@ -312,17 +312,19 @@ py::class_<PyEstimator> bindStreamingEstimator(py::module_& m) {
       .def(
           "add_measurement",
           [](PyEstimator& e, double t, const VectorXd& y, const py::object& channel,
-             const std::optional<MatrixXd>& R) {
+             const std::optional<MatrixXd>& R, const std::optional<VectorXd>& regressors) {
             const int c = channelOf(*e.model, channel);
-            if (c == 0 && !R) {
+            if (c == 0 && !R && !regressors) {
               e.est->addMeasurement(t, y);
               return;
             }
-            e.est->addMeasurement(Measurement(t, y, c, R ? *R : MatrixXd()));
+            e.est->addMeasurement(Measurement(t, y, c, R ? *R : MatrixXd(), regressors ? *regressors : VectorXd()));
           },
           py::arg("t"), py::arg("y"), py::arg("channel") = py::none(), py::arg("R") = py::none(),
+          py::arg("regressors") = py::none(),
           "measurement y at time t on `channel` (name or index; default the model's first), with its own noise "
-          "covariance R when given")
+          "covariance R when given, and the known values h reads on a channel that takes any (Channel.regressors: "
+          "strapdown_ins's gnss_vel, the IMU's mean reading [gyro, accel] at the fix)")
       .def("current", [](PyEstimator& e) { return e.est->current(); }, "newest state and constants, joint covariance")
       .def(
           "smoothed", [](PyEstimator& e, std::int64_t k) { return e.est->smoothed(k); }, py::arg("k"),

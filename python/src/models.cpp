@@ -153,6 +153,8 @@ void bindChannel(py::module_& models) {
       .def_readonly("ekf_gate", &MeasurementChannel::ekf_gate)
       .def_readonly("own_R_scale", &MeasurementChannel::own_R_scale,
                     "variance factor on the covariance a measurement brings (R it gives times this)")
+      .def_readonly("regressors", &MeasurementChannel::regressors,
+                    "known values a measurement on it carries beside y, which h reads (0 on most channels)")
       .def_property_readonly("dim", &MeasurementChannel::dim)
       .def("__repr__", [](const MeasurementChannel& c) {
         return "Channel(name='" + c.name + "', dim=" + std::to_string(c.dim()) + ", loss='" +
@@ -227,8 +229,8 @@ void bindModelFunctions(py::class_<Model, std::shared_ptr<Model>>& cls) {
           "x_c(k+1) without noise; with jacobians=True the tuple (value, J_f_xc, J_f_xb). dt defaults to T.")
       .def(
           "h",
-          [](const Model& m, const VectorXd& xc, const VectorXd& xb, const py::object& channel,
-             bool jacobians) -> py::object {
+          [](const Model& m, const VectorXd& xc, const VectorXd& xb, const py::object& channel, bool jacobians,
+             const std::optional<VectorXd>& regressors) -> py::object {
             const auto d = m.dims();
             requireVector(xc, d.nc, "h: xc");
             requireVector(xb, d.nb, "h: xb");
@@ -237,13 +239,16 @@ void bindModelFunctions(py::class_<Model, std::shared_ptr<Model>>& cls) {
             if (c < 0 || c >= m.numChannels())
               throw InvalidArgument("h: channel " + std::to_string(c) + " out of range (the model has " +
                                     std::to_string(m.numChannels()) + ")");
-            if (!jacobians) return py::cast(m.h(c, xc, xb));
+            const VectorXd known = regressors ? *regressors : VectorXd();
+            if (!jacobians) return py::cast(m.hWith(c, known, xc, xb));
             MatrixXd J_xc, J_xb;
-            VectorXd v = m.h(c, xc, xb, &J_xc, &J_xb);
+            VectorXd v = m.hWith(c, known, xc, xb, &J_xc, &J_xb);
             return py::make_tuple(v, J_xc, J_xb);
           },
           py::arg("xc"), py::arg("xb"), py::arg("channel") = 0, py::arg("jacobians") = false,
-          "y without noise on `channel` (index or name); with jacobians=True (value, J_h_xc, J_h_xb).")
+          py::arg("regressors") = py::none(),
+          "y without noise on `channel` (index or name); with jacobians=True (value, J_h_xc, J_h_xb); `regressors`: "
+          "the known values a channel with Channel.regressors > 0 reads")
       .def("process_noise", &Model::processNoise, py::arg("dt"), "Q for a step of dt")
       .def(
           "check_jacobians",

@@ -112,7 +112,8 @@ def test_strapdown_ins_from_its_registration():
     assert isinstance(m, gssm.models.StrapdownIns) and m.name == "strapdown_ins"
     assert (m.nc, m.nb) == (10, 20) and m.rotation_blocks == [0] and m.angle_states == []
     assert m.constant_names[12] == "imu_delay" and m.constant_names[-1] == "clock_rate"
-    assert [c.name for c in m.channels] == ["gnss", "nhc", "zupt", "zaru"]
+    assert [c.name for c in m.channels] == ["gnss", "nhc", "zupt", "zaru", "gnss_vel"]
+    assert [c.regressors for c in m.channels] == [0, 0, 0, 0, 6]
     assert m.params["prior_delay_sd"] == 0.2
     assert m.channels[0].own_R_scale == 1.0  # the fixes' own sds as reported
     scaled = gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], gnss_sd_scale=2.0)
@@ -123,3 +124,17 @@ def test_strapdown_ins_from_its_registration():
     nxt, J_x, J_b = m.f(x, b, u=[0, 0, 0, 0, 0, -9.797], dt=0.01, jacobians=True)
     assert J_x.shape == (10, 10) and J_b.shape == (10, 20)
     assert abs(nxt[5]) < 1e-3  # at rest on the ground: no vertical acceleration to speak of
+    # The GNSS velocity reads the IMU's reading at the fix: without a lever
+    # arm or a delay it is the velocity itself; with a lever arm it turns.
+    reading = np.array([0.0, 0.0, 0.5, 0.0, 0.0, -9.8])
+    x = np.array(x, dtype=float)
+    x[3:6] = [3.0, -1.0, 0.2]
+    still = np.zeros(20)
+    np.testing.assert_allclose(m.h(x, still, "gnss_vel", regressors=reading), x[3:6], atol=1e-12)
+    with pytest.raises(gssm.InvalidArgument, match="carries 0 known values"):
+        m.h(x, still, "gnss_vel")
+    lever = still.copy()
+    lever[6:9] = [1.0, 0.0, 0.0]  # 1 m ahead along the IMU's x, turning at 0.5 rad/s about its z
+    y, J_x, J_b = m.h(x, lever, "gnss_vel", jacobians=True, regressors=reading)
+    assert J_x.shape == (3, 10) and J_b.shape == (3, 20)
+    np.testing.assert_allclose(np.linalg.norm(y - x[3:6]), 0.5, rtol=1e-12)

@@ -35,7 +35,7 @@ std::vector<PointError> predictionErrorSeries(const Model& model, const OfflineR
     while (input + 1 < inputs.size() && inputs[input + 1].t <= r.t) ++input;
     const Eigen::VectorXd xb = r.mean.tail(nb);
     const Eigen::VectorXd xc = carried(model, r.mean.head(nc), xb, inputs, input, r.t, m.t);
-    out.push_back({m.t, model.h(m.channel, xc, xb) - m.y});
+    out.push_back({m.t, model.hWith(m.channel, m.regressors, xc, xb) - m.y});
   }
   return out;
 }

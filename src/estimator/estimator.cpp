@@ -183,7 +183,7 @@ double Estimator::innovationNis(double dt, const Eigen::VectorXd& u, const Measu
     P.topLeftCorner(d.nc, d.nc) += model_.processNoiseOf(dt, u);
   }
   Eigen::MatrixXd J_h_xc, J_h_xb;
-  Eigen::VectorXd innovation = m.y - model_.h(m.channel, x, xb, &J_h_xc, &J_h_xb);
+  Eigen::VectorXd innovation = m.y - model_.hWith(m.channel, m.regressors, x, xb, &J_h_xc, &J_h_xb);
   wrapAngles(innovation, ch.angles);
   Eigen::MatrixXd H(ch.dim(), d.nc + d.nb);
   H << J_h_xc, J_h_xb;
@@ -222,6 +222,10 @@ void Estimator::requireValues(const Measurement& m) const {
   if (m.R.size())
     requireCovariance(m.R, ch.dim(), std::string(methodName()) + ": own noise covariance of the measurement at t = " +
                                          std::to_string(t));
+  if (!validVector(m.regressors, ch.regressors))
+    requireVector(m.regressors, ch.regressors,
+                  std::string(methodName()) + ": known values (regressors) of the measurement on channel '" + ch.name +
+                      "' at t = " + std::to_string(t));
 }
 
 void Estimator::addLate(const Measurement& m) {

@@ -8,7 +8,8 @@ namespace {
 // single-channel checkpoints keep their v1 bytes).
 enum class FactorTag : std::uint8_t {
   Prior = 1, Process = 2, Measurement = 3, LinearGaussian = 4, MeasurementOnChannel = 5, PriorWithAngles = 6,
-  ProcessBetween = 7  // between any two states (an inserted one), since format version 3
+  ProcessBetween = 7,  // between any two states (an inserted one), since format version 3
+  MeasurementWithRegressors = 8  // on a channel whose h reads known values (Measurement::regressors)
 };
 
 void requireDim(ByteReader& in, const Model& model, const Key& k, Eigen::Index size, const std::string& what) {
@@ -36,11 +37,15 @@ void writeFactor(ByteWriter& out, const Factor& f) {
     out.vec(q->input());
     out.f64(q->dt());
   } else if (const auto* m = dynamic_cast<const MeasurementFactor*>(&f)) {
-    out.u8(static_cast<std::uint8_t>(m->channel() == 0 ? FactorTag::Measurement : FactorTag::MeasurementOnChannel));
+    const bool known = m->regressors().size() > 0;
+    out.u8(static_cast<std::uint8_t>(known               ? FactorTag::MeasurementWithRegressors
+                                     : m->channel() == 0 ? FactorTag::Measurement
+                                                         : FactorTag::MeasurementOnChannel));
     out.i64(m->keys()[0].step);
-    if (m->channel() != 0) out.i32(m->channel());
+    if (known || m->channel() != 0) out.i32(m->channel());
     out.vec(m->measurement());
     out.mat(m->noise().covariance());
+    if (known) out.vec(m->regressors());
   } else if (const auto* l = dynamic_cast<const LinearGaussianFactor*>(&f)) {
     out.u8(static_cast<std::uint8_t>(FactorTag::LinearGaussian));
     out.keys(l->keys());
@@ -85,7 +90,8 @@ FactorPtr readFactor(ByteReader& in, const Model& model, const std::string& what
       return std::make_shared<ProcessFactor>(model, from, to, u, dt);
     }
     case FactorTag::Measurement:
-    case FactorTag::MeasurementOnChannel: {
+    case FactorTag::MeasurementOnChannel:
+    case FactorTag::MeasurementWithRegressors: {
       const std::int64_t k = in.i64((what + " step").c_str());
       if (k <= -(std::int64_t(1) << 53) || k >= (std::int64_t(1) << 53))
         in.fail(what + ": step " + std::to_string(k) + " out of range");
@@ -98,7 +104,12 @@ FactorPtr readFactor(ByteReader& in, const Model& model, const std::string& what
       const int ny = model.channel(channel).dim();
       if (y.size() != ny || R.rows() != ny || R.cols() != ny)
         in.fail(what + ": measurement or noise covariance is not of the channel's size " + std::to_string(ny));
-      return std::make_shared<MeasurementFactor>(model, k, y, channel, GaussianNoise(R, what + " noise"));
+      Eigen::VectorXd known;
+      if (static_cast<FactorTag>(tag) == FactorTag::MeasurementWithRegressors) known = in.vec(what + " regressors");
+      if (known.size() != model.channel(channel).regressors)
+        in.fail(what + ": " + std::to_string(known.size()) + " known values (regressors) but channel '" +
+                model.channel(channel).name + "' reads " + std::to_string(model.channel(channel).regressors));
+      return std::make_shared<MeasurementFactor>(model, k, y, channel, GaussianNoise(R, what + " noise"), known);
     }
     case FactorTag::LinearGaussian: {
       std::vector<Key> keys = in.keys(what + " keys");

@@ -230,18 +230,22 @@ GaussianNoise measurementNoise(const Model& model, std::int64_t k, const Measure
 }  // namespace
 
 MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const Measurement& m)
-    : MeasurementFactor(model, k, m.y, m.channel, measurementNoise(model, k, m)) {}
+    : MeasurementFactor(model, k, m.y, m.channel, measurementNoise(model, k, m), m.regressors) {}
 
 MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y, int channel,
-                                     const GaussianNoise& noise)
+                                     const GaussianNoise& noise, const Eigen::VectorXd& regressors)
     : Factor(withConstants(model, {Key::state(k)}), model.channel(channel).dim(), model.channel(channel).loss),
       model_(&model),
       y_(y),
+      regressors_(regressors),
       channel_(channel),
       noise_(noise) {
   const MeasurementChannel& ch = model.channel(channel);
   if (!validVector(y, ch.dim()))
     requireVector(y, ch.dim(), "measurement on channel '" + ch.name + "' at step " + std::to_string(k));
+  if (!validVector(regressors, ch.regressors))
+    requireVector(regressors, ch.regressors,
+                  "known values (regressors) of the measurement on channel '" + ch.name + "' at step " + std::to_string(k));
   if (noise.dim() != ch.dim())
     throw InvalidArgument("measurement on channel '" + ch.name + "' at step " + std::to_string(k) +
                           ": its noise covariance is " + std::to_string(noise.dim()) + " x " +
@@ -250,7 +254,7 @@ MeasurementFactor::MeasurementFactor(const Model& model, std::int64_t k, const E
 
 void internal::measurementResidual(const Model& model, int channel, const Eigen::Ref<const Eigen::VectorXd>& y,
                                    const GaussianNoise& noise, const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
-                                   std::vector<Eigen::MatrixXd>* J) {
+                                   std::vector<Eigen::MatrixXd>* J, const Eigen::VectorXd& regressors) {
   static const Eigen::VectorXd kNoConstants;
   const bool has_constants = model.dims().nb > 0;
   const Eigen::VectorXd& xc = *x[0];
@@ -259,7 +263,7 @@ void internal::measurementResidual(const Model& model, int channel, const Eigen:
   if (J) J->resize(has_constants ? 2 : 1);
   Eigen::MatrixXd* J_h_xc = J ? &(*J)[0] : nullptr;
   Eigen::MatrixXd* J_h_xb = J ? (has_constants ? &(*J)[1] : &no_constants) : nullptr;
-  model.hInto(channel, xc, xb, r, J_h_xc, J_h_xb);
+  model.hWith(channel, regressors, xc, xb, r, J_h_xc, J_h_xb);
   r -= y;
   wrapAngles(r, model.channel(channel).angles);
   noise.whitenInPlace(r);
@@ -269,7 +273,7 @@ void internal::measurementResidual(const Model& model, int channel, const Eigen:
 
 void MeasurementFactor::linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                                     std::vector<Eigen::MatrixXd>* J) const {
-  internal::measurementResidual(*model_, channel_, y_, noise_, x, r, J);
+  internal::measurementResidual(*model_, channel_, y_, noise_, x, r, J, regressors_);
 }
 
 const std::vector<int>* MeasurementFactor::columnsOf(std::size_t a) const {

@@ -20,10 +20,11 @@ void processResidual(const Model& model, const Eigen::VectorXd& u, double dt, co
                      const Eigen::VectorXd* const* x, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>* J);
 
 /// r = L_R⁻¹ (h_c(x_c(k), x_b) − y) on `channel` (eq. 3), its angle
-/// components wrapped; x = [x_c(k), x_b], x_b only if the model has constants.
+/// components wrapped; x = [x_c(k), x_b], x_b only if the model has constants;
+/// h reads `regressors` (Measurement::regressors) on a channel that takes any.
 void measurementResidual(const Model& model, int channel, const Eigen::Ref<const Eigen::VectorXd>& y,
                          const GaussianNoise& noise, const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
-                         std::vector<Eigen::MatrixXd>* J);
+                         std::vector<Eigen::MatrixXd>* J, const Eigen::VectorXd& regressors = {});
 
 /// Where a variable of `model` holds rotations: its stacked blocks, from 0
 /// in x_c, from n_c in x_b (constants true); null blocks for a model without.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "gssm/core/error.h"
 #include "gssm/io/csv.h"
@@ -54,6 +55,47 @@ void addMeanInput(const std::vector<Input>& inputs, const Model& model, int chan
   if (n > 0) out.emplace_back(to, sum / n, channel);
 }
 
+// [dataset] gnss_velocity_channel: each used fix's own velocity (NED) on
+// this channel, with the mean of the inputs' first `regressors` components
+// within ±window/2 of it (the IMU's reading, with which the lever arm turns).
+struct VelocityFixes {
+  int channel = -1;  // none
+  double window = 0.1;
+};
+
+VelocityFixes velocityFixes(const IniDocument& ini, const Model& model, const GnssSolution& sol) {
+  VelocityFixes v;
+  if (!ini.has("dataset", "gnss_velocity_channel")) return v;
+  v.channel = model.channelIndex(ini.getString("dataset", "gnss_velocity_channel"));
+  if (model.channel(v.channel).dim() != 3)
+    throw InputError(ini.source() + ": [dataset] gnss_velocity_channel: channel '" + model.channel(v.channel).name +
+                     "' has " + std::to_string(model.channel(v.channel).dim()) + " components, a velocity 3");
+  v.window = ini.getDouble("dataset", "gnss_velocity_window", v.window);
+  if (!(v.window > 0)) throw InputError(ini.source() + ": [dataset] gnss_velocity_window must be positive (s)");
+  if (!sol.has_velocity)
+    throw InputError(sol.source + ": no velocity columns (vn ve vu), which [dataset] gnss_velocity_channel needs "
+                     "(RTKLIB: output the velocity, or remove the key)");
+  return v;
+}
+
+// The fix's velocity as a measurement, or none when no input falls in its
+// window (the regressors h reads would be missing).
+std::optional<Measurement> velocityMeasurement(const GnssFix& f, const VelocityFixes& v, const Model& model,
+                                               const std::vector<Input>& inputs) {
+  const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
+  const int k = model.channel(v.channel).regressors;
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(k);
+  int n = 0;
+  auto it = std::lower_bound(inputs.begin(), inputs.end(), f.t - v.window / 2,
+                             [](const Input& u, double t) { return u.t < t; });
+  for (; k > 0 && it != inputs.end() && it->t <= f.t + v.window / 2; ++it, ++n) mean += it->u.head(k);
+  if (k > 0 && n == 0) return std::nullopt;
+  if (n > 0) mean /= n;
+  Eigen::MatrixXd R;
+  if (f.vel_cov_neu.diagonal().maxCoeff() > 0) R = neu_to_ned * f.vel_cov_neu * neu_to_ned;
+  return Measurement(f.t, neu_to_ned * *f.vel_neu, v.channel, R, mean);
+}
+
 StillFixes stillFixes(const IniDocument& ini, const Model& model, const GnssSolution& sol) {
   StillFixes s;
   if (!ini.has("dataset", "gnss_still_channel")) return s;
@@ -86,6 +128,7 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
   for (const Outage& o : outages) out.outages.emplace_back(o.start, o.end);
   const GnssSolution sol = readRtklibPos(path);
   const StillFixes still = stillFixes(ini, model, sol);
+  const VelocityFixes velocity = velocityFixes(ini, model, sol);
   const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
   const double deg = M_PI / 180;
   std::vector<Measurement> used;
@@ -108,6 +151,8 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
     }
     if (f.quality != 1) m.R *= float_scale * float_scale;
     used.push_back(std::move(m));
+    if (velocity.channel >= 0 && f.vel_neu)
+      if (auto v = velocityMeasurement(f, velocity, model, out.inputs)) used.push_back(std::move(*v));
     if (still.channel >= 0 && f.vel_neu->norm() < still.speed) {  // standing: its zero-velocity measurement too
       used.emplace_back(f.t, Eigen::VectorXd::Zero(model.channel(still.channel).dim()), still.channel);
       if (still.rates_channel >= 0) addMeanInput(out.inputs, model, still.rates_channel, previous, f.t, used);

@@ -1,5 +1,6 @@
 #include "io/text_file.h"
 
+#include <filesystem>
 #include <fstream>
 
 #include "gssm/core/error.h"
@@ -7,6 +8,9 @@
 namespace gssm::io {
 
 std::string readTextFile(const std::string& path, const std::string& what) {
+  // A directory opens as a stream on Linux, and its end offset can be 2^63 − 1.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, not the " + what);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the " + what);
   std::string text;

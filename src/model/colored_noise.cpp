@@ -121,18 +121,17 @@ class ColoredNoiseModel final : public Model {
     hInto(channel, xc, xb, out, J_h_xc, J_h_xb);
     return out;
   }
-  // y = h_inner(x_c, x_b) + e_channel: J_h_e = I on the channel's own errors.
   void hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
              Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const override {
-    const int dim = this->channel(channel).dim();  // range check: throws, naming the channels
-    Eigen::MatrixXd J_inner;
-    inner_->hInto(channel, xc.head(a_.inner_nc), xb, out, J_h_xc ? &J_inner : nullptr, J_h_xb);
-    const int o = a_.offset[static_cast<std::size_t>(channel)];
-    if (o >= 0) out += xc.segment(o, dim);
-    if (!J_h_xc) return;
-    J_h_xc->setZero(dim, dims().nc);
-    J_h_xc->leftCols(a_.inner_nc) = J_inner;
-    if (o >= 0) J_h_xc->block(0, o, dim, dim).setIdentity();
+    withErrors(channel, xc, out, J_h_xc, [&](const Eigen::VectorXd& inner_xc, Eigen::MatrixXd* J_inner) {
+      inner_->hInto(channel, inner_xc, xb, out, J_inner, J_h_xb);
+    });
+  }
+  void hRegressedInto(int channel, const Eigen::VectorXd& known, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                      Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const override {
+    withErrors(channel, xc, out, J_h_xc, [&](const Eigen::VectorXd& inner_xc, Eigen::MatrixXd* J_inner) {
+      inner_->hRegressedInto(channel, known, inner_xc, xb, out, J_inner, J_h_xb);
+    });
   }
 
   Eigen::MatrixXd processNoise(double dt) const override {
@@ -179,6 +178,22 @@ class ColoredNoiseModel final : public Model {
   }
 
  private:
+  // y = h_inner(x_c, x_b) + e_channel: J_h_e = I on the channel's own errors
+  // (innerH(inner x_c, J on it) writes h_inner into out).
+  template <class InnerH>
+  void withErrors(int channel, const Eigen::VectorXd& xc, Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc,
+                  InnerH innerH) const {
+    const int dim = this->channel(channel).dim();  // range check: throws, naming the channels
+    Eigen::MatrixXd J_inner;
+    innerH(xc.head(a_.inner_nc), J_h_xc ? &J_inner : nullptr);
+    const int o = a_.offset[static_cast<std::size_t>(channel)];
+    if (o >= 0) out += xc.segment(o, dim);
+    if (!J_h_xc) return;
+    J_h_xc->setZero(dim, dims().nc);
+    J_h_xc->leftCols(a_.inner_nc) = J_inner;
+    if (o >= 0) J_h_xc->block(0, o, dim, dim).setIdentity();
+  }
+
   // The truth in the inner model's stacked components (error states dropped).
   Truth innerTruth(const Truth& truth) const {
     if (truth.components.empty() || a_.count == 0) return truth;

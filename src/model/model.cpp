@@ -75,6 +75,20 @@ Eigen::VectorXd Model::h(int channel, const Eigen::VectorXd& xc, const Eigen::Ve
   return h(xc, xb, J_h_xc, J_h_xb);
 }
 
+void Model::hRegressedInto(int c, const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd&,
+                           Eigen::VectorXd&, Eigen::MatrixXd*, Eigen::MatrixXd*) const {
+  throw InvalidArgument("model '" + name() + "': channel '" + channel(c).name + "' reads " +
+                        std::to_string(channel(c).regressors) +
+                        " known values but the model does not override hRegressedInto");
+}
+
+void Model::throwRegressors(int c, Eigen::Index given) const {
+  const MeasurementChannel& ch = channel(c);
+  throw InvalidArgument("model '" + name() + "': a measurement on channel '" + ch.name + "' carries " +
+                        std::to_string(given) + " known values (regressors); the channel reads " +
+                        std::to_string(ch.regressors));
+}
+
 void Model::throwNoChannel(int c) const {
   throw InvalidArgument("model '" + name() + "': no channel " + std::to_string(c) + " (it has " +
                         std::to_string(numChannels()) + ")");
@@ -116,6 +130,8 @@ void Model::setChannels(std::vector<MeasurementChannel> channels) {
     if (!(ch.own_R_scale > 0) || !std::isfinite(ch.own_R_scale))
       throw InvalidArgument("model: channel '" + ch.name + "': own_R_scale " + std::to_string(ch.own_R_scale) +
                             " must be finite and > 0");
+    if (ch.regressors < 0)
+      throw InvalidArgument("model: channel '" + ch.name + "': regressors " + std::to_string(ch.regressors) + " < 0");
     for (int a : ch.angles)
       if (a < 0 || a >= ch.dim()) throw InvalidArgument("model: channel '" + ch.name + "': angle component out of range");
     for (std::size_t i = 0; i < ch.constants.size(); ++i)
@@ -243,12 +259,18 @@ JacobianCheck checkJacobians(const Model& model, const Eigen::VectorXd& xc,
   compare(J_f_xc, differences([&](const Eigen::VectorXd& v) { return model.f(v, xb, u, dt); }, xc, nc, 0, true), "J_f_xc", out);
   compare(J_f_xb, differences([&](const Eigen::VectorXd& v) { return model.f(xc, v, u, dt); }, xb, nc, nc, true), "J_f_xb", out);
   // Every channel's h (channel 0 is the default h).
+  // Every channel's h (channel 0 is the default h); a channel that reads
+  // known values gets a fixed made-up set of them.
   for (int c = 0; c < model.numChannels(); ++c) {
     const int ny = model.channel(c).dim();
     const std::string at = c == 0 ? "" : "[" + model.channel(c).name + "]";
-    model.h(c, xc, xb, &J_h_xc, &J_h_xb);
-    compare(J_h_xc, differences([&](const Eigen::VectorXd& v) { return model.h(c, v, xb); }, xc, ny, 0, false), "J_h_xc" + at, out);
-    compare(J_h_xb, differences([&](const Eigen::VectorXd& v) { return model.h(c, xc, v); }, xb, ny, nc, false), "J_h_xb" + at, out);
+    Eigen::VectorXd known(model.channel(c).regressors);
+    for (Eigen::Index j = 0; j < known.size(); ++j) known[j] = 0.5 * std::sin(1.3 * static_cast<double>(j) + 0.7);
+    model.hWith(c, known, xc, xb, &J_h_xc, &J_h_xb);
+    compare(J_h_xc, differences([&](const Eigen::VectorXd& v) { return model.hWith(c, known, v, xb); }, xc, ny, 0, false),
+            "J_h_xc" + at, out);
+    compare(J_h_xb, differences([&](const Eigen::VectorXd& v) { return model.hWith(c, known, xc, v); }, xb, ny, nc, false),
+            "J_h_xb" + at, out);
   }
   return out;
 }

@@ -38,7 +38,10 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
   const double T = model.nominalStep();
   const Eigen::VectorXd zc = Eigen::VectorXd::Zero(d.nc);
   if (spec.channels.empty()) throw InvalidArgument("simulate: no measurement channels");
-  for (int c : spec.channels) model.channel(c);  // throws naming a channel the model does not have
+  for (int c : spec.channels)  // model.channel throws naming a channel the model does not have
+    if (model.channel(c).regressors > 0)
+      throw InvalidArgument("simulate: channel '" + model.channel(c).name +
+                            "' reads known values beside the state (regressors), which a simulation has not got");
   run.times.push_back(0.0);
   for (int k = 1; k <= spec.steps; ++k) {
     const double t_prev = (k - 1) * T;
@@ -52,7 +55,7 @@ SimulatedRun simulate(const Model& model, const SimulationSpec& spec, const Norm
     if (k % spec.measure_every == 0) {
       const int c = spec.channels[run.measurements.size() % spec.channels.size()];
       const MeasurementChannel& ch = model.channel(c);
-      Eigen::VectorXd y = model.h(c, x, run.constants);
+      Eigen::VectorXd y = model.hWith(c, Eigen::VectorXd(), x, run.constants);
       if (spec.measurement_noise) y += sampleGaussian(Eigen::VectorXd::Zero(ch.dim()), ch.R, draw);
       wrapAngles(y, ch.angles);
       run.measurements.push_back({t, std::move(y), c, {}});

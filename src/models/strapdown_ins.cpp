@@ -57,7 +57,8 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
 }
 
 ModelNoise insNoise(const StrapdownIns::Params& p) {
-  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.gnss_sd_scale, p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.zaru_sd, p.attitude_sd, p.velocity_sd,
+  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.gnss_sd_scale, p.gnss_vel_sd, p.gnss_vel_sd_scale,
+                   p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.zaru_sd, p.attitude_sd, p.velocity_sd,
                    p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd,
                    p.gyro_scale_sd, p.accel_scale_sd, p.clock_rate_sd, p.clock_wander_sd})
     if (!(v > 0) || !std::isfinite(v)) throw InvalidArgument("StrapdownIns: every σ and T must be > 0");
@@ -103,6 +104,17 @@ MeasurementChannel channelOf(const std::string& name, std::vector<std::string> c
   c.constants = std::move(constants);
   return c;
 }
+
+// The antenna's velocity: it reads the IMU's mean reading at the fix (6
+// regressors) and every constant but the mounting.
+MeasurementChannel gnssVelocityChannel(const StrapdownIns::Params& p) {
+  using S = StrapdownIns;
+  MeasurementChannel c = channelOf("gnss_vel", {"gnss_vn", "gnss_ve", "gnss_vd"}, Eigen::Vector3d::Constant(p.gnss_vel_sd),
+                                   {0, 1, 2, 3, 4, 5, 6, 7, 8, S::kDelay, 13, 14, 15, 16, 17, 18, S::kClockRate});
+  c.regressors = 6;
+  c.own_R_scale = p.gnss_vel_sd_scale * p.gnss_vel_sd_scale;
+  return c;
+}
 }  // namespace
 
 StrapdownIns::StrapdownIns(const Params& p)
@@ -116,7 +128,8 @@ StrapdownIns::StrapdownIns(const Params& p)
   setChannels({std::move(gnss),
                channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11}),
                channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, Eigen::Vector3d::Constant(p.zupt_sd), {}),
-               channelOf("zaru", {"zaru_x", "zaru_y", "zaru_z"}, Eigen::Vector3d::Constant(p.zaru_sd), {0, 1, 2})});
+               channelOf("zaru", {"zaru_x", "zaru_y", "zaru_z"}, Eigen::Vector3d::Constant(p.zaru_sd), {0, 1, 2}),
+               gnssVelocityChannel(p)});
   setRotationBlocks({0});
 }
 
@@ -225,6 +238,8 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
   if (channel == kGnss) return antenna(xc, xb, J_h_xc, J_h_xb);
   if (channel == kNhc) return vehicleVelocity(xc, xb, J_h_xc, J_h_xb);
   if (channel == kZaru) return restingGyro(xc, xb, J_h_xc, J_h_xb);
+  if (channel == kGnssVelocity)
+    throw InvalidArgument("StrapdownIns: channel 'gnss_vel' reads the IMU's reading at the fix: evaluate it by hWith");
   if (J_h_xc) {
     J_h_xc->setZero(3, dims().nc);
     J_h_xc->middleCols<3>(3).setIdentity();
@@ -299,6 +314,48 @@ Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen
   return gyroBias(xc, xb) + w;
 }
 
+// The antenna's velocity at the GNSS time of the fix, given the IMU's mean
+// reading [ω̃, f̃] there (the regressors): with ω = (1 − s_g)∘ω̃ − b_g and
+// f = (1 − s_a)∘f̃ − b_a (as f takes a reading), the antenna turns about the
+// IMU at R·(ω×ℓ), and the state at IMU time t is the true time t + δ, so
+// y = v + R·(ω×ℓ) − δ·a, a = R·f + g(p) (Coriolis, ~1e-3 m/s², left out):
+// ∂y/∂δθ = −R·[ω×ℓ]× + δ·R·[f]×, ∂y/∂v = I, ∂y/∂p = −δ·∂g/∂p,
+// ∂y/∂c = −ρ·a, ∂y/∂b_g = R·[ℓ]×, ∂y/∂s_g = R·[ℓ]×·diag(ω̃),
+// ∂y/∂ℓ = R·[ω]×, ∂y/∂b_a = δ·R, ∂y/∂s_a = δ·R·diag(f̃), ∂y/∂d = −a,
+// ∂y/∂ρ = −c·a.
+void StrapdownIns::hRegressedInto(int channel, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc,
+                                  const Eigen::VectorXd& xb, Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc,
+                                  Eigen::MatrixXd* J_h_xb) const {
+  if (channel != kGnssVelocity) return Model::hRegressedInto(channel, regressors, xc, xb, out, J_h_xc, J_h_xb);
+  const Eigen::Vector3d gyro = regressors.head<3>(), accel = regressors.tail<3>();
+  const Eigen::Vector3d w = gyro - xb.segment<3>(kGyroScale).cwiseProduct(gyro) - gyroBias(xc, xb);
+  const Eigen::Vector3d f = accel - xb.segment<3>(kAccelScale).cwiseProduct(accel) - xb.segment<3>(kAccelBias);
+  const Eigen::Matrix3d R = so3::Exp(xc.head<3>());
+  const Eigen::Vector3d lever = xb.segment<3>(kLever), turn = w.cross(lever);
+  Eigen::Matrix3d J_g_p;
+  const Eigen::Vector3d a = R * f + frame_.gravity(xc.segment<3>(6), J_h_xc ? &J_g_p : nullptr);
+  const double delay = xb[kDelay] + xb[kClockRate] * xc[kClock];
+  out = xc.segment<3>(3) + R * turn - delay * a;
+  if (J_h_xc) {
+    J_h_xc->setZero(3, dims().nc);
+    J_h_xc->leftCols<3>() = -R * hat(turn) + delay * R * hat(f);
+    J_h_xc->middleCols<3>(3).setIdentity();
+    J_h_xc->middleCols<3>(6) = -delay * J_g_p;
+    J_h_xc->col(kClock) = -xb[kClockRate] * a;
+    if (gyroBiasWalks()) J_h_xc->middleCols<3>(kGyroWalk) = R * hat(lever);
+  }
+  if (J_h_xb) {
+    J_h_xb->setZero(3, kConstants);
+    J_h_xb->middleCols<3>(kGyroBias) = R * hat(lever);
+    J_h_xb->middleCols<3>(kAccelBias) = delay * R;
+    J_h_xb->middleCols<3>(kLever) = R * hat(w);
+    J_h_xb->col(kDelay) = -a;
+    J_h_xb->middleCols<3>(kGyroScale) = R * hat(lever) * gyro.asDiagonal();
+    J_h_xb->middleCols<3>(kAccelScale) = delay * R * accel.asDiagonal();
+    J_h_xb->col(kClockRate) = -xc[kClock] * a;
+  }
+}
+
 Eigen::MatrixXd StrapdownIns::processNoise(double dt) const { return insProcessNoise(p_, dt); }
 
 }  // namespace gssm::models
@@ -323,6 +380,9 @@ std::vector<ParamSpec> insParams() {
       learnable(real("model", "accel_sd", "accelerometer white noise, m/s²/√Hz")),
       learnable(real("model", "gnss_sd", "σ of each GNSS coordinate when a fix gives none (m)")),
       learnable(real("model", "gnss_sd_scale", "factor on the σs each GNSS fix reports (1: as reported)")),
+      learnable(real("model", "gnss_vel_sd",
+                     "σ of each GNSS velocity component when a fix gives none (m/s; [dataset] gnss_velocity_channel)")),
+      learnable(real("model", "gnss_vel_sd_scale", "factor on the velocity σs each GNSS fix reports (1: as reported)")),
       learnable(real("model", "nhc_sd", "σ of the vehicle's sideways velocity at the IMU (m/s)")),
       learnable(real("model", "nhc_down_sd",
                      "σ of its vertical velocity (m/s; with one σ for both the constraint is blind to the mounting's "
@@ -433,7 +493,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   p.anchor = readAnchor(in);
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
   for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
-                            {"gnss_sd", &p.gnss_sd}, {"gnss_sd_scale", &p.gnss_sd_scale}, {"nhc_sd", &p.nhc_sd},
+                            {"gnss_sd", &p.gnss_sd}, {"gnss_sd_scale", &p.gnss_sd_scale},
+                            {"gnss_vel_sd", &p.gnss_vel_sd}, {"gnss_vel_sd_scale", &p.gnss_vel_sd_scale}, {"nhc_sd", &p.nhc_sd},
                             {"nhc_down_sd", &p.nhc_down_sd},
                             {"zupt_sd", &p.zupt_sd}, {"zaru_sd", &p.zaru_sd},
                             {"clock_wander_sd", &p.clock_wander_sd}, {"gyro_bias_walk", &p.gyro_bias_walk}})
@@ -472,7 +533,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("model", "anchor", Eigen::Vector3d(p.anchor.lat / kDeg, p.anchor.lon / kDeg, p.anchor.height));
   out.vector("model", "mount_rpy", p.mount_rpy / kDeg);
   for (auto [key, value] : {std::pair{"gyro_sd", p.gyro_sd}, {"accel_sd", p.accel_sd}, {"gnss_sd", p.gnss_sd},
-                            {"gnss_sd_scale", p.gnss_sd_scale}, {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
+                            {"gnss_sd_scale", p.gnss_sd_scale}, {"gnss_vel_sd", p.gnss_vel_sd},
+                            {"gnss_vel_sd_scale", p.gnss_vel_sd_scale}, {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
                             {"zupt_sd", p.zupt_sd}, {"zaru_sd", p.zaru_sd},
                             {"clock_wander_sd", p.clock_wander_sd}, {"gyro_bias_walk", p.gyro_bias_walk}})
     out.real("model", key, value);

@@ -119,7 +119,7 @@ bool ExtendedKalmanFilter::update(const Measurement& m) {
   UpdateBuffers& b = u_;
   b.xc = z_.head(d.nc);
   b.xb = z_.tail(d.nb);
-  model_->hInto(m.channel, b.xc, b.xb, b.yhat, &b.J_h_xc, &b.J_h_xb);
+  model_->hWith(m.channel, m.regressors, b.xc, b.xb, b.yhat, &b.J_h_xc, &b.J_h_xb);
   b.H.resize(ch.dim(), d.nc + d.nb);
   b.H << b.J_h_xc, b.J_h_xb;
   if (m.R.size()) innovationCovariance(m.R, ch.own_R_scale);  // ch.covarianceOf(m.R), without a fresh matrix

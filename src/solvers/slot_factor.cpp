@@ -33,7 +33,7 @@ SlotFactor::SlotFactor(const FactorPtr& f, const Model* model) : SlotFactor() {
     noise_ = p->noise();
     new (&step_) Step{p->dt(), p->input()};
     kind_ = Kind::Process;
-  } else if (m && &m->model() == model) {
+  } else if (m && &m->model() == model && m->regressors().size() == 0) {  // else: kept whole
     noise_ = m->noise();
     channel_ = m->channel();
     loss_kind_ = static_cast<std::uint8_t>(m->loss().kind);

@@ -12,10 +12,15 @@ struct Measurement {
   Eigen::VectorXd y;
   int channel = 0;    ///< the model's measurement channel (0: the default)
   Eigen::MatrixXd R;  ///< this measurement's own noise covariance; empty: the channel's
+  /// Known values h reads beside the state, as many as the channel's
+  /// MeasurementChannel::regressors (empty on most channels): e.g. the IMU's
+  /// reading at a GNSS velocity fix, with which the lever arm turns.
+  Eigen::VectorXd regressors;
 
   Measurement() = default;
-  Measurement(double t_, Eigen::VectorXd y_, int channel_ = 0, Eigen::MatrixXd R_ = {})
-      : t(t_), y(std::move(y_)), channel(channel_), R(std::move(R_)) {}
+  Measurement(double t_, Eigen::VectorXd y_, int channel_ = 0, Eigen::MatrixXd R_ = {},
+              Eigen::VectorXd regressors_ = {})
+      : t(t_), y(std::move(y_)), channel(channel_), R(std::move(R_)), regressors(std::move(regressors_)) {}
 };
 
 /// An input u held constant from time t until the next input (zero-order hold).

@@ -127,9 +127,10 @@ class MeasurementFactor final : public Factor {
   MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y);
   /// On m.channel, with m.R when given (else the channel's R).
   MeasurementFactor(const Model& model, std::int64_t k, const Measurement& m);
-  /// On `channel` with an explicit noise model (checkpoints).
+  /// On `channel` with an explicit noise model (checkpoints), and the
+  /// known values h reads when the channel reads any (Measurement::regressors).
   MeasurementFactor(const Model& model, std::int64_t k, const Eigen::VectorXd& y, int channel,
-                    const GaussianNoise& noise);
+                    const GaussianNoise& noise, const Eigen::VectorXd& regressors = {});
   void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
                    std::vector<Eigen::MatrixXd>* J) const override;
   std::string describe() const override;
@@ -137,6 +138,7 @@ class MeasurementFactor final : public Factor {
   /// names them.
   const std::vector<int>* columnsOf(std::size_t a) const override;
   const Eigen::VectorXd& measurement() const { return y_; }
+  const Eigen::VectorXd& regressors() const { return regressors_; }
   int channel() const { return channel_; }
   const GaussianNoise& noise() const { return noise_; }
   const Model& model() const { return *model_; }
@@ -145,6 +147,7 @@ class MeasurementFactor final : public Factor {
  private:
   const Model* model_;
   Eigen::VectorXd y_;
+  Eigen::VectorXd regressors_;
   int channel_;
   GaussianNoise noise_;
 };

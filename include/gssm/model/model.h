@@ -43,6 +43,10 @@ struct MeasurementChannel {
   /// model exposes it, e.g. strapdown_ins's gnss_sd_scale). The channel's
   /// own R is not scaled.
   double own_R_scale = 1;
+  /// How many known values a measurement on this channel carries beside y
+  /// (Measurement::regressors), which h reads: 0 on most channels; h of such
+  /// a channel is Model::hWith (a GNSS velocity: the IMU's mean reading).
+  int regressors = 0;
   int dim() const { return static_cast<int>(components.size()); }
   /// The noise covariance of a measurement on this channel that brings
   /// `own` (Measurement::R; empty: none): own_R_scale·own, else R.
@@ -104,6 +108,28 @@ class Model {
   /// this and lets h() call it.
   virtual void hInto(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::VectorXd& out,
                      Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const;
+  /// h of a measurement on `channel` that carries `regressors`
+  /// (Measurement::regressors): hInto on a channel that reads none,
+  /// hRegressedInto on one that does. InvalidArgument naming the channel
+  /// when their number is not the channel's. Every estimator calls this.
+  void hWith(int c, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+             Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const {
+    if (regressors.size() != channel(c).regressors) throwRegressors(c, regressors.size());
+    if (regressors.size() == 0) hInto(c, xc, xb, out, J_h_xc, J_h_xb);
+    else hRegressedInto(c, regressors, xc, xb, out, J_h_xc, J_h_xb);
+  }
+  /// hWith into a fresh vector (tests, reports: off the solvers' loops).
+  Eigen::VectorXd hWith(int c, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                        Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const {
+    Eigen::VectorXd out;
+    hWith(c, regressors, xc, xb, out, J_h_xc, J_h_xb);
+    return out;
+  }
+  /// h of a channel with MeasurementChannel::regressors > 0 (a model with
+  /// such a channel overrides it; the default throws, naming the channel).
+  virtual void hRegressedInto(int channel, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc,
+                              const Eigen::VectorXd& xb, Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc,
+                              Eigen::MatrixXd* J_h_xb) const;
 
   /// The measurement channels (at least one; channel 0 has n_y components).
   int numChannels() const { return static_cast<int>(channels_.size()); }
@@ -234,6 +260,7 @@ class Model {
 
  private:
   [[noreturn]] void throwNoChannel(int c) const;
+  [[noreturn]] void throwRegressors(int c, Eigen::Index given) const;
   std::vector<MeasurementChannel> channels_;
   std::vector<GaussianNoise> channel_noise_;
   std::vector<int> angle_states_;

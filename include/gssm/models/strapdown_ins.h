@@ -31,8 +31,11 @@
 // p + R_nb·ℓ − (d + ρ·c)·v), `nhc`
 // (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z),
 // `zupt` (the velocity, zero while standing), `zaru` (the gyro's mean
-// reading while standing: b_g + R_nbᵀ·ω_ie). R_vb maps the IMU's axes to
-// the vehicle's (forward, right, down); R_vb0 is its nominal value.
+// reading while standing: b_g + R_nbᵀ·ω_ie), `gnss_vel` (the antenna's NED
+// velocity at the fix's time, v + R_nb·(ω×ℓ) − δ·(R_nb·f + g): it reads the
+// IMU's mean reading [ω̃, f̃] at the fix, Measurement::regressors). R_vb
+// maps the IMU's axes to the vehicle's (forward, right, down); R_vb0 is its
+// nominal value.
 #include <Eigen/Core>
 
 #include "gssm/model/model.h"
@@ -51,6 +54,8 @@ class StrapdownIns final : public Model {
     double accel_sd = 1e-2;                    ///< accelerometer white noise, m/s²/√Hz
     double gnss_sd = 0.02;                     ///< σ of each GNSS coordinate (m) unless a fix gives its own
     double gnss_sd_scale = 1;                  ///< factor on the σs a fix gives (learnable: the receiver's honesty)
+    double gnss_vel_sd = 0.05;                 ///< σ of each GNSS velocity component (m/s) unless a fix gives its own
+    double gnss_vel_sd_scale = 1;              ///< factor on the velocity σs a fix gives
     double nhc_sd = 0.1;                       ///< σ of the vehicle's sideways velocity at the IMU (m/s)
     double nhc_down_sd = 0.1;                  ///< σ of its vertical velocity (m/s)
     double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)
@@ -98,6 +103,10 @@ class StrapdownIns final : public Model {
                     Eigen::MatrixXd* J_h_xb = nullptr) const override;
   Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
+  /// The `gnss_vel` channel: h given the IMU's mean reading [ω̃, f̃] at the fix.
+  void hRegressedInto(int channel, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc,
+                      const Eigen::VectorXd& xb, Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc,
+                      Eigen::MatrixXd* J_h_xb) const override;
   Eigen::MatrixXd processNoise(double dt) const override;
   int readingsPerStep() const override { return p_.imu_per_state; }
   /// lat, lon (deg), height (m) of the antenna; vn, ve, vd (m/s); the
@@ -125,7 +134,7 @@ class StrapdownIns final : public Model {
     if (gyroBiasWalks()) b += xc.segment<3>(kGyroWalk);
     return b;
   }
-  enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2, kZaru = 3 };
+  enum Channel : int { kGnss = 0, kNhc = 1, kZupt = 2, kZaru = 3, kGnssVelocity = 4 };
 
  private:
   // One strapdown step under one reading u = [ω̃, f̃] (the f of N = 1).
