@@ -248,6 +248,18 @@ TEST(StrapdownIns, GnssVelocityIsTheRateOfTheAntennasFixPosition) {
   still[StrapdownIns::kDelay] = 0;
   EXPECT_LT((model.hWith(vel, u, xc, still) - xc.segment<3>(3)).norm(), 1e-12);
   EXPECT_GT((y - xc.segment<3>(3)).norm(), 0.3);
+  // A velocity that lags its fix by τ (gnss_vel_latency) is the one at the
+  // delay d + τ; its Jacobians hold there too.
+  StrapdownIns::Params lagged = driveParams(0.01);
+  lagged.gnss_vel_latency = 0.12;
+  const StrapdownIns late(lagged);
+  Eigen::VectorXd later = xb;
+  later[StrapdownIns::kDelay] += 0.12;
+  EXPECT_LT((late.hWith(vel, u, xc, xb) - model.hWith(vel, u, xc, later)).norm(), 1e-12);
+  const JacobianCheck check = checkJacobians(late, xc, xb, u, 0.01);
+  EXPECT_TRUE(check.ok(1e-5)) << check.worst;
+  lagged.gnss_vel_latency = -0.1;
+  testing::expectThrowsNaming<InvalidArgument>([&] { StrapdownIns{lagged}; }, "gnss_vel_latency must be >= 0");
   testing::expectThrowsNaming<InvalidArgument>([&] { model.h(vel, xc, xb); }, "hWith");
   testing::expectThrowsNaming<InvalidArgument>([&] { model.hWith(vel, Eigen::VectorXd(3), xc, xb); },
                                                "channel 'gnss_vel' carries 3 known values");

@@ -66,6 +66,8 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
     throw InvalidArgument("StrapdownIns: imu_per_state = " + std::to_string(p.imu_per_state) + ": expected 1..1000");
   if (!(p.start_heading_sd >= 0) || !std::isfinite(p.start_heading_sd))
     throw InvalidArgument("StrapdownIns: start_heading_sd must be >= 0");
+  if (!(p.gnss_vel_latency >= 0) || !std::isfinite(p.gnss_vel_latency))
+    throw InvalidArgument("StrapdownIns: gnss_vel_latency must be >= 0 (s)");
   if (!(p.gyro_bias_walk >= 0) || !std::isfinite(p.gyro_bias_walk))
     throw InvalidArgument("StrapdownIns: gyro_bias_walk must be >= 0 (0: a constant gyro bias)");
   ModelNoise n;
@@ -318,7 +320,8 @@ Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen
 // reading [ω̃, f̃] there (the regressors): with ω = (1 − s_g)∘ω̃ − b_g and
 // f = (1 − s_a)∘f̃ − b_a (as f takes a reading), the antenna turns about the
 // IMU at R·(ω×ℓ), and the state at IMU time t is the true time t + δ, so
-// y = v + R·(ω×ℓ) − δ·a, a = R·f + g(p) (Coriolis, ~1e-3 m/s², left out):
+// y = v + R·(ω×ℓ) − δ·a, a = R·f + g(p) (Coriolis, ~1e-3 m/s², left out;
+// a velocity that lags its fix by τ = gnss_vel_latency: δ + τ for δ):
 // ∂y/∂δθ = −R·[ω×ℓ]× + δ·R·[f]×, ∂y/∂v = I, ∂y/∂p = −δ·∂g/∂p,
 // ∂y/∂c = −ρ·a, ∂y/∂b_g = R·[ℓ]×, ∂y/∂s_g = R·[ℓ]×·diag(ω̃),
 // ∂y/∂ℓ = R·[ω]×, ∂y/∂b_a = δ·R, ∂y/∂s_a = δ·R·diag(f̃), ∂y/∂d = −a,
@@ -334,7 +337,7 @@ void StrapdownIns::hRegressedInto(int channel, const Eigen::VectorXd& regressors
   const Eigen::Vector3d lever = xb.segment<3>(kLever), turn = w.cross(lever);
   Eigen::Matrix3d J_g_p;
   const Eigen::Vector3d a = R * f + frame_.gravity(xc.segment<3>(6), J_h_xc ? &J_g_p : nullptr);
-  const double delay = xb[kDelay] + xb[kClockRate] * xc[kClock];
+  const double delay = xb[kDelay] + xb[kClockRate] * xc[kClock] + p_.gnss_vel_latency;
   out = xc.segment<3>(3) + R * turn - delay * a;
   if (J_h_xc) {
     J_h_xc->setZero(3, dims().nc);
@@ -383,6 +386,9 @@ std::vector<ParamSpec> insParams() {
       learnable(real("model", "gnss_vel_sd",
                      "σ of each GNSS velocity component when a fix gives none (m/s; [dataset] gnss_velocity_channel)")),
       learnable(real("model", "gnss_vel_sd_scale", "factor on the velocity σs each GNSS fix reports (1: as reported)")),
+      learnable(real("model", "gnss_vel_latency",
+                     "how long each fix's velocity lags its time (s; a receiver's filtered or averaged Doppler "
+                     "velocity; 0: instantaneous)")),
       learnable(real("model", "nhc_sd", "σ of the vehicle's sideways velocity at the IMU (m/s)")),
       learnable(real("model", "nhc_down_sd",
                      "σ of its vertical velocity (m/s; with one σ for both the constraint is blind to the mounting's "
@@ -494,7 +500,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
   for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
                             {"gnss_sd", &p.gnss_sd}, {"gnss_sd_scale", &p.gnss_sd_scale},
-                            {"gnss_vel_sd", &p.gnss_vel_sd}, {"gnss_vel_sd_scale", &p.gnss_vel_sd_scale}, {"nhc_sd", &p.nhc_sd},
+                            {"gnss_vel_sd", &p.gnss_vel_sd}, {"gnss_vel_sd_scale", &p.gnss_vel_sd_scale},
+                            {"gnss_vel_latency", &p.gnss_vel_latency}, {"nhc_sd", &p.nhc_sd},
                             {"nhc_down_sd", &p.nhc_down_sd},
                             {"zupt_sd", &p.zupt_sd}, {"zaru_sd", &p.zaru_sd},
                             {"clock_wander_sd", &p.clock_wander_sd}, {"gyro_bias_walk", &p.gyro_bias_walk}})
@@ -534,7 +541,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("model", "mount_rpy", p.mount_rpy / kDeg);
   for (auto [key, value] : {std::pair{"gyro_sd", p.gyro_sd}, {"accel_sd", p.accel_sd}, {"gnss_sd", p.gnss_sd},
                             {"gnss_sd_scale", p.gnss_sd_scale}, {"gnss_vel_sd", p.gnss_vel_sd},
-                            {"gnss_vel_sd_scale", p.gnss_vel_sd_scale}, {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
+                            {"gnss_vel_sd_scale", p.gnss_vel_sd_scale}, {"gnss_vel_latency", p.gnss_vel_latency},
+                            {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
                             {"zupt_sd", p.zupt_sd}, {"zaru_sd", p.zaru_sd},
                             {"clock_wander_sd", p.clock_wander_sd}, {"gyro_bias_walk", p.gyro_bias_walk}})
     out.real("model", key, value);

@@ -56,6 +56,9 @@ class StrapdownIns final : public Model {
     double gnss_sd_scale = 1;                  ///< factor on the σs a fix gives (learnable: the receiver's honesty)
     double gnss_vel_sd = 0.05;                 ///< σ of each GNSS velocity component (m/s) unless a fix gives its own
     double gnss_vel_sd_scale = 1;              ///< factor on the velocity σs a fix gives
+    /// How long a fix's velocity lags its time (s): a receiver's filtered or
+    /// interval-averaged Doppler velocity (learnable, > 0; 0: instantaneous).
+    double gnss_vel_latency = 0;
     double nhc_sd = 0.1;                       ///< σ of the vehicle's sideways velocity at the IMU (m/s)
     double nhc_down_sd = 0.1;                  ///< σ of its vertical velocity (m/s)
     double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)
