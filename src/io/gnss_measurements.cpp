@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <optional>
+#include <iterator>
 
 #include "gssm/core/error.h"
 #include "gssm/io/csv.h"
@@ -31,6 +31,16 @@ std::vector<Outage> readOutages(const std::string& path) {
   return out;
 }
 
+// into ← into and more, in time order (into's first where times are equal).
+void mergeInTime(std::vector<Measurement>& into, std::vector<Measurement> more) {
+  std::vector<Measurement> merged;
+  merged.reserve(into.size() + more.size());
+  std::merge(std::make_move_iterator(into.begin()), std::make_move_iterator(into.end()),
+             std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()), std::back_inserter(merged),
+             [](const Measurement& a, const Measurement& b) { return a.t < b.t; });
+  into = std::move(merged);
+}
+
 bool inside(const std::vector<Outage>& outages, double t) {
   return std::any_of(outages.begin(), outages.end(), [t](const Outage& o) { return t >= o.start && t < o.end; });
 }
@@ -56,8 +66,11 @@ void addMeanInput(const std::vector<Input>& inputs, const Model& model, int chan
 }
 
 // [dataset] gnss_velocity_channel: each used fix's own velocity (NED) on
-// this channel, with the mean of the inputs' first `regressors` components
-// within ±window/2 of it (the IMU's reading, with which the lever arm turns).
+// this channel, with the known values its h reads (the channel's
+// regressors, 3 or more): the mean of the inputs' first regressors − 3
+// components within ±window/2 of the fix (the IMU's rates, with which the
+// lever arm turns), then the velocity's rate of change (NED) from the
+// neighbouring used fixes (what the receiver's delay and lag multiply).
 struct VelocityFixes {
   int channel = -1;  // none
   double window = 0.1;
@@ -67,9 +80,11 @@ VelocityFixes velocityFixes(const IniDocument& ini, const Model& model, const Gn
   VelocityFixes v;
   if (!ini.has("dataset", "gnss_velocity_channel")) return v;
   v.channel = model.channelIndex(ini.getString("dataset", "gnss_velocity_channel"));
-  if (model.channel(v.channel).dim() != 3)
-    throw InputError(ini.source() + ": [dataset] gnss_velocity_channel: channel '" + model.channel(v.channel).name +
-                     "' has " + std::to_string(model.channel(v.channel).dim()) + " components, a velocity 3");
+  const MeasurementChannel& ch = model.channel(v.channel);
+  if (ch.dim() != 3 || ch.regressors < 3)
+    throw InputError(ini.source() + ": [dataset] gnss_velocity_channel: channel '" + ch.name + "' has " +
+                     std::to_string(ch.dim()) + " components and reads " + std::to_string(ch.regressors) +
+                     " known values; a GNSS velocity has 3 and needs at least 3 (its rate of change)");
   v.window = ini.getDouble("dataset", "gnss_velocity_window", v.window);
   if (!(v.window > 0)) throw InputError(ini.source() + ": [dataset] gnss_velocity_window must be positive (s)");
   if (!sol.has_velocity)
@@ -78,22 +93,35 @@ VelocityFixes velocityFixes(const IniDocument& ini, const Model& model, const Gn
   return v;
 }
 
-// The fix's velocity as a measurement, or none when no input falls in its
-// window (the regressors h reads would be missing).
-std::optional<Measurement> velocityMeasurement(const GnssFix& f, const VelocityFixes& v, const Model& model,
-                                               const std::vector<Input>& inputs) {
+Eigen::Vector3d velocityNed(const GnssFix& f) { return Eigen::Vector3d(1, 1, -1).cwiseProduct(*f.vel_neu); }
+
+// The used fixes' velocities as measurements, in time order. A fix without
+// an input in its window, or without a used neighbour within 1 s, has none
+// (the known values h reads would be missing).
+std::vector<Measurement> velocityMeasurements(const std::vector<const GnssFix*>& fixes, const VelocityFixes& v,
+                                              const Model& model, const std::vector<Input>& inputs) {
   const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
-  const int k = model.channel(v.channel).regressors;
-  Eigen::VectorXd mean = Eigen::VectorXd::Zero(k);
-  int n = 0;
-  auto it = std::lower_bound(inputs.begin(), inputs.end(), f.t - v.window / 2,
-                             [](const Input& u, double t) { return u.t < t; });
-  for (; k > 0 && it != inputs.end() && it->t <= f.t + v.window / 2; ++it, ++n) mean += it->u.head(k);
-  if (k > 0 && n == 0) return std::nullopt;
-  if (n > 0) mean /= n;
-  Eigen::MatrixXd R;
-  if (f.vel_cov_neu.diagonal().maxCoeff() > 0) R = neu_to_ned * f.vel_cov_neu * neu_to_ned;
-  return Measurement(f.t, neu_to_ned * *f.vel_neu, v.channel, R, mean);
+  const int k = model.channel(v.channel).regressors - 3;
+  std::vector<Measurement> out;
+  for (std::size_t i = 0; i < fixes.size(); ++i) {
+    const GnssFix& f = *fixes[i];
+    const GnssFix& a = *fixes[i > 0 && f.t - fixes[i - 1]->t <= 1.0 ? i - 1 : i];
+    const GnssFix& b = *fixes[i + 1 < fixes.size() && fixes[i + 1]->t - f.t <= 1.0 ? i + 1 : i];
+    if (&a == &b) continue;
+    Eigen::VectorXd known(k + 3);
+    known.tail<3>() = (velocityNed(b) - velocityNed(a)) / (b.t - a.t);
+    Eigen::VectorXd mean = Eigen::VectorXd::Zero(k);
+    int n = 0;
+    auto it = std::lower_bound(inputs.begin(), inputs.end(), f.t - v.window / 2,
+                               [](const Input& u, double t) { return u.t < t; });
+    for (; k > 0 && it != inputs.end() && it->t <= f.t + v.window / 2; ++it, ++n) mean += it->u.head(k);
+    if (k > 0 && n == 0) continue;
+    known.head(k) = mean / std::max(n, 1);
+    Eigen::MatrixXd R;
+    if (f.vel_cov_neu.diagonal().maxCoeff() > 0) R = neu_to_ned * f.vel_cov_neu * neu_to_ned;
+    out.emplace_back(f.t, velocityNed(f), v.channel, R, known);
+  }
+  return out;
 }
 
 StillFixes stillFixes(const IniDocument& ini, const Model& model, const GnssSolution& sol) {
@@ -132,6 +160,7 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
   const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
   const double deg = M_PI / 180;
   std::vector<Measurement> used;
+  std::vector<const GnssFix*> moving;  // the used fixes with a velocity, for gnss_velocity_channel
   double previous = out.t0;
   for (const GnssFix& f : sol.fixes) {
     if (!(f.t > out.t0)) {  // before the first IMU row, or the start the INI sets
@@ -151,19 +180,15 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
     }
     if (f.quality != 1) m.R *= float_scale * float_scale;
     used.push_back(std::move(m));
-    if (velocity.channel >= 0 && f.vel_neu)
-      if (auto v = velocityMeasurement(f, velocity, model, out.inputs)) used.push_back(std::move(*v));
+    if (velocity.channel >= 0 && f.vel_neu) moving.push_back(&f);
     if (still.channel >= 0 && f.vel_neu->norm() < still.speed) {  // standing: its zero-velocity measurement too
       used.emplace_back(f.t, Eigen::VectorXd::Zero(model.channel(still.channel).dim()), still.channel);
       if (still.rates_channel >= 0) addMeanInput(out.inputs, model, still.rates_channel, previous, f.t, used);
     }
     previous = f.t;
   }
-  std::vector<Measurement> merged;
-  merged.reserve(out.measurements.size() + used.size());
-  std::merge(out.measurements.begin(), out.measurements.end(), used.begin(), used.end(), std::back_inserter(merged),
-             [](const Measurement& a, const Measurement& b) { return a.t < b.t; });
-  out.measurements = std::move(merged);
+  if (velocity.channel >= 0) mergeInTime(used, velocityMeasurements(moving, velocity, model, out.inputs));
+  mergeInTime(out.measurements, std::move(used));
 }
 
 }  // namespace gssm::io

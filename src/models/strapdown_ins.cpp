@@ -107,12 +107,13 @@ MeasurementChannel channelOf(const std::string& name, std::vector<std::string> c
   return c;
 }
 
-// The antenna's velocity: it reads the IMU's mean reading at the fix (6
-// regressors) and every constant but the mounting.
+// The antenna's velocity: it reads the IMU's mean rates and the velocity's
+// rate of change at the fix (6 regressors), and the gyro's constants, the
+// lever arm and the clock's.
 MeasurementChannel gnssVelocityChannel(const StrapdownIns::Params& p) {
   using S = StrapdownIns;
   MeasurementChannel c = channelOf("gnss_vel", {"gnss_vn", "gnss_ve", "gnss_vd"}, Eigen::Vector3d::Constant(p.gnss_vel_sd),
-                                   {0, 1, 2, 3, 4, 5, 6, 7, 8, S::kDelay, 13, 14, 15, 16, 17, 18, S::kClockRate});
+                                   {0, 1, 2, 6, 7, 8, S::kDelay, 13, 14, 15, S::kClockRate});
   c.regressors = 6;
   c.own_R_scale = p.gnss_vel_sd_scale * p.gnss_vel_sd_scale;
   return c;
@@ -317,44 +318,37 @@ Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen
 }
 
 // The antenna's velocity at the GNSS time of the fix, given the IMU's mean
-// reading [ω̃, f̃] there (the regressors): with ω = (1 − s_g)∘ω̃ − b_g and
-// f = (1 − s_a)∘f̃ − b_a (as f takes a reading), the antenna turns about the
-// IMU at R·(ω×ℓ), and the state at IMU time t is the true time t + δ, so
-// y = v + R·(ω×ℓ) − δ·a, a = R·f + g(p) (Coriolis, ~1e-3 m/s², left out;
-// a velocity that lags its fix by τ = gnss_vel_latency: δ + τ for δ):
-// ∂y/∂δθ = −R·[ω×ℓ]× + δ·R·[f]×, ∂y/∂v = I, ∂y/∂p = −δ·∂g/∂p,
-// ∂y/∂c = −ρ·a, ∂y/∂b_g = R·[ℓ]×, ∂y/∂s_g = R·[ℓ]×·diag(ω̃),
-// ∂y/∂ℓ = R·[ω]×, ∂y/∂b_a = δ·R, ∂y/∂s_a = δ·R·diag(f̃), ∂y/∂d = −a,
-// ∂y/∂ρ = −c·a.
+// rates ω̃ there and the velocity's rate of change a (NED, from the fixes'
+// own velocities: data, so that the delay's term does not tie the attitude
+// to gravity through R·f + g): with ω = (1 − s_g)∘ω̃ − b_g the antenna turns
+// about the IMU at R·(ω×ℓ), and the state at IMU time t is the true time
+// t + δ, so y = v + R·(ω×ℓ) − δ·a (a velocity that lags its fix by
+// τ = gnss_vel_latency: δ + τ for δ). ∂y/∂δθ = −R·[ω×ℓ]×, ∂y/∂v = I,
+// ∂y/∂c = −ρ·a, ∂y/∂b_g = R·[ℓ]×, ∂y/∂s_g = R·[ℓ]×·diag(ω̃), ∂y/∂ℓ = R·[ω]×,
+// ∂y/∂d = −a, ∂y/∂ρ = −c·a.
 void StrapdownIns::hRegressedInto(int channel, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc,
                                   const Eigen::VectorXd& xb, Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc,
                                   Eigen::MatrixXd* J_h_xb) const {
   if (channel != kGnssVelocity) return Model::hRegressedInto(channel, regressors, xc, xb, out, J_h_xc, J_h_xb);
-  const Eigen::Vector3d gyro = regressors.head<3>(), accel = regressors.tail<3>();
+  const Eigen::Vector3d gyro = regressors.head<3>(), a = regressors.tail<3>();
   const Eigen::Vector3d w = gyro - xb.segment<3>(kGyroScale).cwiseProduct(gyro) - gyroBias(xc, xb);
-  const Eigen::Vector3d f = accel - xb.segment<3>(kAccelScale).cwiseProduct(accel) - xb.segment<3>(kAccelBias);
   const Eigen::Matrix3d R = so3::Exp(xc.head<3>());
   const Eigen::Vector3d lever = xb.segment<3>(kLever), turn = w.cross(lever);
-  Eigen::Matrix3d J_g_p;
-  const Eigen::Vector3d a = R * f + frame_.gravity(xc.segment<3>(6), J_h_xc ? &J_g_p : nullptr);
   const double delay = xb[kDelay] + xb[kClockRate] * xc[kClock] + p_.gnss_vel_latency;
   out = xc.segment<3>(3) + R * turn - delay * a;
   if (J_h_xc) {
     J_h_xc->setZero(3, dims().nc);
-    J_h_xc->leftCols<3>() = -R * hat(turn) + delay * R * hat(f);
+    J_h_xc->leftCols<3>() = -R * hat(turn);
     J_h_xc->middleCols<3>(3).setIdentity();
-    J_h_xc->middleCols<3>(6) = -delay * J_g_p;
     J_h_xc->col(kClock) = -xb[kClockRate] * a;
     if (gyroBiasWalks()) J_h_xc->middleCols<3>(kGyroWalk) = R * hat(lever);
   }
   if (J_h_xb) {
     J_h_xb->setZero(3, kConstants);
     J_h_xb->middleCols<3>(kGyroBias) = R * hat(lever);
-    J_h_xb->middleCols<3>(kAccelBias) = delay * R;
     J_h_xb->middleCols<3>(kLever) = R * hat(w);
     J_h_xb->col(kDelay) = -a;
     J_h_xb->middleCols<3>(kGyroScale) = R * hat(lever) * gyro.asDiagonal();
-    J_h_xb->middleCols<3>(kAccelScale) = delay * R * accel.asDiagonal();
     J_h_xb->col(kClockRate) = -xc[kClock] * a;
   }
 }

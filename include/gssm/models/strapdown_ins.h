@@ -32,8 +32,9 @@
 // (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z),
 // `zupt` (the velocity, zero while standing), `zaru` (the gyro's mean
 // reading while standing: b_g + R_nbᵀ·ω_ie), `gnss_vel` (the antenna's NED
-// velocity at the fix's time, v + R_nb·(ω×ℓ) − δ·(R_nb·f + g): it reads the
-// IMU's mean reading [ω̃, f̃] at the fix, Measurement::regressors). R_vb
+// velocity at the fix's time, v + R_nb·(ω×ℓ) − δ·a: it reads the IMU's mean
+// rates ω̃ and the velocity's rate of change a (NED) at the fix,
+// Measurement::regressors). R_vb
 // maps the IMU's axes to the vehicle's (forward, right, down); R_vb0 is its
 // nominal value.
 #include <Eigen/Core>
@@ -106,7 +107,8 @@ class StrapdownIns final : public Model {
                     Eigen::MatrixXd* J_h_xb = nullptr) const override;
   Eigen::VectorXd h(int channel, const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
                     Eigen::MatrixXd* J_h_xc = nullptr, Eigen::MatrixXd* J_h_xb = nullptr) const override;
-  /// The `gnss_vel` channel: h given the IMU's mean reading [ω̃, f̃] at the fix.
+  /// The `gnss_vel` channel: h given [ω̃, a] at the fix (the IMU's mean
+  /// rates, the velocity's rate of change in NED).
   void hRegressedInto(int channel, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc,
                       const Eigen::VectorXd& xb, Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc,
                       Eigen::MatrixXd* J_h_xb) const override;
