@@ -14,6 +14,7 @@
 #include "gssm/core/rotation_blocks.h"
 #include "gssm/core/so3.h"
 #include "gssm/core/time.h"
+#include "gssm/estimator/estimator.h"
 #include "gssm/factors/factors.h"
 #include "gssm/factors/problem.h"
 #include "gssm/io/config.h"
@@ -310,6 +311,23 @@ TEST(StrapdownIns, GnssVelocityMeasurementsCarryTheirKnownValuesEverywhere) {
   EXPECT_EQ(r, r_back);
   const Eigen::Vector3d expected = R.diagonal().cwiseSqrt().cwiseInverse().asDiagonal() * (model.hWith(vel, known, xc, xb) - y);
   EXPECT_LT((r - expected).norm(), 1e-12);
+
+  // Every streaming method (the NIS too) refuses a velocity fix without its
+  // known values, naming them, and takes the next one that has them.
+  for (Method method : {Method::Ekf, Method::FixedLag, Method::Incremental}) {
+    EstimatorOptions o;
+    o.method = method;
+    o.compute_nis = true;
+    auto est = makeEstimator(model, o);
+    Eigen::VectorXd still(6);
+    still << 0, 0, 0, 0, 0, -9.797;
+    est->addInput(0.0, still);
+    testing::expectThrowsNaming<InvalidArgument>([&] { est->addMeasurement(Measurement(0.05, y, vel, R)); },
+                                                 "known values (regressors) of the measurement on channel 'gnss_vel'");
+    est->addMeasurement(Measurement(0.05, y, vel, R, known));
+    EXPECT_TRUE(est->current().mean.allFinite()) << methodName(method);
+    EXPECT_EQ(est->report().measurements, 1) << methodName(method);
+  }
 }
 
 // [prior] heading_sd adds variance to the start attitude along a turn about
