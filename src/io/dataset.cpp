@@ -69,7 +69,7 @@ std::vector<IniKey> datasetIniKeys() {
       {"gnss_still_channel", "word", "", "a zero-velocity measurement on this channel at every fix slower than gnss_still_speed"},
       {"gnss_still_speed", "number", "0.05", "a fix's own speed (m/s) below which the vehicle is standing"},
       {"gnss_still_rates", "word", "", "while standing, the mean of the inputs' first components since the previous fix on this channel"},
-      {"gnss_velocity_channel", "word", "", "each used fix's own velocity on this channel, with the inputs' mean reading around it"},
+      {"gnss_velocity_channel", "word", "", "each used fix's own velocity on this channel, with the inputs' mean reading around it and the velocity's rate of change"},
       {"gnss_velocity_window", "number", "0.1", "the span (s) around a velocity fix over which the inputs are averaged"},
       {"zero_channels", "words", "", "channels measured as zero at zero_rate (vehicle constraints)"},
       {"zero_rate", "number", "0", "rate (Hz) of the zero_channels' pseudo-measurements"}};

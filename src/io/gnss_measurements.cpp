@@ -53,15 +53,25 @@ struct StillFixes {
   int rates_channel = -1;  // gnss_still_rates: none
 };
 
+Eigen::Matrix3d neuToNed() { return Eigen::Vector3d(1, 1, -1).asDiagonal(); }
+
+// The sum of the inputs' first k components from `first` up to time `to`
+// (inclusive), and how many inputs it holds.
+int sumInputs(std::vector<Input>::const_iterator first, const std::vector<Input>& inputs, double to, int k,
+              Eigen::VectorXd& sum) {
+  sum.setZero(k);
+  int n = 0;
+  for (; first != inputs.end() && first->t <= to; ++first, ++n) sum += first->u.head(k);
+  return n;
+}
+
 // The mean of the inputs' first dim(channel) components over (from, to]
 // (the gyro's reading while the car stands still), as a measurement at `to`.
 void addMeanInput(const std::vector<Input>& inputs, const Model& model, int channel, double from, double to,
                   std::vector<Measurement>& out) {
-  const int dim = model.channel(channel).dim();
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(dim);
-  int n = 0;
+  Eigen::VectorXd sum;
   auto it = std::upper_bound(inputs.begin(), inputs.end(), from, [](double t, const Input& u) { return t < u.t; });
-  for (; it != inputs.end() && it->t <= to; ++it, ++n) sum += it->u.head(dim);
+  const int n = sumInputs(it, inputs, to, model.channel(channel).dim(), sum);
   if (n > 0) out.emplace_back(to, sum / n, channel);
 }
 
@@ -93,14 +103,14 @@ VelocityFixes velocityFixes(const IniDocument& ini, const Model& model, const Gn
   return v;
 }
 
-Eigen::Vector3d velocityNed(const GnssFix& f) { return Eigen::Vector3d(1, 1, -1).cwiseProduct(*f.vel_neu); }
+Eigen::Vector3d velocityNed(const GnssFix& f) { return neuToNed() * *f.vel_neu; }
 
 // The used fixes' velocities as measurements, in time order. A fix without
 // an input in its window, or without a used neighbour within 1 s, has none
 // (the known values h reads would be missing).
 std::vector<Measurement> velocityMeasurements(const std::vector<const GnssFix*>& fixes, const VelocityFixes& v,
                                               const Model& model, const std::vector<Input>& inputs) {
-  const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
+  const Eigen::Matrix3d neu_to_ned = neuToNed();
   const int k = model.channel(v.channel).regressors - 3;
   std::vector<Measurement> out;
   for (std::size_t i = 0; i < fixes.size(); ++i) {
@@ -110,13 +120,12 @@ std::vector<Measurement> velocityMeasurements(const std::vector<const GnssFix*>&
     if (&a == &b) continue;
     Eigen::VectorXd known(k + 3);
     known.tail<3>() = (velocityNed(b) - velocityNed(a)) / (b.t - a.t);
-    Eigen::VectorXd mean = Eigen::VectorXd::Zero(k);
-    int n = 0;
+    Eigen::VectorXd sum;
     auto it = std::lower_bound(inputs.begin(), inputs.end(), f.t - v.window / 2,
                                [](const Input& u, double t) { return u.t < t; });
-    for (; k > 0 && it != inputs.end() && it->t <= f.t + v.window / 2; ++it, ++n) mean += it->u.head(k);
+    const int n = sumInputs(it, inputs, f.t + v.window / 2, k, sum);
     if (k > 0 && n == 0) continue;
-    known.head(k) = mean / std::max(n, 1);
+    known.head(k) = sum / std::max(n, 1);
     Eigen::MatrixXd R;
     if (f.vel_cov_neu.diagonal().maxCoeff() > 0) R = neu_to_ned * f.vel_cov_neu * neu_to_ned;
     out.emplace_back(f.t, velocityNed(f), v.channel, R, known);
@@ -157,7 +166,7 @@ void readGnssMeasurements(const std::string& path, const std::string& outages_pa
   const GnssSolution sol = readRtklibPos(path);
   const StillFixes still = stillFixes(ini, model, sol);
   const VelocityFixes velocity = velocityFixes(ini, model, sol);
-  const Eigen::Matrix3d neu_to_ned = Eigen::Vector3d(1, 1, -1).asDiagonal();
+  const Eigen::Matrix3d neu_to_ned = neuToNed();
   const double deg = M_PI / 180;
   std::vector<Measurement> used;
   std::vector<const GnssFix*> moving;  // the used fixes with a velocity, for gnss_velocity_channel

@@ -258,7 +258,6 @@ JacobianCheck checkJacobians(const Model& model, const Eigen::VectorXd& xc,
   model.f(xc, xb, u, dt, &J_f_xc, &J_f_xb);
   compare(J_f_xc, differences([&](const Eigen::VectorXd& v) { return model.f(v, xb, u, dt); }, xc, nc, 0, true), "J_f_xc", out);
   compare(J_f_xb, differences([&](const Eigen::VectorXd& v) { return model.f(xc, v, u, dt); }, xb, nc, nc, true), "J_f_xb", out);
-  // Every channel's h (channel 0 is the default h).
   // Every channel's h (channel 0 is the default h); a channel that reads
   // known values gets a fixed made-up set of them.
   for (int c = 0; c < model.numChannels(); ++c) {

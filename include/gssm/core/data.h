@@ -13,7 +13,7 @@ struct Measurement {
   int channel = 0;    ///< the model's measurement channel (0: the default)
   Eigen::MatrixXd R;  ///< this measurement's own noise covariance; empty: the channel's
   /// Known values h reads beside the state, as many as the channel's
-  /// MeasurementChannel::regressors (empty on most channels): e.g. the IMU's
+  /// MeasurementChannel::regressors (empty on most channels): e.g. the gyro's
   /// reading at a GNSS velocity fix, with which the lever arm turns.
   Eigen::VectorXd regressors;
 

@@ -45,7 +45,8 @@ struct MeasurementChannel {
   double own_R_scale = 1;
   /// How many known values a measurement on this channel carries beside y
   /// (Measurement::regressors), which h reads: 0 on most channels; h of such
-  /// a channel is Model::hWith (a GNSS velocity: the IMU's mean reading).
+  /// a channel is Model::hWith (a GNSS velocity: the gyro's mean reading
+  /// and the velocity's rate of change).
   int regressors = 0;
   int dim() const { return static_cast<int>(components.size()); }
   /// The noise covariance of a measurement on this channel that brings
