@@ -437,5 +437,53 @@ TEST(Scoring, ReachesAClosedFormMaximumAndStopsWherePassesFail) {
   }
 }
 
+// With passes two at a time, on three parameters each line-search trial
+// runs beside a slope pass at its point and the start beside its slope's:
+// a taken step costs two rounds (trial + 3 slope passes), not three (the
+// trial alone, then the slope's); on two, the trials go two at a time and
+// the slope's passes fill a round. Either way along the serial path.
+TEST(Scoring, RunsTheNextSlopesPassesBesideEachTrialAlongTheSerialPath) {
+  const Eigen::MatrixXd y_all =
+      (Eigen::MatrixXd(4, 3) << 0.9, -1, 2, 1.3, -2, 2.5, 0.7, -1.5, 1, 1.1, -0.5, 3).finished();
+  for (const Eigen::Index p : {2, 3}) {
+    const Eigen::MatrixXd y = y_all.leftCols(p);
+    const Eigen::ArrayXd weight = Eigen::Vector3d(1, 4, 0.25).head(p).array();
+    int rounds = 0;  // wall-clock rounds of passes two at a time
+    const internal::LikelihoodTermsAt at = [&](const std::vector<Eigen::VectorXd>& thetas) {
+      rounds += static_cast<int>((thetas.size() + 1) / 2);
+      std::vector<internal::LikelihoodTerms> out;
+      for (const auto& th : thetas) {
+        internal::LikelihoodTerms t;
+        t.terms = -0.5 * ((y.rowwise() - th.transpose()).array().square().rowwise() * weight.transpose())
+                             .rowwise()
+                             .sum()
+                             .matrix();
+        t.total = t.terms.sum();
+        out.push_back(t);
+      }
+      return out;
+    };
+    internal::ScoringOptions o;
+    o.lo = Eigen::VectorXd::Constant(p, -10), o.hi = Eigen::VectorXd::Constant(p, 10);
+    o.tolerance = 1e-12;
+    const auto serial = internal::maximizeByScoring(at, Eigen::VectorXd::Zero(p), o);
+    internal::ScoringOptions two = o;
+    two.parallel_passes = 2;
+    rounds = 0;
+    const auto batched = internal::maximizeByScoring(at, Eigen::VectorXd::Zero(p), two);
+    ASSERT_TRUE(serial.converged) << p;
+    EXPECT_EQ(batched.x, serial.x) << p;
+    EXPECT_EQ(batched.value, serial.value) << p;
+    EXPECT_EQ(batched.iterations, serial.iterations) << p;
+    EXPECT_TRUE(batched.converged) << p;
+    // the top: each column's mean (less half a forward step)
+    EXPECT_LT((serial.x - y.colwise().mean().transpose()).cwiseAbs().maxCoeff(), 1e-4) << p;
+    // Serially p + 1 passes a taken step; two at a time a round per two
+    // (the trial alone, then the slope's: 3 rounds of 4 passes on three).
+    EXPECT_LE(2 * rounds, serial.evaluations + 2 * (batched.evaluations - serial.evaluations)) << p;
+    EXPECT_LT(4 * rounds, 3 * serial.evaluations) << rounds << " rounds, " << serial.evaluations << " serial passes";
+  }
+}
+
 }  // namespace
 }  // namespace gssm

@@ -35,9 +35,10 @@ struct ScoringOptions {
   /// step/2 of the true one: 5e-6 in log σ, far inside any standard error.
   double step = 1e-5;
   double max_step = 2;  ///< largest move of one θ per iteration (a factor e² in σ)
-  /// How many passes `at` runs at once: the line search's trial steps go
-  /// that many at a time (the same step taken as one at a time, in fewer
-  /// rounds where the first is refused; the trials after it are extra).
+  /// How many passes `at` runs at once: each line-search trial goes with
+  /// that many less one of the slope's passes at the trial point, and the
+  /// start with its slope's (the same path as one pass at a time, in fewer
+  /// rounds where the trial is taken; where it is refused they are extra).
   int parallel_passes = 1;
 };
 
