@@ -16,6 +16,8 @@
 
 #include "gssm/analysis/metrics.h"
 #include "gssm/estimator/estimator.h"
+#include "gssm/factors/problem.h"
+#include "gssm/solvers/ekf.h"
 #include "gssm/io/config.h"
 #include "gssm/io/dataset.h"
 #include "gssm/model/packed_inputs.h"
@@ -87,6 +89,22 @@ void streamDrive(benchmark::State& state, gssm::Method method, bool packed) {
   state.counters["epochs"] = static_cast<double>(epochs.size());
 }
 
+// One filter pass over the whole drive as noise learning runs it (the
+// offline loop over a step schedule, the fixes' likelihood terms kept):
+// learning is tens of these.
+void BM_InsLearningPass(benchmark::State& state) {
+  const Drive& d = drive(true);
+  const auto schedule = gssm::stepSchedule(d.data.measurements, d.data.inputs, d.data.t0);
+  gssm::ExtendedKalmanFilterOptions e = d.options.ekf;
+  e.keep_log_likelihood_terms = true;
+  for (auto _ : state) {
+    gssm::ExtendedKalmanFilter filter(*d.model, e, d.data.t0);
+    gssm::filterAlong(filter, schedule, d.data.measurements, d.data.inputs);
+    benchmark::DoNotOptimize(filter.logLikelihood());
+  }
+  state.counters["steps"] = static_cast<double>(schedule.size());
+}
+
 void BM_InsEkf(benchmark::State& s) { streamDrive(s, gssm::Method::Ekf, s.range(0) != 0); }
 void BM_InsFixedLag(benchmark::State& s) { streamDrive(s, gssm::Method::FixedLag, s.range(0) != 0); }
 void BM_InsIncremental(benchmark::State& s) { streamDrive(s, gssm::Method::Incremental, s.range(0) != 0); }
@@ -94,6 +112,7 @@ void BM_InsIncremental(benchmark::State& s) { streamDrive(s, gssm::Method::Incre
 }  // namespace
 
 // Argument: 0 a state per IMU sample, 1 the scenario's packed steps.
+BENCHMARK(BM_InsLearningPass)->Unit(benchmark::kMillisecond)->Iterations(10);
 BENCHMARK(BM_InsEkf)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_InsFixedLag)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_InsIncremental)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
