@@ -19,13 +19,19 @@ so3::Vector3 NavFrame::gravity(const so3::Vector3& p, so3::Matrix3* J_g_p) const
 
 NavState step(const NavState& x, const so3::Vector3& gyro, const so3::Vector3& accel, const so3::Vector3& bg,
               const so3::Vector3& ba, double dt, const NavFrame& frame, StepJacobians* J) {
+  return step(x, gyro, accel, bg, ba, dt, frame, LocalGravity(frame, x.p), J);
+}
+
+NavState step(const NavState& x, const so3::Vector3& gyro, const so3::Vector3& accel, const so3::Vector3& bg,
+              const so3::Vector3& ba, double dt, const NavFrame& frame, const LocalGravity& gravity,
+              StepJacobians* J) {
   using so3::Matrix3;
   const so3::Vector3& w_ie = frame.earthRate();
   const so3::Vector3 a_body = accel - ba;
   Matrix3 Jr_w;
   const Matrix3 dR = so3::Exp((gyro - bg) * dt, J ? &Jr_w : nullptr);
-  Matrix3 a_p;  // ∂g/∂p
-  const so3::Vector3 a = x.R * a_body + frame.gravity(x.p, J ? &a_p : nullptr) - 2 * w_ie.cross(x.v);
+  const Matrix3& a_p = gravity.J_g_p;  // ∂g/∂p
+  const so3::Vector3 a = x.R * a_body + gravity.at(x.p) - 2 * w_ie.cross(x.v);
   NavState n;
   n.R = so3::Exp(-w_ie * dt) * x.R * dR;
   n.v = x.v + a * dt;

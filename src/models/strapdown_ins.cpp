@@ -168,9 +168,10 @@ Eigen::VectorXd StrapdownIns::f(const Eigen::VectorXd& xc, const Eigen::VectorXd
   strapdown::StepJacobians J;
   const Eigen::Vector3d sg = xb.segment<3>(kGyroScale), sa = xb.segment<3>(kAccelScale);
   const Eigen::Vector3d bg = gyroBias(xc, xb), ba = xb.segment<3>(kAccelBias);
+  const strapdown::LocalGravity gravity(frame_, x.p);  // one geodetic evaluation a pack
   forEachPackedReading(u, p_.imu_per_state, dt, [&](const auto& reading, double h) {
     const Eigen::Vector3d gyro = reading.template head<3>(), accel = reading.template tail<3>();
-    x = strapdown::step(x, gyro - sg.cwiseProduct(gyro), accel - sa.cwiseProduct(accel), bg, ba, h, frame_,
+    x = strapdown::step(x, gyro - sg.cwiseProduct(gyro), accel - sa.cwiseProduct(accel), bg, ba, h, frame_, gravity,
                         jac ? &J : nullptr);
     if (!jac) return;
     jb << J.J_next_bg, J.J_next_ba, J.J_next_bg * gyro.asDiagonal(), J.J_next_ba * accel.asDiagonal();
