@@ -118,7 +118,11 @@ TEST(PackedInputs, InsOverAPackIsItsOneReadingStepsInTurn) {
         left -= h;
       }
       const Eigen::VectorXd y = packed.f(xc, xb, u, dt);
-      EXPECT_LT((y - x).cwiseAbs().maxCoeff(), 1e-12) << "trial " << trial << " dt " << dt;
+      // The pack takes gravity from its start point and the field's slope
+      // (strapdown::LocalGravity), the steps from each reading's point: a
+      // few 1e-8 m/s² over the metre moved, ~1e-9 m/s in velocity. A
+      // reading skipped or cut wrong moves it by 1e-3 and more.
+      EXPECT_LT((y - x).cwiseAbs().maxCoeff(), 1e-8) << "trial " << trial << " dt " << dt;
     }
   }
 }
