@@ -123,6 +123,9 @@ class ExtendedKalmanFilter {
   std::vector<double> log_likelihood_terms_;
   std::vector<char> counted_;  // per channel, from likelihood_channels (empty: all)
   std::int64_t rejected_ = 0;
+  /// Whether P_ is exactly symmetric: every update leaves it so, the prior
+  /// and a loaded P need not be (the next prediction symmetrizes all of it).
+  bool symmetric_ = false;
   UpdateBuffers u_;
   PredictBuffers p_;
 };
