@@ -131,7 +131,7 @@ bool searchAlong(const LikelihoodTermsAt& at, const Eigen::VectorXd& x, const Ei
                  bool central, const ScoringOptions& o, int& evaluations) {
   const auto P = static_cast<std::size_t>(std::max(o.parallel_passes, 1));
   const std::size_t s = static_cast<std::size_t>(x.size()) * (central ? 2 : 1);
-  const auto early = static_cast<std::ptrdiff_t>(s % P == 0 ? 0 : std::min(s % P, P - 1));
+  const auto early = static_cast<std::ptrdiff_t>(s % P);
   double alpha = 1;
   while (alpha > 1e-3 && evaluations < o.max_evaluations) {
     std::vector<Eigen::VectorXd> trials;
