@@ -97,7 +97,10 @@ std::vector<IniKey> datasetIniKeys();
 ///       gyro's reading while standing)
 ///     zero_channels = NAMES, zero_rate = HZ: a zero measurement on each of
 ///       those channels every 1/rate s after t0 (a vehicle's non-holonomic
-///       constraint stated as a channel of the model)
+///       constraint stated as a channel of the model); zero_at_inputs =
+///       true: each at the input reading nearest its time, or at a
+///       measurement within half a reading's interval of that reading (no
+///       state of its own between readings: docs/DESIGN.md §12)
 void readDatasetData(const std::string& dir, const Model& model, Dataset& out,
                      BadRows bad_rows = BadRows::Throw, const IniDocument* config = nullptr);
 
