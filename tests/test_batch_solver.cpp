@@ -325,6 +325,48 @@ TEST(BatchSolver, ALastUndampedStepWithoutRelinearizationKeepsTheFactorizationIt
   }
 }
 
+// A variable that does not factor beside a far stiffer one eliminated
+// before it: the message names both, for rounding may be what lost it.
+// Here x2 and x3 are held only in their difference (truly singular at x3,
+// its JᵀJ diagonal 1), and x0 has 1e10.
+TEST(BatchSolver, SingularBesideAStiffVariableNamesTheStiffOne) {
+  Values x;
+  for (int k = 0; k < 4; ++k) x.insert(Key::state(k), Eigen::VectorXd::Zero(1));
+  const auto linear = [&x](std::vector<Key> keys, std::vector<Eigen::MatrixXd> J) {
+    return std::make_shared<LinearGaussianFactor>(keys, J, Eigen::VectorXd::Zero(1), x);
+  };
+  const Eigen::MatrixXd one = Eigen::MatrixXd::Ones(1, 1);
+  FactorGraph g;
+  g.add(linear({Key::state(0)}, {1e5 * one}));
+  g.add(linear({Key::state(0), Key::state(1)}, {one, -one}));
+  g.add(linear({Key::state(2), Key::state(3)}, {one, -one}));
+  BatchSolverOptions o;
+  o.method = BatchSolverOptions::Method::GaussNewton;
+  try {
+    BatchSolver(o).solve(g, x);
+    FAIL() << "x2 + x3 is free: the system must not factor";
+  } catch (const NumericalError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("x_c(3) component 0"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("x_c(0) component 0, eliminated before it, has 1e+10"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("rounding"), std::string::npos) << msg;
+  }
+  // Without the stiff one, the plain explanation.
+  FactorGraph soft;
+  soft.add(linear({Key::state(0)}, {one}));
+  soft.add(g[1]);
+  soft.add(g[2]);
+  try {
+    BatchSolver(o).solve(soft, x);
+    FAIL() << "x2 + x3 is free: the system must not factor";
+  } catch (const NumericalError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("x_c(3) component 0"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("rounding"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("do not determine it"), std::string::npos) << msg;
+  }
+}
+
 TEST(BatchSolver, SingularSystemNamesTheVariableAndLeavesValuesUnchanged) {
   // A linear model where constant b2 enters nothing and has no prior
   // information beyond... we remove its prior by building the graph by hand.
@@ -354,6 +396,7 @@ TEST(BatchSolver, SingularSystemNamesTheVariableAndLeavesValuesUnchanged) {
     EXPECT_NE(msg.find("x_b"), std::string::npos) << msg;
     EXPECT_NE(msg.find("constant"), std::string::npos) << msg;
     EXPECT_NE(msg.find("component 1"), std::string::npos) << msg;  // b2, the one nothing determines
+    EXPECT_NE(msg.find("nothing measures it"), std::string::npos) << msg;  // its column of J is zero
   }
   for (const auto& kv : x0) EXPECT_EQ(x.at(kv.first), kv.second);
   // Levenberg–Marquardt: damping lets it iterate (the iterate lives in the

@@ -543,16 +543,41 @@ struct BatchSolver::Impl {
     throw NumericalError(os.str());
   }
 
-  [[noreturn]] void throwSingular(Eigen::Index column) const {
-    // The variable holding this column: the last offset at or before it.
+  // A weakly held variable's pivot can be ~1e-8 of its JᵀJ diagonal (the
+  // GNSS/INS drive's last state inside an outage: ~1 against 4e7); where a
+  // column eliminated before it is this much stiffer, that column's
+  // rounding (2.2e-16 of it) is the pivot's size, and a determined variable
+  // can fail to factor.
+  static constexpr double kStiffRatio = 1e8;
+  // The variable holding a column of H: the last offset at or before it.
+  std::pair<Key, Eigen::Index> variableAt(Eigen::Index column) const {
     const std::size_t v = static_cast<std::size_t>(std::upper_bound(offset.begin(), offset.end(), column) - offset.begin()) - 1;
-    const Key k = layout[v];
+    return {layout[v], column - offset[v]};
+  }
+  // Names the variable at `column` of H and why it may not factor, from
+  // JᵀJ's diagonal (`diagonal`, undamped): its own, and the nearest column
+  // eliminated before it that is kStiffRatio times stiffer.
+  [[noreturn]] void throwSingular(Eigen::Index column, const Eigen::VectorXd& diagonal) const {
+    const auto [k, component] = variableAt(column);
     std::ostringstream os;
-    os << "BatchSolver: the information matrix is not positive definite at variable "
-       << k.toString() << " component " << column - offset[v]
-       << (k.isConstants() ? " (a constant)" : " (a time-series state)")
-       << ": the data and priors do not determine it (unobserved, a zero Jacobian such as a "
-          "range at x = h = 0, or a non-finite value). Add a prior on it or check the model.";
+    os << "BatchSolver: the information matrix is not positive definite at variable " << k.toString()
+       << " component " << component << (k.isConstants() ? " (a constant)" : " (a time-series state)");
+    const double d = column < diagonal.size() ? diagonal[column] : NAN;
+    Eigen::Index stiff = std::min(column, diagonal.size()) - 1;  // the nearest such column before it
+    while (stiff >= 0 && !(diagonal[stiff] >= kStiffRatio * d)) --stiff;
+    if (d == 0) {
+      os << ": nothing measures it (its column of J is zero: unobserved, or a zero Jacobian such as a range at "
+            "x = h = 0). Add a prior on it or check the model.";
+    } else if (stiff >= 0) {
+      const auto [sk, sc] = variableAt(stiff);
+      os << ": the data and priors may not determine it (a combination of variables they cannot separate), or "
+            "rounding lost what does: its JᵀJ diagonal is " << d << ", and " << sk.toString() << " component "
+         << sc << ", eliminated before it, has " << diagonal[stiff] << " (states a fraction of a millisecond apart, or a "
+            "tiny σ). Add a prior on it, check the model, or space the states further apart.";
+    } else {
+      os << ": the data and priors do not determine it (unobserved, a combination of variables they cannot "
+            "separate, or a non-finite value). Add a prior on it or check the model.";
+    }
     throw NumericalError(os.str());
   }
 };
@@ -634,7 +659,7 @@ struct BatchSolver::Impl::Iteration {
       // Undamped (Gauss–Newton, or LM finishing after its tests passed) the
       // information matrix itself is singular: the final factorization would
       // fail the same way, and damping again only led back here, forever.
-      if (policy.undamped() || !policy.canDampMore()) s.throwSingular(bad);
+      if (policy.undamped() || !policy.canDampMore()) s.throwSingular(bad, diag);
       policy.singular();
       ++sum.rejected_steps;
       return true;
@@ -729,7 +754,7 @@ struct BatchSolver::Impl::Iteration {
     s.setDamping(diag, 0.0);
     ++sum.factorizations;
     const Eigen::Index bad = s.factorize();
-    if (bad >= 0) s.throwSingular(bad);
+    if (bad >= 0) s.throwSingular(bad, diag);
   }
 };
 
@@ -789,7 +814,7 @@ void BatchSolver::evaluateAt(const FactorGraph& graph, const Values& values) {
   const double cost = s.linearize(graph, values, g, diag);
   s.setDamping(diag, 0.0);
   const Eigen::Index bad = s.factorize();
-  if (bad >= 0) s.throwSingular(bad);
+  if (bad >= 0) s.throwSingular(bad, diag);
   s.has_solution = true;
   internal::flatten(values, s.factored_point);
   s.factored_gradient = std::move(g);
