@@ -342,29 +342,28 @@ TEST(BatchSolver, SingularBesideAStiffVariableNamesTheStiffOne) {
   g.add(linear({Key::state(2), Key::state(3)}, {one, -one}));
   BatchSolverOptions o;
   o.method = BatchSolverOptions::Method::GaussNewton;
-  try {
-    BatchSolver(o).solve(g, x);
-    FAIL() << "x2 + x3 is free: the system must not factor";
-  } catch (const NumericalError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("x_c(3) component 0"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("x_c(0) component 0, eliminated before it, has 1e+10"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("rounding"), std::string::npos) << msg;
-  }
+  const auto messageOf = [&](const FactorGraph& graph) {  // x2 + x3 is free: it must not factor
+    Values y = x;
+    try {
+      BatchSolver(o).solve(graph, y);
+    } catch (const NumericalError& e) {
+      return std::string(e.what());
+    }
+    return std::string("factored");
+  };
+  const std::string stiff = messageOf(g);
+  EXPECT_NE(stiff.find("x_c(3) component 0"), std::string::npos) << stiff;
+  EXPECT_NE(stiff.find("x_c(0) component 0, eliminated before it, has 1e+10"), std::string::npos) << stiff;
+  EXPECT_NE(stiff.find("rounding"), std::string::npos) << stiff;
   // Without the stiff one, the plain explanation.
   FactorGraph soft;
   soft.add(linear({Key::state(0)}, {one}));
   soft.add(g[1]);
   soft.add(g[2]);
-  try {
-    BatchSolver(o).solve(soft, x);
-    FAIL() << "x2 + x3 is free: the system must not factor";
-  } catch (const NumericalError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("x_c(3) component 0"), std::string::npos) << msg;
-    EXPECT_EQ(msg.find("rounding"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("do not determine it"), std::string::npos) << msg;
-  }
+  const std::string plain = messageOf(soft);
+  EXPECT_NE(plain.find("x_c(3) component 0"), std::string::npos) << plain;
+  EXPECT_EQ(plain.find("rounding"), std::string::npos) << plain;
+  EXPECT_NE(plain.find("do not determine it"), std::string::npos) << plain;
 }
 
 TEST(BatchSolver, SingularSystemNamesTheVariableAndLeavesValuesUnchanged) {
