@@ -13,6 +13,8 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "gssm/analysis/causal_map.h"
+#include "gssm/core/error.h"
 #include "gssm/io/config.h"
 #include "gssm/io/process.h"
 #include "plot_library.h"
@@ -78,6 +80,34 @@ gssm::io::ProcessCallbacks consoleCallbacks() {
   return cb;
 }
 
+// --causal-map: at each withheld measurement, the batch MAP of the data
+// at or before it (what an online smoother that relinearized everything
+// at every step would give), into OUTDIR/causal-map.csv and one line.
+void writeCausalMap(const gssm::io::ProcessResult& r, const gssm::io::ProcessOptions& o) {
+  if (r.dataset.withheld.empty()) throw gssm::InputError("--causal-map: the dataset withholds nothing to score");
+  gssm::EstimatorOptions options = gssm::io::estimatorOptions(r.config, *r.model);
+  options.t0 = r.dataset.t0;
+  const gssm::CausalMapErrors c =
+      gssm::causalMapErrors(*r.model, options, r.dataset.measurements, r.dataset.inputs, r.dataset.withheld,
+                            r.dataset.rows, static_cast<int>(o.threads));
+  const std::string path = (std::filesystem::path(o.out_dir) / "causal-map.csv").string();
+  std::ofstream csv(path);
+  csv << "t,horizontal_error";
+  const auto width = c.errors.empty() ? 0 : c.errors.front().error.size();
+  for (Eigen::Index i = 0; i < width; ++i) csv << ",error_" << i;
+  csv << "\n" << std::setprecision(17);
+  for (const auto& e : c.errors) {
+    csv << e.t << "," << e.error.head(std::min<Eigen::Index>(2, width)).norm();
+    for (Eigen::Index i = 0; i < width; ++i) csv << "," << e.error[i];
+    csv << "\n";
+  }
+  const gssm::PointErrors s = gssm::summarizePointErrors(c.errors);
+  std::cout << "causal MAP at " << s.count << " of " << r.dataset.withheld.size()
+            << " withheld measurements: horizontal RMS " << s.horizontal_rms << " m, max " << s.horizontal_max
+            << " m (" << path << ")\n";
+  for (const auto& [t, why] : c.failed) std::cout << "  not solved at t = " << std::setprecision(17) << t << ": " << why << "\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -99,6 +129,8 @@ int main(int argc, char** argv) {
     cli.flag("learn", "learn the noise from the log first ([learn] of the INI); writes OUTDIR/scenario.ini, learn.json");
     cli.flag("skip-bad-rows", "skip malformed measurement rows (listed in metrics.json) instead of stopping at the first");
     cli.option("threads", "N", "methods run at the same time (default: one per core; 1: one after another)");
+    cli.flag("causal-map", "also solve the batch of the data up to each withheld measurement (the exact causal MAP, "
+                           "an online method's optimum): OUTDIR/causal-map.csv; one solve each, slow");
     cli.parse(argc, argv);
     gssm::apps::PlotLibrary plot;  // loads while the dataset is read and run
     const gssm::io::ProcessOptions options = processOptions(cli);
@@ -109,6 +141,7 @@ int main(int argc, char** argv) {
     for (const auto& p : plot.functions().write_process_figures(r, options.out_dir, static_cast<int>(options.threads)))
       std::cout << "figure: " << p << "\n";
     std::cout << "gssm-process: wrote " << options.out_dir << "/metrics.json and estimates-*.csv\n";
+    if (cli.given("causal-map")) writeCausalMap(r, options);
     if (r.status.partial) {
       // Everything before the bad row was processed and written; say where it stopped.
       std::cerr << "gssm-process: error: " << r.status.stopped_at << " (processed the "

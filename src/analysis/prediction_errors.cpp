@@ -40,11 +40,10 @@ std::vector<PointError> predictionErrorSeries(const Model& model, const OfflineR
   return out;
 }
 
-PointErrors predictionErrors(const Model& model, const OfflineRun& run, const std::vector<Input>& inputs,
-                             const std::vector<Measurement>& at) {
+PointErrors summarizePointErrors(const std::vector<PointError>& errors) {
   PointErrors e;
   double sum_h = 0, sum = 0, max_h = 0, max = 0;
-  for (const PointError& p : predictionErrorSeries(model, run, inputs, at)) {
+  for (const PointError& p : errors) {
     const Eigen::VectorXd& d = p.error;
     const double h = d.head(std::min<Eigen::Index>(2, d.size())).norm(), n = d.norm();
     sum_h += h * h, sum += n * n, max_h = std::max(max_h, h), max = std::max(max, n);
@@ -55,6 +54,11 @@ PointErrors predictionErrors(const Model& model, const OfflineRun& run, const st
   e.horizontal_rms = std::sqrt(sum_h / count), e.horizontal_max = max_h;
   e.rms = std::sqrt(sum / count), e.max = max;
   return e;
+}
+
+PointErrors predictionErrors(const Model& model, const OfflineRun& run, const std::vector<Input>& inputs,
+                             const std::vector<Measurement>& at) {
+  return summarizePointErrors(predictionErrorSeries(model, run, inputs, at));
 }
 
 }  // namespace gssm

@@ -76,7 +76,10 @@ struct PointError {
 /// minus the measurement. Measurements before the first row are not scored.
 std::vector<PointError> predictionErrorSeries(const Model& model, const OfflineRun& run,
                                               const std::vector<Input>& inputs, const std::vector<Measurement>& at);
-/// Their RMS and largest values, horizontal and whole.
+/// Errors' RMS and largest values, horizontal (the first two components)
+/// and whole.
+PointErrors summarizePointErrors(const std::vector<PointError>& errors);
+/// predictionErrorSeries', summarized.
 PointErrors predictionErrors(const Model& model, const OfflineRun& run, const std::vector<Input>& inputs,
                              const std::vector<Measurement>& at);
 
