@@ -24,7 +24,6 @@ CausalMapErrors causalMapErrors(const Model& model, EstimatorOptions options,
   options.method = Method::Batch;
   options.batch.threads = 1;  // the solves run side by side instead
   std::vector<std::vector<PointError>> found(at.size());
-  std::vector<std::string> why(at.size());
   const auto errors = runJobs(at.size(), static_cast<std::size_t>(std::max(threads, 1)), [&](std::size_t k) {
     const double t = at[k].t;
     const OfflineRun run = runOffline(model, options, upTo(measurements, t), upTo(inputs, t), {}, {}, rows);
