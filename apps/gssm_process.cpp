@@ -97,7 +97,7 @@ void writeCausalMap(const gssm::io::ProcessResult& r, const gssm::io::ProcessOpt
   for (Eigen::Index i = 0; i < width; ++i) csv << ",error_" << i;
   csv << "\n" << std::setprecision(17);
   for (const auto& e : c.errors) {
-    csv << e.t << "," << e.error.head(std::min<Eigen::Index>(2, width)).norm();
+    csv << e.t << "," << gssm::horizontalNorm(e.error);
     for (Eigen::Index i = 0; i < width; ++i) csv << "," << e.error[i];
     csv << "\n";
   }

@@ -40,12 +40,14 @@ std::vector<PointError> predictionErrorSeries(const Model& model, const OfflineR
   return out;
 }
 
+double horizontalNorm(const Eigen::VectorXd& error) { return error.head(std::min<Eigen::Index>(2, error.size())).norm(); }
+
 PointErrors summarizePointErrors(const std::vector<PointError>& errors) {
   PointErrors e;
   double sum_h = 0, sum = 0, max_h = 0, max = 0;
   for (const PointError& p : errors) {
     const Eigen::VectorXd& d = p.error;
-    const double h = d.head(std::min<Eigen::Index>(2, d.size())).norm(), n = d.norm();
+    const double h = horizontalNorm(d), n = d.norm();
     sum_h += h * h, sum += n * n, max_h = std::max(max_h, h), max = std::max(max, n);
     ++e.count;
   }

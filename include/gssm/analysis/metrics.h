@@ -76,8 +76,9 @@ struct PointError {
 /// minus the measurement. Measurements before the first row are not scored.
 std::vector<PointError> predictionErrorSeries(const Model& model, const OfflineRun& run,
                                               const std::vector<Input>& inputs, const std::vector<Measurement>& at);
-/// Errors' RMS and largest values, horizontal (the first two components)
-/// and whole.
+/// An error's horizontal size: the norm of its first two components.
+double horizontalNorm(const Eigen::VectorXd& error);
+/// Errors' RMS and largest values, horizontal (horizontalNorm) and whole.
 PointErrors summarizePointErrors(const std::vector<PointError>& errors);
 /// predictionErrorSeries', summarized.
 PointErrors predictionErrors(const Model& model, const OfflineRun& run, const std::vector<Input>& inputs,
