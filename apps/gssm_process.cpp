@@ -16,6 +16,7 @@
 #include "gssm/analysis/causal_map.h"
 #include "gssm/core/error.h"
 #include "gssm/io/config.h"
+#include "gssm/io/point_errors_csv.h"
 #include "gssm/io/process.h"
 #include "plot_library.h"
 
@@ -91,16 +92,7 @@ void writeCausalMap(const gssm::io::ProcessResult& r, const gssm::io::ProcessOpt
       gssm::causalMapErrors(*r.model, options, r.dataset.measurements, r.dataset.inputs, r.dataset.withheld,
                             r.dataset.rows, static_cast<int>(o.threads));
   const std::string path = (std::filesystem::path(o.out_dir) / "causal-map.csv").string();
-  std::ofstream csv(path);
-  csv << "t,horizontal_error";
-  const auto width = c.errors.empty() ? 0 : c.errors.front().error.size();
-  for (Eigen::Index i = 0; i < width; ++i) csv << ",error_" << i;
-  csv << "\n" << std::setprecision(17);
-  for (const auto& e : c.errors) {
-    csv << e.t << "," << gssm::horizontalNorm(e.error);
-    for (Eigen::Index i = 0; i < width; ++i) csv << "," << e.error[i];
-    csv << "\n";
-  }
+  gssm::io::writePointErrorsCsv(path, c.errors);
   const gssm::PointErrors s = gssm::summarizePointErrors(c.errors);
   std::cout << "causal MAP at " << s.count << " of " << r.dataset.withheld.size()
             << " withheld measurements: horizontal RMS " << s.horizontal_rms << " m, max " << s.horizontal_max

@@ -177,6 +177,31 @@ TEST(StrapdownIns, RoundTripsThroughItsIniForm) {
   EXPECT_LT((p.mount_rpy - model.params().mount_rpy).cwiseAbs().maxCoeff(), 1e-15);
 }
 
+// [prior] gyro_bias, accel_bias, gyro_scale, accel_scale, delay, clock_rate:
+// a calibration of the IMU (a previous log's, a datasheet's) as the prior
+// means of the constants, in x_b's order and the IMU's axes; 0 by default;
+// they round-trip through the INI form.
+TEST(StrapdownIns, CalibrationIsThePriorMeanOfTheConstants) {
+  StrapdownIns::Params p = driveParams(0.01);
+  EXPECT_EQ(StrapdownIns(p).priorConstants().mean.segment<6>(StrapdownIns::kGyroBias).norm(), 0.0);
+  p.gyro_bias = Eigen::Vector3d(1e-3, -2e-3, 3e-3), p.accel_bias = Eigen::Vector3d(0.05, -0.06, 0.7);
+  p.gyro_scale = Eigen::Vector3d(-0.01, 0.04, 0.002), p.accel_scale = Eigen::Vector3d(0.039, 0.034, 0.085);
+  p.delay = -0.101, p.clock_rate = -3.9e-4;
+  const StrapdownIns model(p);
+  const Eigen::VectorXd& m = model.priorConstants().mean;
+  EXPECT_EQ(m.segment<3>(StrapdownIns::kGyroBias), p.gyro_bias);
+  EXPECT_EQ(m.segment<3>(StrapdownIns::kAccelBias), p.accel_bias);
+  EXPECT_EQ(m.segment<3>(StrapdownIns::kGyroScale), p.gyro_scale);
+  EXPECT_EQ(m.segment<3>(StrapdownIns::kAccelScale), p.accel_scale);
+  EXPECT_EQ(m[StrapdownIns::kDelay], p.delay);
+  EXPECT_EQ(m[StrapdownIns::kClockRate], p.clock_rate);
+  EXPECT_EQ(m.segment<3>(StrapdownIns::kMount).norm(), 0.0);  // the mounting's is mount_rpy
+  io::IniDocument ini;
+  io::writeModel(model, ini);
+  const auto again = io::makeModel(io::IniDocument::parse(ini.toString(), "ins.ini"));
+  EXPECT_LT((again->priorConstants().mean - m).cwiseAbs().maxCoeff(), 1e-15);
+}
+
 // [model] gnss_sd_scale scales the σs each fix reports (a measurement's own
 // R, times its square) and nothing else: the EKF's update, the smoothers'
 // factor and the estimators' NIS see a fix with R under the scale s as the

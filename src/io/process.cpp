@@ -13,6 +13,7 @@
 #include "gssm/core/parallel.h"
 #include "gssm/io/config.h"
 #include "gssm/io/learn_config.h"
+#include "gssm/io/point_errors_csv.h"
 #include "gssm/io/run_files.h"
 #include "gssm/io/track_pos.h"
 
@@ -140,7 +141,8 @@ void compareToReference(const Model& model, const ProcessResult& r, const Offlin
 // Errors at the withheld measurements (inside a log's GNSS outages) and at
 // the used ones of their channel (outside).
 void scoreWithheld(const Model& model, const Dataset& d, const OfflineRun& run, RunMetrics& m) {
-  m.withheld = predictionErrors(model, run, d.inputs, d.withheld);
+  m.withheld_errors = predictionErrorSeries(model, run, d.inputs, d.withheld);
+  m.withheld = summarizePointErrors(m.withheld_errors);
   m.used = predictionErrors(model, run, d.inputs, usedOnWithheldChannel(d));
 }
 
@@ -234,6 +236,10 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
     r.runs.push_back(std::move(m.run));
     r.metrics.push_back(std::move(m.metrics));
     r.files.push_back((fs::path(o.out_dir) / RunFiles::estimatesName(method)).string());
+    if (!r.metrics.back().withheld_errors.empty()) {  // each withheld measurement's error, to score any part
+      r.files.push_back((fs::path(o.out_dir) / ("withheld-" + std::string(methodName(method)) + ".csv")).string());
+      writePointErrorsCsv(r.files.back(), r.metrics.back().withheld_errors);
+    }
     if (method == Method::Batch && reportsGeodeticTrack(*model)) {  // the smoothed track, for RTKPLOT
       r.files.push_back((fs::path(o.out_dir) / "track-batch.pos").string());
       writeTrackPos(r.files.back(), *model, r.runs.back());

@@ -89,7 +89,13 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   n.prior_state.covariance.topLeftCorner<3, 3>() +=
       p.start_heading_sd * p.start_heading_sd * down_in_body * down_in_body.transpose();
   Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
+  bmean.segment<3>(StrapdownIns::kGyroBias) = p.gyro_bias;
+  bmean.segment<3>(StrapdownIns::kAccelBias) = p.accel_bias;
   bmean.segment<3>(StrapdownIns::kLever) = so3::fromRollPitchYaw(p.mount_rpy).transpose() * p.lever;  // IMU axes
+  bmean(StrapdownIns::kDelay) = p.delay;
+  bmean.segment<3>(StrapdownIns::kGyroScale) = p.gyro_scale;
+  bmean.segment<3>(StrapdownIns::kAccelScale) = p.accel_scale;
+  bmean(StrapdownIns::kClockRate) = p.clock_rate;
   bsd << Eigen::Vector3d::Constant(p.gyro_bias_sd), Eigen::Vector3d::Constant(p.accel_bias_sd),
       Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd,
       Eigen::Vector3d::Constant(p.gyro_scale_sd), Eigen::Vector3d::Constant(p.accel_scale_sd), p.clock_rate_sd;
@@ -403,18 +409,24 @@ std::vector<ParamSpec> insParams() {
            "track's heading holds the IMU's only through the mounting: mount_sd accounts for that)"),
       real("prior", "velocity_sd", "prior σ of v(0) (m/s)"),
       real("prior", "position_sd", "prior σ of p(0) (m)"),
-      real("prior", "gyro_bias_sd", "prior σ of the gyro bias (rad/s), mean 0"),
-      real("prior", "accel_bias_sd", "prior σ of the accelerometer bias (m/s²), mean 0"),
+      vector("prior", "gyro_bias", "prior mean of the gyro bias, IMU axes (rad/s; default 0: a calibration)"),
+      real("prior", "gyro_bias_sd", "prior σ of the gyro bias (rad/s)"),
+      vector("prior", "accel_bias", "prior mean of the accelerometer bias, IMU axes (m/s²; default 0)"),
+      real("prior", "accel_bias_sd", "prior σ of the accelerometer bias (m/s²)"),
       vector("prior", "lever", "prior mean of the lever arm IMU → antenna, vehicle axes (m)"),
       real("prior", "lever_sd", "its σ (m)"),
       real("prior", "mount_sd", "prior σ of the mounting misalignment (deg), mean 0"),
-      real("prior", "delay_sd", "prior σ of the IMU's time delay at the start (s, added to its stamps), mean 0"),
-      real("prior", "clock_rate_sd", "prior σ of the IMU clock's rate error (s/s: the delay grows by it), mean 0"),
+      real("prior", "delay", "prior mean of the IMU's time delay at the start (s, added to its stamps; default 0)"),
+      real("prior", "delay_sd", "prior σ of the IMU's time delay at the start (s)"),
+      real("prior", "clock_rate", "prior mean of the IMU clock's rate error (s/s: the delay grows by it; default 0)"),
+      real("prior", "clock_rate_sd", "prior σ of the IMU clock's rate error (s/s)"),
       real("model", "clock_wander_sd", "the IMU clock's wander beyond its constant rate (s/√s)"),
       learnable(real("model", "gyro_bias_walk",
                      "the gyro bias's random walk beyond its constant part (rad/s/√s; 0: a constant bias)")),
-      real("prior", "gyro_scale_sd", "prior σ of each gyro axis's scale factor error (1 = 100 %), mean 0"),
-      real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error, mean 0")};
+      vector("prior", "gyro_scale", "prior mean of each gyro axis's scale factor error (1 = 100 %; default 0)"),
+      real("prior", "gyro_scale_sd", "prior σ of each gyro axis's scale factor error (1 = 100 %)"),
+      vector("prior", "accel_scale", "prior mean of each accelerometer axis's scale factor error (default 0)"),
+      real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error")};
   return p;
 }
 
@@ -465,7 +477,11 @@ std::vector<Input> startImu(const ParamSource& in, double& t0) {
 // outages), the position that of the IMU (the antenna's less the prior lever).
 void startFromData(const ParamSource& in, StrapdownIns::Params& p) {
   double t0 = 0;
-  const std::vector<Input> imu = startImu(in, t0);
+  std::vector<Input> imu = startImu(in, t0);
+  for (Input& r : imu) {  // the readings as the calibration of the prior means has them (f's correction)
+    r.u.head<3>() -= p.gyro_scale.cwiseProduct(r.u.head<3>()) + p.gyro_bias;
+    r.u.tail<3>() -= p.accel_scale.cwiseProduct(r.u.tail<3>()) + p.accel_bias;
+  }
   const Eigen::MatrixXd fixes = in.dataFile(in.text("dataset", "gnss", "gnss.pos"), {"t", "lat", "lon", "height", "q"});
   Eigen::MatrixXd outages(0, 2);
   if (in.has("dataset", "gnss_outages") && in.hasDataFile(in.text("dataset", "gnss_outages")))  // none: none withheld
@@ -501,7 +517,11 @@ StrapdownIns::Params readIns(const ParamSource& in) {
                             {"zupt_sd", &p.zupt_sd}, {"zaru_sd", &p.zaru_sd},
                             {"clock_wander_sd", &p.clock_wander_sd}, {"gyro_bias_walk", &p.gyro_bias_walk}})
     *value = in.real("model", key, *value);
-  if (in.has("prior", "lever")) p.lever = in.vector("prior", "lever", 3);
+  for (auto [key, value] : {std::pair{"lever", &p.lever}, {"gyro_bias", &p.gyro_bias}, {"accel_bias", &p.accel_bias},
+                            {"gyro_scale", &p.gyro_scale}, {"accel_scale", &p.accel_scale}})
+    if (in.has("prior", key)) *value = in.vector("prior", key, 3);
+  p.delay = in.real("prior", "delay", p.delay);
+  p.clock_rate = in.real("prior", "clock_rate", p.clock_rate);
   const double per_state = in.real("model", "imu_per_state", 1);
   if (!(per_state >= 1 && per_state <= 1000 && per_state == std::floor(per_state)))
     throw InputError(in.where("model", "imu_per_state") + " = " + std::to_string(per_state) +
@@ -544,7 +564,11 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);
   out.vector("prior", "start_velocity", p.start_velocity);
   out.vector("prior", "start_position", p.start_position);
-  out.vector("prior", "lever", p.lever);
+  for (auto [key, value] : {std::pair{"lever", &p.lever}, {"gyro_bias", &p.gyro_bias}, {"accel_bias", &p.accel_bias},
+                            {"gyro_scale", &p.gyro_scale}, {"accel_scale", &p.accel_scale}})
+    out.vector("prior", key, *value);
+  out.real("prior", "delay", p.delay);
+  out.real("prior", "clock_rate", p.clock_rate);
   for (auto [key, value] : {std::pair{"attitude_sd", p.attitude_sd / kDeg},
                             {"heading_sd", p.start_heading_sd / kDeg}, {"velocity_sd", p.velocity_sd},
                             {"position_sd", p.position_sd}, {"gyro_bias_sd", p.gyro_bias_sd},

@@ -19,6 +19,12 @@ struct PointErrors {
   double rms = NAN, max = NAN;  ///< of the whole vector (3-D)
 };
 
+/// One measurement's error: prediction − measurement at its time.
+struct PointError {
+  double t = 0;
+  Eigen::VectorXd error;
+};
+
 struct RunMetrics {
   Method method = Method::Ekf;
   std::vector<std::string> names;  ///< the compared components' names (the truth's; all stacked states by default)
@@ -51,6 +57,9 @@ struct RunMetrics {
   /// outages: the truth inside them) and against those on the same channel
   /// that were used (outside them); count 0 when the dataset withholds none.
   PointErrors withheld, used;
+  /// The errors at each withheld measurement, in time order (what
+  /// `withheld` summarizes).
+  std::vector<PointError> withheld_errors;
 };
 
 /// Matches rows to truth by time (runErrors); throws InvalidArgument if an
@@ -62,12 +71,6 @@ RunMetrics computeMetrics(const Model& model, const OfflineRun& run, const Truth
 /// terms, Model::comparableConstants; null: m.constants as they are);
 /// InvalidArgument on a size mismatch.
 void compareConstants(RunMetrics& m, const Eigen::VectorXd& reference, const Gaussian* compared = nullptr);
-
-/// One measurement's error: prediction − measurement at its time.
-struct PointError {
-  double t = 0;
-  Eigen::VectorXd error;
-};
 
 /// The run's errors at `at` (all on one channel, in time order): at each
 /// measurement's time t, the newest row at or before t (causal for a

@@ -73,15 +73,21 @@ class StrapdownIns final : public Model {
     /// nominal mounting, whose yaw is uncertain by mount_sd ([prior]
     /// heading_sd; docs/DESIGN.md §12).
     double start_heading_sd = 0;
-    double gyro_bias_sd = 0.01;                ///< prior σ of b_g (rad/s), mean 0
-    double accel_bias_sd = 0.1;                ///< prior σ of b_a (m/s²), mean 0
+    double gyro_bias_sd = 0.01;                ///< prior σ of b_g (rad/s)
+    double accel_bias_sd = 0.1;                ///< prior σ of b_a (m/s²)
+    /// Prior means of the IMU's own constants, in its axes: a calibration
+    /// (the gyro's and accelerometer's biases, rad/s and m/s²; their scale
+    /// factor errors, 1 = 100 %), the delay at the start (s) and the clock's
+    /// rate error (s/s). 0 by default: the IMU as its datasheet has it.
+    Eigen::Vector3d gyro_bias{0, 0, 0}, accel_bias{0, 0, 0}, gyro_scale{0, 0, 0}, accel_scale{0, 0, 0};
+    double delay = 0, clock_rate = 0;
     Eigen::Vector3d lever{0, 0, 0};            ///< prior mean of the lever arm in vehicle axes (m; x_b holds R_vb0ᵀ·it)
     double lever_sd = 0.1;                     ///< its σ (m)
     double mount_sd = 0.1;                     ///< prior σ of μ (rad), mean 0
-    double delay_sd = 0.1;                     ///< prior σ of d (s), mean 0
-    double gyro_scale_sd = 0.01;               ///< prior σ of the gyro's scale factor errors, mean 0
-    double accel_scale_sd = 0.01;              ///< prior σ of the accelerometer's scale factor errors, mean 0
-    double clock_rate_sd = 1e-3;               ///< prior σ of ρ (s/s), mean 0
+    double delay_sd = 0.1;                     ///< prior σ of d (s)
+    double gyro_scale_sd = 0.01;               ///< prior σ of the gyro's scale factor errors
+    double accel_scale_sd = 0.01;              ///< prior σ of the accelerometer's scale factor errors
+    double clock_rate_sd = 1e-3;               ///< prior σ of ρ (s/s)
     double clock_wander_sd = 1e-4;             ///< the clock's random walk beyond ρ (s/√s)
     /// The gyro bias's random walk beyond the constant b_g (rad/s/√s); 0:
     /// the bias is constant (x_c has no β_g)
