@@ -3,6 +3,8 @@
 // (the car pulls away) and in motion (turning, on a hill) — against its truth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <random>
 
@@ -83,6 +85,33 @@ TEST(InsStart, StandingAndInMotionMatchTheTruth) {
                          Eigen::Matrix3d::Identity(), model.frame());
       },
       {"no IMU row"});
+}
+
+// A GNSS outage soon after the car pulls away (the drive's first one, 1.5 s
+// after): the heading from the fixes before the gap, not from a chord
+// across it, which averages the turn the car makes in the outage.
+TEST(InsStart, PullingAwayIntoAnOutageTakesTheTrackBeforeIt) {
+  const StrapdownIns model(startParams());
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const testing::SimulatedDrive d = testing::simulateDrive(model, 30.0, testing::normalSampler(seed));
+    std::vector<double> all_t, ft;
+    std::vector<Eigen::Vector3d> all_p, fp;
+    fixesFrom(d, 0.0, all_t, all_p);
+    double gap_from = 0;  // the outage: 10 s after the first fix 1.5 m from the start
+    for (std::size_t i = 0; i < all_t.size() && gap_from == 0; ++i)
+      if ((all_p[i] - all_p.front()).head<2>().norm() >= 1.5) gap_from = all_t[i] + 1e-3;
+    for (std::size_t i = 0; i < all_t.size(); ++i)
+      if (all_t[i] < gap_from || all_t[i] >= gap_from + 10) ft.push_back(all_t[i]), fp.push_back(all_p[i]);
+    const models::InsStart s = models::insStart(0.0, d.inputs, ft, fp, model.mounting(d.constants), model.frame());
+    const Eigen::Matrix3d truth = so3::Exp(d.states.front().head<3>());
+    EXPECT_LT(std::abs(so3::minus(s.R_nb, truth).z()), 0.08) << "seed " << seed;
+    // The chord across the gap, as the start took before: off by the turn.
+    const Eigen::Vector3d across = fp[static_cast<std::size_t>(
+                                       std::find_if(ft.begin(), ft.end(), [&](double t) { return t >= gap_from; }) -
+                                       ft.begin())] - fp.front();
+    const double yaw_across = std::atan2(across.y(), across.x());
+    EXPECT_GT(std::abs(std::remainder(yaw_across - s.track_yaw, 2 * M_PI)), 0.15) << "seed " << seed;
+  }
 }
 
 }  // namespace

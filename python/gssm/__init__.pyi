@@ -31,6 +31,7 @@ class SmootherOptions:
     relinearize_threshold: float
     constants_check_sigmas: float
     full_pass_growth: float
+    full_pass_rounds: int
     max_local_iterations: int
     wildfire_threshold: float
     iterate_to_convergence: bool

@@ -53,6 +53,20 @@ Track fitTrack(double t0, double from, double to, const std::vector<double>& ft,
   tr.c = N.ldlt().solve(B);
   return tr;
 }
+// At rest: the direction to the first fix track_distance from the first
+// one, or to the last before a gap in the fixes if that is
+// min_track_distance away (ins_start.h).
+Eigen::Vector3d pullingAwayTrack(const std::vector<double>& fix_t, const std::vector<Eigen::Vector3d>& fix_ned,
+                                 const InsStartOptions& o) {
+  auto distance = [&](std::size_t i) { return (fix_ned[i] - fix_ned.front()).head<2>().norm(); };
+  for (std::size_t i = 1; i < fix_ned.size(); ++i) {
+    if (fix_t[i] - fix_t[i - 1] > o.track_gap && distance(i - 1) >= o.min_track_distance)
+      return fix_ned[i - 1] - fix_ned.front();
+    if (distance(i) >= o.track_distance) return fix_ned[i] - fix_ned.front();
+  }
+  throw InputError("INS start: the GNSS track never gets " + std::to_string(o.track_distance) +
+                   " m from its start: no heading for the vehicle");
+}
 }  // namespace
 
 InsStart insStart(double t0, const std::vector<Input>& imu, const std::vector<double>& fix_t,
@@ -94,14 +108,7 @@ InsStart insStart(double t0, const std::vector<Input>& imu, const std::vector<do
   const Eigen::Vector3d accel =
       s.moving ? Eigen::Vector3d((velocity(t0 + o.window) - s.velocity) / o.window) : Eigen::Vector3d::Zero();
   const Eigen::Vector3d gravity = frame.gravity(fix_ned.front());
-  if (!s.moving) {  // pulling away: the first fix far enough from the start
-    std::size_t i = 0;
-    while (i < fix_ned.size() && (fix_ned[i] - fix_ned.front()).head<2>().norm() < o.track_distance) ++i;
-    if (i == fix_ned.size())
-      throw InputError("INS start: the GNSS track never gets " + std::to_string(o.track_distance) +
-                       " m from its start: no heading for the vehicle");
-    track = fix_ned[i] - fix_ned.front();
-  }
+  if (!s.moving) track = pullingAwayTrack(fix_t, fix_ned, o);
   // In 3-D: the vehicle's forward axis is along its velocity (slope
   // included: a flattened track would tilt the answer on a hill).
   s.track_yaw = std::atan2(track.y(), track.x());

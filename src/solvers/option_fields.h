@@ -23,6 +23,7 @@ void fields(Io& io, SmootherOptions& s) {
   io(s.relinearize_threshold, "smoother relinearize_threshold");
   io(s.constants_check_sigmas, "smoother constants_check_sigmas");
   if (io.version() >= 4) io(s.full_pass_growth, "smoother full_pass_growth");
+  if (io.version() >= 6) io(s.full_pass_rounds, "smoother full_pass_rounds");
   io(s.max_local_iterations, "smoother max_local_iterations");
   io(s.wildfire_threshold, "smoother wildfire_threshold", true);  // ∞ = lazy
   io(s.iterate_to_convergence, "smoother iterate_to_convergence");

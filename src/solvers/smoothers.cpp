@@ -43,6 +43,8 @@ bool SmootherOptions::validate(std::string* why) const {
   if (!(relinearize_threshold > 0)) return fail("relinearize_threshold must be > 0");
   if (!(constants_check_sigmas > 0)) return fail("constants_check_sigmas must be > 0");
   if (!(full_pass_growth >= 1) || !std::isfinite(full_pass_growth)) return fail("full_pass_growth must be >= 1");
+  if (full_pass_rounds < 1 || full_pass_rounds > 100)
+    return fail("full_pass_rounds must be in [1, 100], got " + std::to_string(full_pass_rounds));
   // Upper bounds: values beyond them only make an update run for minutes
   // (a checkpoint fuzzer found max_local_iterations = 4194307).
   if (max_local_iterations < 0 || max_local_iterations > 100)
@@ -256,8 +258,12 @@ void SmootherCore::checkAllWhenTheConstantsMoved(UpdateReport& rep, internal::En
   engine.marginalSd(Key::constants(), sd);
   const double moved = ((xb - constants_at_last_check_).cwiseAbs().array() / sd.array()).maxCoeff();
   if (moved <= options.constants_check_sigmas) return;
-  counts.variables_backsubstituted += engine.solveAll();
-  relinearize(engine.nonlinearSlots(), options.relinearize_threshold, rep, counts);
+  for (int round = 0; round < options.full_pass_rounds; ++round) {
+    const int before = rep.iterations;
+    counts.variables_backsubstituted += engine.solveAll();
+    relinearize(engine.nonlinearSlots(), options.relinearize_threshold, rep, counts);
+    if (rep.iterations == before) break;  // nothing was stale
+  }
   rep.relinearization_pass = true;
   engine.estimateInto(Key::constants(), constants_at_last_check_);
   held_at_last_pass_ = static_cast<std::int64_t>(engine.numVariables());

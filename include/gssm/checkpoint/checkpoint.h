@@ -35,8 +35,8 @@ namespace gssm {
 /// older files resume with growth 1, a pass whenever the constants moved).
 /// Version 5 the point of the paper window's kept factorization (its last
 /// Gauss–Newton step is not relinearized; older files use the window's
-/// values).
-constexpr std::uint32_t kCheckpointVersion = 5;
+/// values). Version 6 SmootherOptions::full_pass_rounds (older files: 1).
+constexpr std::uint32_t kCheckpointVersion = 6;
 
 /// What a checkpoint says about itself (filled by restore).
 struct CheckpointInfo {

@@ -41,6 +41,7 @@ void optionKeys(Visitor& v, SmootherOptions& o) {
   v("relinearize_threshold", o.relinearize_threshold, "whitened linearization error ‖r(x̂) − r_lin(x̂)‖ above which a factor is relinearized");
   v("constants_check_sigmas", o.constants_check_sigmas, "check every factor when the constants moved more than this many marginal σ since the last check");
   v("full_pass_growth", o.full_pass_growth, "> 1: a full relinearization pass only once the history grew by this factor since the last (1: whenever the constants moved)");
+  v("full_pass_rounds", o.full_pass_rounds, "relinearize-and-re-eliminate rounds of a full pass, each until no factor is stale (1: one Gauss–Newton step)");
   v("max_local_iterations", o.max_local_iterations, "relinearize-and-re-eliminate rounds on the re-eliminated top per update");
   v("wildfire_threshold", o.wildfire_threshold, "back-substitution descends only while the change exceeds this (iSAM2's wildfire; default: never, lazy)");
   v("iterate_to_convergence", o.iterate_to_convergence, "iterate every update to convergence over all factors (O(n): equals the batch)");

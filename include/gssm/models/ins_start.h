@@ -8,7 +8,11 @@
 //  * the vehicle's forward axis (R_vbᵀ·e_x in the IMU's axes) against the
 //    GNSS track: the velocity at the start if the car moves (faster than
 //    `moving_speed`), else the direction to the first fix `track_distance`
-//    from the start (the car pulling away), in 3-D — yaw.
+//    from the start (the car pulling away), in 3-D — yaw. When the fixes
+//    stop before that (a gap longer than `track_gap`: an outage soon after
+//    pulling away), the direction to the last fix before the gap, if it is
+//    `min_track_distance` from the start: a chord across the gap would
+//    average the turns the car made in it.
 #include <Eigen/Core>
 #include <string>
 #include <vector>
@@ -24,6 +28,8 @@ struct InsStartOptions {
   double window = 3.0;
   double moving_speed = 1.0;    ///< m/s: faster is "in motion" (the track from the velocity)
   double track_distance = 3.0;  ///< m: at rest, the track from the first fix this far away
+  double track_gap = 1.0;           ///< s: fixes further apart than this end the pulling-away track
+  double min_track_distance = 1.0;  ///< m: ... if its last fix before the gap is this far from the start
 };
 
 struct InsStart {

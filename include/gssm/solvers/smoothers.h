@@ -75,6 +75,13 @@ struct SmootherOptions {
   /// whose n is its window, every (growth − 1)·window states). 1: whenever
   /// the constants moved.
   double full_pass_growth = 1.0;
+  /// Relinearize-and-re-eliminate rounds of a full pass, each until no
+  /// factor is stale. 1: one Gauss–Newton step from the pass's point. When
+  /// the constants have moved far since the factors were linearized (a
+  /// mounting learnt in an outage, the GNSS/INS drive) one step can leave
+  /// the newest states far from the causal optimum; a second converges
+  /// there (docs/DESIGN.md §12), at the cost of the pass's O(n) work again.
+  int full_pass_rounds = 1;
   /// Relinearize-and-re-eliminate rounds on the top per update (start-up).
   int max_local_iterations = 3;
   /// Back-substitution descends into a subtree only while the solution
