@@ -202,6 +202,29 @@ TEST(StrapdownIns, CalibrationIsThePriorMeanOfTheConstants) {
   EXPECT_LT((again->priorConstants().mean - m).cwiseAbs().maxCoeff(), 1e-15);
 }
 
+// [model] nhc_loss, nhc_loss_scale: a robust loss on the vehicle
+// constraints only (the GNSS fixes and the standing updates stay
+// Gaussian); the scale defaults to the kind's; an unknown kind is named;
+// both round-trip through the INI form.
+TEST(StrapdownIns, NhcLossIsOnTheConstraintsOnly) {
+  StrapdownIns::Params p = driveParams(0.01);
+  p.nhc_loss.kind = RobustLoss::Kind::Huber, p.nhc_loss.scale = 1.345;
+  const StrapdownIns model(p);
+  for (int c = 0; c < model.numChannels(); ++c)
+    EXPECT_EQ(model.channel(c).loss.kind, model.channel(c).name == "nhc" ? RobustLoss::Kind::Huber : RobustLoss::Kind::None)
+        << model.channel(c).name;
+  io::IniDocument ini;
+  io::writeModel(model, ini);
+  const auto again = io::makeModel(io::IniDocument::parse(ini.toString(), "ins.ini"));
+  const MeasurementChannel& nhc = again->channel(again->channelIndex("nhc"));
+  EXPECT_EQ(nhc.loss.kind, RobustLoss::Kind::Huber);
+  EXPECT_EQ(nhc.loss.scale, 1.345);
+  std::string text = ini.toString();
+  text.replace(text.find("nhc_loss = huber"), 16, "nhc_loss = hubber");
+  testing::expectThrowsNaming<InputError>([&] { io::makeModel(io::IniDocument::parse(text, "ins.ini")); },
+                                          {"ins.ini", "nhc_loss", "hubber"});
+}
+
 // [model] gnss_sd_scale scales the σs each fix reports (a measurement's own
 // R, times its square) and nothing else: the EKF's update, the smoothers'
 // factor and the estimators' NIS see a fix with R under the scale s as the

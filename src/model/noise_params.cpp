@@ -56,25 +56,26 @@ void writeNoise(const Model& model, ParamSink& out, NoiseKeys keys) {
   }
 }
 
-std::vector<ParamSpec> lossParams(const std::string& section) {
-  return {param::text(section, "loss", "robust loss on the measurements: none, huber, cauchy or tukey"),
-          param::real(section, "loss_scale", "where the loss departs from the square (noise sds)")};
+std::vector<ParamSpec> lossParams(const std::string& section, const std::string& prefix, const std::string& what) {
+  return {param::text(section, prefix + "loss", "robust loss on " + what + ": none, huber, cauchy or tukey"),
+          param::real(section, prefix + "loss_scale", "where the loss departs from the square (noise sds)")};
 }
 
-RobustLoss readLoss(const ParamSource& in, const std::string& section) {
+RobustLoss readLoss(const ParamSource& in, const std::string& section, const std::string& prefix) {
   RobustLoss loss;
-  const std::string kind = in.text(section, "loss", "none");
+  const std::string key = prefix + "loss", scale_key = prefix + "loss_scale";
+  const std::string kind = in.text(section, key, "none");
   if (!RobustLoss::named(kind, &loss.kind))
-    throw InputError(in.where(section, "loss") + " = '" + kind + "': expected none, huber, cauchy or tukey");
-  loss.scale = in.real(section, "loss_scale", RobustLoss::defaultScale(loss.kind));
+    throw InputError(in.where(section, key) + " = '" + kind + "': expected none, huber, cauchy or tukey");
+  loss.scale = in.real(section, scale_key, RobustLoss::defaultScale(loss.kind));
   std::string why;
-  if (!loss.validate(&why)) throw InputError(in.where(section, "loss_scale") + ": " + why);
+  if (!loss.validate(&why)) throw InputError(in.where(section, scale_key) + ": " + why);
   return loss;
 }
 
-void writeLoss(const RobustLoss& loss, const std::string& section, ParamSink& out) {
-  out.text(section, "loss", RobustLoss::name(loss.kind));
-  out.real(section, "loss_scale", loss.scale);
+void writeLoss(const RobustLoss& loss, const std::string& section, ParamSink& out, const std::string& prefix) {
+  out.text(section, prefix + "loss", RobustLoss::name(loss.kind));
+  out.real(section, prefix + "loss_scale", loss.scale);
 }
 
 }  // namespace gssm

@@ -6,6 +6,7 @@
 
 #include "gssm/core/error.h"
 #include "gssm/core/so3.h"
+#include "gssm/model/noise_params.h"
 #include "gssm/model/packed_inputs.h"
 #include "gssm/model/registry.h"
 #include "gssm/models/ins_start.h"
@@ -134,8 +135,9 @@ StrapdownIns::StrapdownIns(const Params& p)
   MeasurementChannel gnss =
       channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay, kClockRate});
   gnss.own_R_scale = p.gnss_sd_scale * p.gnss_sd_scale;
-  setChannels({std::move(gnss),
-               channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11}),
+  MeasurementChannel nhc = channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11});
+  nhc.loss = p.nhc_loss;
+  setChannels({std::move(gnss), std::move(nhc),
                channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, Eigen::Vector3d::Constant(p.zupt_sd), {}),
                channelOf("zaru", {"zaru_x", "zaru_y", "zaru_z"}, Eigen::Vector3d::Constant(p.zaru_sd), {0, 1, 2}),
                gnssVelocityChannel(p)});
@@ -427,6 +429,8 @@ std::vector<ParamSpec> insParams() {
       real("prior", "gyro_scale_sd", "prior σ of each gyro axis's scale factor error (1 = 100 %)"),
       vector("prior", "accel_scale", "prior mean of each accelerometer axis's scale factor error (default 0)"),
       real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error")};
+  for (auto& l : lossParams("model", "nhc_", "the vehicle constraints (nhc: a bump or a skid breaks them)"))
+    p.push_back(l);
   return p;
 }
 
@@ -522,6 +526,7 @@ StrapdownIns::Params readIns(const ParamSource& in) {
     if (in.has("prior", key)) *value = in.vector("prior", key, 3);
   p.delay = in.real("prior", "delay", p.delay);
   p.clock_rate = in.real("prior", "clock_rate", p.clock_rate);
+  p.nhc_loss = readLoss(in, "model", "nhc_");
   const double per_state = in.real("model", "imu_per_state", 1);
   if (!(per_state >= 1 && per_state <= 1000 && per_state == std::floor(per_state)))
     throw InputError(in.where("model", "imu_per_state") + " = " + std::to_string(per_state) +
@@ -561,6 +566,7 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
                             {"zupt_sd", p.zupt_sd}, {"zaru_sd", p.zaru_sd},
                             {"clock_wander_sd", p.clock_wander_sd}, {"gyro_bias_walk", p.gyro_bias_walk}})
     out.real("model", key, value);
+  writeLoss(p.nhc_loss, "model", out, "nhc_");
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);
   out.vector("prior", "start_velocity", p.start_velocity);
   out.vector("prior", "start_position", p.start_position);

@@ -22,10 +22,12 @@ ModelNoise readNoise(const ParamSource& in, const ModelDims& dims, const ModelNo
 /// Writes the model's T, Q (of one nominal step), R of channel 0 and priors.
 void writeNoise(const Model& model, ParamSink& out, NoiseKeys keys = {});
 
-/// [section] loss (none | huber | cauchy | tukey) and loss_scale (default:
-/// RobustLoss::defaultScale of the kind).
-std::vector<ParamSpec> lossParams(const std::string& section);
-RobustLoss readLoss(const ParamSource& in, const std::string& section);
-void writeLoss(const RobustLoss& loss, const std::string& section, ParamSink& out);
+/// [section] `loss` (none | huber | cauchy | tukey) and `loss_scale`
+/// (default: RobustLoss::defaultScale of the kind), each after `prefix`,
+/// which names the channel a model's loss is for (strapdown_ins: `nhc_`).
+std::vector<ParamSpec> lossParams(const std::string& section, const std::string& prefix = "",
+                                  const std::string& what = "the measurements");
+RobustLoss readLoss(const ParamSource& in, const std::string& section, const std::string& prefix = "");
+void writeLoss(const RobustLoss& loss, const std::string& section, ParamSink& out, const std::string& prefix = "");
 
 }  // namespace gssm

@@ -64,6 +64,9 @@ class StrapdownIns final : public Model {
     double nhc_down_sd = 0.1;                  ///< σ of its vertical velocity (m/s)
     double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)
     double zaru_sd = 0.005;                    ///< σ of the gyro's mean reading while standing (rad/s)
+    /// Robust loss on the vehicle constraints (`nhc`): a bump or a skid
+    /// breaks them for a moment (none: Gaussian).
+    RobustLoss nhc_loss;
     Eigen::Vector3d start_rpy{0, 0, 0};        ///< prior mean of the IMU's attitude, roll, pitch, yaw (rad)
     Eigen::Vector3d start_velocity{0, 0, 0};   ///< prior mean of v(0) (m/s, NED)
     Eigen::Vector3d start_position{0, 0, 0};   ///< prior mean of p(0) (m, NED)
