@@ -205,20 +205,25 @@ TEST(StrapdownIns, CalibrationIsThePriorMeanOfTheConstants) {
 // [model] nhc_loss, nhc_loss_scale: a robust loss on the vehicle
 // constraints only (the GNSS fixes and the standing updates stay
 // Gaussian); the scale defaults to the kind's; an unknown kind is named;
-// both round-trip through the INI form.
+// nhc_ekf_gate, the EKF's gate on them alone; all round-trip through the
+// INI form.
 TEST(StrapdownIns, NhcLossIsOnTheConstraintsOnly) {
   StrapdownIns::Params p = driveParams(0.01);
   p.nhc_loss.kind = RobustLoss::Kind::Huber, p.nhc_loss.scale = 1.345;
+  p.nhc_ekf_gate = 13.8;
   const StrapdownIns model(p);
-  for (int c = 0; c < model.numChannels(); ++c)
-    EXPECT_EQ(model.channel(c).loss.kind, model.channel(c).name == "nhc" ? RobustLoss::Kind::Huber : RobustLoss::Kind::None)
-        << model.channel(c).name;
+  for (int c = 0; c < model.numChannels(); ++c) {
+    const bool nhc = model.channel(c).name == "nhc";
+    EXPECT_EQ(model.channel(c).loss.kind, nhc ? RobustLoss::Kind::Huber : RobustLoss::Kind::None) << c;
+    EXPECT_EQ(model.channel(c).ekf_gate, nhc ? 13.8 : 0.0) << c;
+  }
   io::IniDocument ini;
   io::writeModel(model, ini);
   const auto again = io::makeModel(io::IniDocument::parse(ini.toString(), "ins.ini"));
   const MeasurementChannel& nhc = again->channel(again->channelIndex("nhc"));
   EXPECT_EQ(nhc.loss.kind, RobustLoss::Kind::Huber);
   EXPECT_EQ(nhc.loss.scale, 1.345);
+  EXPECT_EQ(nhc.ekf_gate, 13.8);
   std::string text = ini.toString();
   text.replace(text.find("nhc_loss = huber"), 16, "nhc_loss = hubber");
   testing::expectThrowsNaming<InputError>([&] { io::makeModel(io::IniDocument::parse(text, "ins.ini")); },

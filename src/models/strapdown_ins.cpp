@@ -69,6 +69,8 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
     throw InvalidArgument("StrapdownIns: start_heading_sd must be >= 0");
   if (!(p.gnss_vel_latency >= 0) || !std::isfinite(p.gnss_vel_latency))
     throw InvalidArgument("StrapdownIns: gnss_vel_latency must be >= 0 (s)");
+  if (!(p.nhc_ekf_gate >= 0) || !std::isfinite(p.nhc_ekf_gate))
+    throw InvalidArgument("StrapdownIns: nhc_ekf_gate must be >= 0 (0: no gate)");
   if (!(p.gyro_bias_walk >= 0) || !std::isfinite(p.gyro_bias_walk))
     throw InvalidArgument("StrapdownIns: gyro_bias_walk must be >= 0 (0: a constant gyro bias)");
   ModelNoise n;
@@ -137,6 +139,7 @@ StrapdownIns::StrapdownIns(const Params& p)
   gnss.own_R_scale = p.gnss_sd_scale * p.gnss_sd_scale;
   MeasurementChannel nhc = channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11});
   nhc.loss = p.nhc_loss;
+  nhc.ekf_gate = p.nhc_ekf_gate;
   setChannels({std::move(gnss), std::move(nhc),
                channelOf("zupt", {"zupt_n", "zupt_e", "zupt_d"}, Eigen::Vector3d::Constant(p.zupt_sd), {}),
                channelOf("zaru", {"zaru_x", "zaru_y", "zaru_z"}, Eigen::Vector3d::Constant(p.zaru_sd), {0, 1, 2}),
@@ -431,6 +434,8 @@ std::vector<ParamSpec> insParams() {
       real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error")};
   for (auto& l : lossParams("model", "nhc_", "the vehicle constraints (nhc: a bump or a skid breaks them)"))
     p.push_back(l);
+  p.push_back(param::real("model", "nhc_ekf_gate",
+                          "the EKF (no loss) rejects a constraint whose NIS exceeds this (2 dof; 0: no gate)"));
   return p;
 }
 
@@ -519,7 +524,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
                             {"gnss_vel_latency", &p.gnss_vel_latency}, {"nhc_sd", &p.nhc_sd},
                             {"nhc_down_sd", &p.nhc_down_sd},
                             {"zupt_sd", &p.zupt_sd}, {"zaru_sd", &p.zaru_sd},
-                            {"clock_wander_sd", &p.clock_wander_sd}, {"gyro_bias_walk", &p.gyro_bias_walk}})
+                            {"clock_wander_sd", &p.clock_wander_sd}, {"gyro_bias_walk", &p.gyro_bias_walk},
+                            {"nhc_ekf_gate", &p.nhc_ekf_gate}})
     *value = in.real("model", key, *value);
   for (auto [key, value] : {std::pair{"lever", &p.lever}, {"gyro_bias", &p.gyro_bias}, {"accel_bias", &p.accel_bias},
                             {"gyro_scale", &p.gyro_scale}, {"accel_scale", &p.accel_scale}})
@@ -564,7 +570,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
                             {"gnss_vel_sd_scale", p.gnss_vel_sd_scale}, {"gnss_vel_latency", p.gnss_vel_latency},
                             {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
                             {"zupt_sd", p.zupt_sd}, {"zaru_sd", p.zaru_sd},
-                            {"clock_wander_sd", p.clock_wander_sd}, {"gyro_bias_walk", p.gyro_bias_walk}})
+                            {"clock_wander_sd", p.clock_wander_sd}, {"gyro_bias_walk", p.gyro_bias_walk},
+                            {"nhc_ekf_gate", p.nhc_ekf_gate}})
     out.real("model", key, value);
   writeLoss(p.nhc_loss, "model", out, "nhc_");
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);

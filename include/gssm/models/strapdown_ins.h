@@ -67,6 +67,9 @@ class StrapdownIns final : public Model {
     /// Robust loss on the vehicle constraints (`nhc`): a bump or a skid
     /// breaks them for a moment (none: Gaussian).
     RobustLoss nhc_loss;
+    /// The EKF, which has no loss, rejects a constraint whose NIS exceeds
+    /// this (MeasurementChannel::ekf_gate; 0: none).
+    double nhc_ekf_gate = 0;
     Eigen::Vector3d start_rpy{0, 0, 0};        ///< prior mean of the IMU's attitude, roll, pitch, yaw (rad)
     Eigen::Vector3d start_velocity{0, 0, 0};   ///< prior mean of v(0) (m/s, NED)
     Eigen::Vector3d start_position{0, 0, 0};   ///< prior mean of p(0) (m, NED)
