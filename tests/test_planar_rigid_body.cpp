@@ -451,7 +451,9 @@ TEST(PlanarRigidBody, FullPassRoundsLandNearerTheCausalOptimum) {
       const Eigen::VectorXd sd = optimum.covariance.diagonal().cwiseSqrt();
       sum += ((est->current().mean - optimum.mean).cwiseAbs().cwiseQuotient(sd)).maxCoeff(), ++passes;
     }
-    if (resumed) EXPECT_EQ((*resumed)->current().mean, est->current().mean);
+    if (resumed) {
+      EXPECT_EQ((*resumed)->current().mean, est->current().mean);
+    }
     EXPECT_GT(passes, 2);
     return sum / std::max(passes, 1);
   };
