@@ -1,6 +1,7 @@
 #include "gssm/models/strapdown_ins.h"
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -514,21 +515,52 @@ void startFromData(const ParamSource& in, StrapdownIns::Params& p) {
   p.start_position = s.position - s.R_nb * R_vb0.transpose() * p.lever;
 }
 
+// The keys read and written as they are, one table for both directions
+// (P: Params, or const Params to write); the angles, read in degrees, and
+// T are apart.
+template <class P>
+auto modelReals(P& p) {
+  return std::array{std::pair{"gyro_sd", &p.gyro_sd}, std::pair{"accel_sd", &p.accel_sd},
+                    std::pair{"gnss_sd", &p.gnss_sd}, std::pair{"gnss_sd_scale", &p.gnss_sd_scale},
+                    std::pair{"gnss_vel_sd", &p.gnss_vel_sd}, std::pair{"gnss_vel_sd_scale", &p.gnss_vel_sd_scale},
+                    std::pair{"gnss_vel_latency", &p.gnss_vel_latency}, std::pair{"nhc_sd", &p.nhc_sd},
+                    std::pair{"nhc_down_sd", &p.nhc_down_sd}, std::pair{"zupt_sd", &p.zupt_sd},
+                    std::pair{"zaru_sd", &p.zaru_sd}, std::pair{"clock_wander_sd", &p.clock_wander_sd},
+                    std::pair{"gyro_bias_walk", &p.gyro_bias_walk}, std::pair{"nhc_ekf_gate", &p.nhc_ekf_gate}};
+}
+
+// The calibration's prior means in [prior], 3 values each.
+template <class P>
+auto calibrationPriors(P& p) {
+  return std::array{std::pair{"lever", &p.lever}, std::pair{"gyro_bias", &p.gyro_bias},
+                    std::pair{"accel_bias", &p.accel_bias}, std::pair{"gyro_scale", &p.gyro_scale},
+                    std::pair{"accel_scale", &p.accel_scale}};
+}
+
+// The prior's angular σs, in degrees in the INI.
+template <class P>
+auto angleSds(P& p) {
+  return std::array{std::pair{"attitude_sd", &p.attitude_sd}, std::pair{"heading_sd", &p.start_heading_sd},
+                    std::pair{"mount_sd", &p.mount_sd}};
+}
+
+// The prior's other σs, in their own units.
+template <class P>
+auto priorSds(P& p) {
+  return std::array{std::pair{"velocity_sd", &p.velocity_sd}, std::pair{"position_sd", &p.position_sd},
+                    std::pair{"gyro_bias_sd", &p.gyro_bias_sd}, std::pair{"accel_bias_sd", &p.accel_bias_sd},
+                    std::pair{"lever_sd", &p.lever_sd}, std::pair{"delay_sd", &p.delay_sd},
+                    std::pair{"gyro_scale_sd", &p.gyro_scale_sd}, std::pair{"accel_scale_sd", &p.accel_scale_sd},
+                    std::pair{"clock_rate_sd", &p.clock_rate_sd}};
+}
+
 StrapdownIns::Params readIns(const ParamSource& in) {
   StrapdownIns::Params p;
   p.anchor = readAnchor(in);
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
-  for (auto [key, value] : {std::pair{"T", &p.T}, {"gyro_sd", &p.gyro_sd}, {"accel_sd", &p.accel_sd},
-                            {"gnss_sd", &p.gnss_sd}, {"gnss_sd_scale", &p.gnss_sd_scale},
-                            {"gnss_vel_sd", &p.gnss_vel_sd}, {"gnss_vel_sd_scale", &p.gnss_vel_sd_scale},
-                            {"gnss_vel_latency", &p.gnss_vel_latency}, {"nhc_sd", &p.nhc_sd},
-                            {"nhc_down_sd", &p.nhc_down_sd},
-                            {"zupt_sd", &p.zupt_sd}, {"zaru_sd", &p.zaru_sd},
-                            {"clock_wander_sd", &p.clock_wander_sd}, {"gyro_bias_walk", &p.gyro_bias_walk},
-                            {"nhc_ekf_gate", &p.nhc_ekf_gate}})
-    *value = in.real("model", key, *value);
-  for (auto [key, value] : {std::pair{"lever", &p.lever}, {"gyro_bias", &p.gyro_bias}, {"accel_bias", &p.accel_bias},
-                            {"gyro_scale", &p.gyro_scale}, {"accel_scale", &p.accel_scale}})
+  p.T = in.real("model", "T", p.T);
+  for (auto [key, value] : modelReals(p)) *value = in.real("model", key, *value);
+  for (auto [key, value] : calibrationPriors(p))
     if (in.has("prior", key)) *value = in.vector("prior", key, 3);
   p.delay = in.real("prior", "delay", p.delay);
   p.clock_rate = in.real("prior", "clock_rate", p.clock_rate);
@@ -548,15 +580,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   if (in.has("prior", "start_rpy")) p.start_rpy = in.vector("prior", "start_rpy", 3) * kDeg;
   if (in.has("prior", "start_velocity")) p.start_velocity = in.vector("prior", "start_velocity", 3);
   if (in.has("prior", "start_position")) p.start_position = in.vector("prior", "start_position", 3);
-  p.attitude_sd = in.real("prior", "attitude_sd", p.attitude_sd / kDeg) * kDeg;
-  p.mount_sd = in.real("prior", "mount_sd", p.mount_sd / kDeg) * kDeg;
-  p.start_heading_sd = in.real("prior", "heading_sd", p.start_heading_sd / kDeg) * kDeg;
-  for (auto [key, value] : {std::pair{"velocity_sd", &p.velocity_sd}, {"position_sd", &p.position_sd},
-                            {"gyro_bias_sd", &p.gyro_bias_sd}, {"accel_bias_sd", &p.accel_bias_sd},
-                            {"lever_sd", &p.lever_sd}, {"delay_sd", &p.delay_sd},
-                            {"gyro_scale_sd", &p.gyro_scale_sd}, {"accel_scale_sd", &p.accel_scale_sd},
-                            {"clock_rate_sd", &p.clock_rate_sd}})
-    *value = in.real("prior", key, *value);
+  for (auto [key, value] : angleSds(p)) *value = in.real("prior", key, *value / kDeg) * kDeg;
+  for (auto [key, value] : priorSds(p)) *value = in.real("prior", key, *value);
   return p;
 }
 
@@ -565,30 +590,16 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.real("model", "imu_per_state", p.imu_per_state);
   out.vector("model", "anchor", Eigen::Vector3d(p.anchor.lat / kDeg, p.anchor.lon / kDeg, p.anchor.height));
   out.vector("model", "mount_rpy", p.mount_rpy / kDeg);
-  for (auto [key, value] : {std::pair{"gyro_sd", p.gyro_sd}, {"accel_sd", p.accel_sd}, {"gnss_sd", p.gnss_sd},
-                            {"gnss_sd_scale", p.gnss_sd_scale}, {"gnss_vel_sd", p.gnss_vel_sd},
-                            {"gnss_vel_sd_scale", p.gnss_vel_sd_scale}, {"gnss_vel_latency", p.gnss_vel_latency},
-                            {"nhc_sd", p.nhc_sd}, {"nhc_down_sd", p.nhc_down_sd},
-                            {"zupt_sd", p.zupt_sd}, {"zaru_sd", p.zaru_sd},
-                            {"clock_wander_sd", p.clock_wander_sd}, {"gyro_bias_walk", p.gyro_bias_walk},
-                            {"nhc_ekf_gate", p.nhc_ekf_gate}})
-    out.real("model", key, value);
+  for (auto [key, value] : modelReals(p)) out.real("model", key, *value);
   writeLoss(p.nhc_loss, "model", out, "nhc_");
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);
   out.vector("prior", "start_velocity", p.start_velocity);
   out.vector("prior", "start_position", p.start_position);
-  for (auto [key, value] : {std::pair{"lever", &p.lever}, {"gyro_bias", &p.gyro_bias}, {"accel_bias", &p.accel_bias},
-                            {"gyro_scale", &p.gyro_scale}, {"accel_scale", &p.accel_scale}})
-    out.vector("prior", key, *value);
+  for (auto [key, value] : calibrationPriors(p)) out.vector("prior", key, *value);
   out.real("prior", "delay", p.delay);
   out.real("prior", "clock_rate", p.clock_rate);
-  for (auto [key, value] : {std::pair{"attitude_sd", p.attitude_sd / kDeg},
-                            {"heading_sd", p.start_heading_sd / kDeg}, {"velocity_sd", p.velocity_sd},
-                            {"position_sd", p.position_sd}, {"gyro_bias_sd", p.gyro_bias_sd},
-                            {"accel_bias_sd", p.accel_bias_sd}, {"lever_sd", p.lever_sd}, {"mount_sd", p.mount_sd / kDeg},
-                            {"delay_sd", p.delay_sd}, {"gyro_scale_sd", p.gyro_scale_sd},
-                            {"accel_scale_sd", p.accel_scale_sd}, {"clock_rate_sd", p.clock_rate_sd}})
-    out.real("prior", key, value);
+  for (auto [key, value] : angleSds(p)) out.real("prior", key, *value / kDeg);
+  for (auto [key, value] : priorSds(p)) out.real("prior", key, *value);
 }
 
 const ModelRegistration strapdown_ins_registration{{

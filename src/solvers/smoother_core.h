@@ -36,6 +36,8 @@ class SmootherCore {
  private:
   void relinearize(const std::vector<int>& candidates, double threshold, UpdateReport& rep,
                    internal::EngineCounts& counts);
+  template <class Gather>
+  void relinearizeUntilSettled(int rounds, UpdateReport& rep, internal::EngineCounts& counts, Gather gather);
   void iterateToConvergence(UpdateReport& rep, internal::EngineCounts& counts);
   double levenbergMarquardt(UpdateReport& rep, internal::EngineCounts& counts, double& tree_lambda);
   double reEliminateUndamped(UpdateReport& rep, internal::EngineCounts& counts, double cost);

@@ -240,6 +240,20 @@ void SmootherCore::newtonPolishTree(UpdateReport& rep, internal::EngineCounts& c
   else if (!failure.empty()) rep.note = "Newton polish stopped: " + failure;
 }
 
+// Relinearizes the factors `gather` puts in the slots buffer, gathered
+// anew each round (the last round moved the estimates), until none is
+// stale or a relinearization fails, at most `rounds` times.
+template <class Gather>
+void SmootherCore::relinearizeUntilSettled(int rounds, UpdateReport& rep, internal::EngineCounts& counts,
+                                           Gather gather) {
+  for (int round = 0; round < rounds; ++round) {
+    gather(local_slots_);
+    const int before = rep.iterations;
+    relinearize(local_slots_, options.relinearize_threshold, rep, counts);
+    if (rep.iterations == before) return;  // nothing was stale
+  }
+}
+
 // Old factors all touch the constants: check them all, in one bounded pass,
 // only when the constants moved enough to matter (in buffers: this runs
 // after every update).
@@ -258,12 +272,10 @@ void SmootherCore::checkAllWhenTheConstantsMoved(UpdateReport& rep, internal::En
   engine.marginalSd(Key::constants(), sd);
   const double moved = ((xb - constants_at_last_check_).cwiseAbs().array() / sd.array()).maxCoeff();
   if (moved <= options.constants_check_sigmas) return;
-  for (int round = 0; round < options.full_pass_rounds; ++round) {
-    const int before = rep.iterations;
+  relinearizeUntilSettled(options.full_pass_rounds, rep, counts, [&](std::vector<int>& slots) {
     counts.variables_backsubstituted += engine.solveAll();
-    relinearize(engine.nonlinearSlots(), options.relinearize_threshold, rep, counts);
-    if (rep.iterations == before) break;  // nothing was stale
-  }
+    slots = engine.nonlinearSlots();
+  });
   rep.relinearization_pass = true;
   engine.estimateInto(Key::constants(), constants_at_last_check_);
   held_at_last_pass_ = static_cast<std::int64_t>(engine.numVariables());
@@ -291,17 +303,13 @@ UpdateReport SmootherCore::apply(const std::vector<FactorPtr>& new_factors, cons
   } else {
     // Start-up nonlinearity: relinearize the factors of the top, which is
     // being re-eliminated anyway.
-    for (int it = 0; it < options.max_local_iterations; ++it) {
-      std::vector<int>& local = local_slots_;
+    relinearizeUntilSettled(options.max_local_iterations, rep, counts, [&](std::vector<int>& local) {
       internal::clearKeepingSmall(local);  // a whole-history top grew it
       for (const auto& k : counts.top)
         if (!k.isConstants()) engine.appendSlotsOf(k, local);
       std::sort(local.begin(), local.end());
       local.erase(std::unique(local.begin(), local.end()), local.end());
-      const int before = rep.iterations;
-      relinearize(local, options.relinearize_threshold, rep, counts);
-      if (rep.iterations == before) break;
-    }
+    });
     if (engine.hasVariable(Key::constants())) checkAllWhenTheConstantsMoved(rep, counts);
   }
   rep.cliques_reeliminated = counts.cliques_reeliminated;
