@@ -23,14 +23,16 @@ struct SimulatedDrive {
   Eigen::VectorXd constants;            ///< true x_b
 };
 
-/// The vehicle's desired attitude (roll 0, a pitch for the hills, a yaw
-/// for the turns) and forward speed at t: standing 5 s, then driving.
-inline void vehicleAt(double t, Eigen::Matrix3d& R_nv, double& speed) {
+/// The vehicle's desired attitude (a pitch for the hills, a yaw for the
+/// turns, a roll rocking at 0.5 Hz by roll_amplitude rad while driving) and
+/// forward speed at t: standing 5 s, then driving.
+inline void vehicleAt(double t, Eigen::Matrix3d& R_nv, double& speed, double roll_amplitude = 0.0) {
   const double drive = std::max(0.0, t - 5.0);
   speed = std::min(10.0, 2.0 * drive);
   const double yaw = 0.3 + (drive > 0 ? 0.25 * 30 / (2 * M_PI) * (1 - std::cos(2 * M_PI * drive / 30)) : 0.0);
   const double pitch = 0.05 * std::sin(2 * M_PI * drive / 40);
-  R_nv = so3::fromRollPitchYaw(Eigen::Vector3d(0.0, pitch, yaw));
+  const double roll = roll_amplitude * std::sin(2 * M_PI * drive / 2);
+  R_nv = so3::fromRollPitchYaw(Eigen::Vector3d(roll, pitch, yaw));
 }
 
 /// The IMU's roll, pitch, yaw at the drive's start, mounted at `mount_rpy`
@@ -42,16 +44,31 @@ inline Eigen::Vector3d driveStartRpy(const Eigen::Vector3d& mount_rpy) {
   return so3::rollPitchYaw(R_nv * so3::fromRollPitchYaw(mount_rpy));
 }
 
+/// The IMU's velocity in vehicle axes for the vehicle's forward speed and
+/// its rate Ω (vehicle axes): the constraints hold at the model's points
+/// (Params::nhc_point, the truth's where they are constants), so the IMU
+/// moves sideways by −(Ω×r_side)_y and vertically by −(Ω×r_vert)_z.
+inline Eigen::Vector3d imuVelocityInVehicle(const models::StrapdownIns& model, const Eigen::VectorXd& constants,
+                                            double speed, const Eigen::Vector3d& Omega) {
+  const Eigen::Vector4d r = model.nhcPoint(constants);
+  const Eigen::Vector3d side = Omega.cross(Eigen::Vector3d(r[0], 0, r[1]));
+  const Eigen::Vector3d vert = Omega.cross(Eigen::Vector3d(r[2], r[3], 0));
+  return {speed, -side.y(), -vert.z()};
+}
+
 /// Drives `seconds` with `model` (its T the IMU interval); the constants
-/// drawn from the model's prior, the start its prior mean.
-inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double seconds, const NormalSampler& draw) {
+/// drawn from the model's prior, the start its prior mean; the body rocks
+/// in roll by roll_amplitude (rad) while driving. A constraint at points
+/// off the IMU carries the step's gyro reading (Measurement::regressors).
+inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double seconds, const NormalSampler& draw,
+                                    double roll_amplitude = 0.0) {
   SimulatedDrive d;
   const double T = model.nominalStep();
   d.constants = sampleGaussian(model.priorConstants().mean, model.priorConstants().covariance, draw);
   const Eigen::Matrix3d R_vb = model.mounting(d.constants);
   Eigen::Matrix3d R_nv;
   double speed;
-  vehicleAt(0, R_nv, speed);
+  vehicleAt(0, R_nv, speed, roll_amplitude);
   Eigen::VectorXd x(models::StrapdownIns::kStates);
   x << so3::Log(R_nv * R_vb), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0;
   d.states.push_back(x);
@@ -61,12 +78,13 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
     const double t = k * T;
     // The IMU's true rate and specific force that take the state to the
     // desired attitude and velocity at t + T under the model's step.
-    vehicleAt(t + T, R_nv, speed);
+    vehicleAt(t + T, R_nv, speed, roll_amplitude);
     const Eigen::Matrix3d R = so3::Exp(x.head<3>());
     const Eigen::Matrix3d R_next = R_nv * R_vb;
-    const Eigen::Vector3d v = x.segment<3>(3), v_next = R_nv * Eigen::Vector3d(speed, 0, 0);
     const Eigen::Vector3d w_ie = model.frame().earthRate();
     const Eigen::Vector3d gyro = so3::Log(R.transpose() * so3::Exp(w_ie * T) * R_next) / T;
+    const Eigen::Vector3d v = x.segment<3>(3);
+    const Eigen::Vector3d v_next = R_nv * imuVelocityInVehicle(model, d.constants, speed, R_vb * gyro);
     const Eigen::Vector3d accel =
         R.transpose() * ((v_next - v) / T - model.frame().gravity(x.segment<3>(6)) + 2 * w_ie.cross(v));
     Eigen::VectorXd u(6);
@@ -88,7 +106,9 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
     if (n % per_constraint == 0) {
       const bool standing = tn < 5.0;
       const int c = standing ? Ins::kZupt : Ins::kNhc;
-      d.measurements.push_back({tn, Eigen::VectorXd::Zero(model.channel(c).dim()), c, {}});
+      const bool reads_rate = model.channel(c).regressors > 0;
+      d.measurements.push_back({tn, Eigen::VectorXd::Zero(model.channel(c).dim()), c, {},
+                                reads_rate ? Eigen::VectorXd(u.head<3>()) : Eigen::VectorXd()});
     }
   }
   return d;

@@ -52,10 +52,20 @@ StrapdownIns::Params driveParams(double T) {
 }
 
 TEST(StrapdownIns, JacobiansMatchTangentDifferencesAtEveryAttitude) {
-  for (double walk : {0.0, 1e-4}) {  // the gyro bias constant, then with its walking part β_g in x_c
+  // the gyro bias constant, then with its walking part β_g in x_c; the
+  // vehicle constraints at the IMU, then at points off it (three of them
+  // constants, one held at its mean)
+  for (double walk : {0.0, 1e-4})
+  for (bool points : {false, true}) {
   StrapdownIns::Params params = driveParams(0.01);
   params.gyro_bias_walk = walk;
+  if (points) {
+    params.nhc_point << 0.2, 0.7, 1.1, -0.3;
+    params.nhc_point_sd << 0.5, 1.0, 0.0, 0.4;
+  }
   const StrapdownIns model(params);
+  ASSERT_EQ(model.dims().nb, StrapdownIns::kConstants + (points ? 3 : 0));
+  ASSERT_EQ(model.channel(StrapdownIns::kNhc).regressors, points ? 3 : 0);
   ASSERT_EQ(model.dims().nc, walk > 0 ? 13 : 10);
   const std::vector<Eigen::Vector3d> rpy{{0.01, -0.02, 0.3}, {0.3, M_PI / 2, 1.0}, {0.1, -0.2, M_PI - 1e-6},
                                          {0.0, 0.0, -M_PI + 1e-6}, {M_PI - 1e-3, 0.2, 2.0}};
@@ -64,8 +74,10 @@ TEST(StrapdownIns, JacobiansMatchTangentDifferencesAtEveryAttitude) {
     p.xc = testing::uniformVector(rng, model.dims().nc, -20, 20);
     if (walk > 0) p.xc.tail<3>() *= 1e-4;  // β_g in rad/s
     p.xc.head<3>() = so3::Log(so3::fromRollPitchYaw(rpy[std::uniform_int_distribution<std::size_t>(0, rpy.size() - 1)(rng)]));
-    p.xb = testing::uniformVector(rng, StrapdownIns::kConstants, -0.1, 0.1);
+    p.xb = testing::uniformVector(rng, model.dims().nb, -0.1, 0.1);
     p.xb.segment<3>(StrapdownIns::kLever) = testing::uniformVector(rng, 3, -1, 1);
+    p.xb.tail(model.dims().nb - StrapdownIns::kConstants) =
+        testing::uniformVector(rng, model.dims().nb - StrapdownIns::kConstants, -1.5, 1.5);
     p.u = testing::uniformVector(rng, 6, -1, 1);
     p.u[5] -= 9.8;
     p.dt = 0.01;
@@ -74,21 +86,81 @@ TEST(StrapdownIns, JacobiansMatchTangentDifferencesAtEveryAttitude) {
   }
 }
 
+// The vehicle constraints at points off the IMU against the velocity of
+// those points computed another way: in NED, v + R·(ω×r_b) with r_b the
+// point in the IMU's axes (R_vbᵀ·r), then in vehicle axes. A component
+// whose σ is 0 stays at its mean; the points' constants are named; h
+// without the gyro's reading is refused, naming hWith; at the IMU the
+// channel reads nothing and is the velocity at the IMU.
+TEST(StrapdownIns, NhcAtPointsIsThosePointsVelocityInVehicleAxes) {
+  StrapdownIns::Params params = driveParams(0.01);
+  params.nhc_point << 0.3, 0.8, 1.2, -0.4;
+  params.nhc_point_sd << 1.0, 1.0, 0.0, 0.5;
+  const StrapdownIns model(params);
+  const std::vector<std::string> tail(model.names().constants.end() - 3, model.names().constants.end());
+  EXPECT_EQ(tail, (std::vector<std::string>{"nhc_side_f", "nhc_side_d", "nhc_vert_r"}));
+  EXPECT_EQ(model.nhcPointIndex(2), -1);
+  const int b = StrapdownIns::kConstants;
+  EXPECT_EQ(model.priorConstants().mean.tail<3>(), Eigen::Vector3d(0.3, 0.8, -0.4));
+  EXPECT_EQ(model.priorConstants().covariance.diagonal().tail<3>(), Eigen::Vector3d(1.0, 1.0, 0.25));
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 10; ++trial) {
+    Eigen::VectorXd xc(model.dims().nc), xb = testing::uniformVector(rng, model.dims().nb, -0.05, 0.05);
+    xc << so3::Log(so3::fromRollPitchYaw(testing::uniformVector(rng, 3, -3, 3))), testing::uniformVector(rng, 3, -10, 10),
+        testing::uniformVector(rng, 3, -100, 100), 20.0;
+    xb.tail<3>() = testing::uniformVector(rng, 3, -1.5, 1.5);
+    const Eigen::Vector3d gyro = testing::uniformVector(rng, 3, -0.5, 0.5);
+    const Eigen::Vector3d omega =
+        gyro - xb.segment<3>(StrapdownIns::kGyroScale).cwiseProduct(gyro) - xb.segment<3>(StrapdownIns::kGyroBias);
+    const Eigen::Matrix3d R = so3::Exp(xc.head<3>()), R_vb = model.mounting(xb);
+    auto vehicleVelocityAt = [&](const Eigen::Vector3d& r) -> Eigen::Vector3d {
+      const Eigen::Vector3d v_ned = xc.segment<3>(3) + R * omega.cross(R_vb.transpose() * r);
+      return R_vb * R.transpose() * v_ned;
+    };
+    const Eigen::Vector3d side(xb[b], 0, xb[b + 1]), vert(1.2, xb[b + 2], 0);
+    const Eigen::VectorXd y = model.hWith(StrapdownIns::kNhc, gyro, xc, xb);
+    EXPECT_NEAR(y[0], vehicleVelocityAt(side).y(), 1e-12);
+    EXPECT_NEAR(y[1], vehicleVelocityAt(vert).z(), 1e-12);
+    EXPECT_GT(std::abs(y[0] - (R_vb * R.transpose() * xc.segment<3>(3)).y()), 1e-3);  // the points matter
+  }
+  Eigen::VectorXd xc = model.priorState().mean, xb = model.priorConstants().mean;
+  testing::expectThrowsNaming<InvalidArgument>([&] { model.h(StrapdownIns::kNhc, xc, xb); }, "hWith");
+  const StrapdownIns at_imu(driveParams(0.01));
+  EXPECT_EQ(at_imu.channel(StrapdownIns::kNhc).regressors, 0);
+  EXPECT_EQ(at_imu.dims().nb, StrapdownIns::kConstants);
+  xc.segment<3>(3) << 3, -1, 0.5;
+  const Eigen::Matrix3d R_vb = at_imu.mounting(xb.head(StrapdownIns::kConstants));
+  EXPECT_LT((at_imu.h(StrapdownIns::kNhc, xc, xb.head(StrapdownIns::kConstants)) -
+             (R_vb * so3::Exp(xc.head<3>()).transpose() * xc.segment<3>(3)).tail<2>())
+                .norm(),
+            1e-12);
+  params.nhc_point_sd[1] = -1;
+  testing::expectThrowsNaming<InvalidArgument>([&] { StrapdownIns{params}; }, "nhc_point_sd >= 0");
+}
+
 // Model::report against central differences on the stacked tangent (its
 // sds: J·Σ·Jᵀ) and against the model's own pieces (its values).
 TEST(StrapdownIns, ReportsAntennaVehicleAttitudeAndConstantsWithFirstOrderSds) {
-  for (double walk : {0.0, 1e-4}) {  // with β_g the reported gyro bias is b_g + β_g
+  // with β_g the reported gyro bias is b_g + β_g; the constraints' points
+  // that are constants are reported as they are, after the others
+  for (double walk : {0.0, 1e-4}) {
   StrapdownIns::Params params = driveParams(0.01);
   params.gyro_bias_walk = walk;
+  if (walk > 0) params.nhc_point_sd << 1.0, 1.0, 0.0, 0.0;
   const StrapdownIns model(params);
-  const int nc = model.dims().nc, n = nc + StrapdownIns::kConstants;
+  const int nc = model.dims().nc, nb = model.dims().nb, n = nc + nb;
+  if (walk > 0) {
+    const std::vector<std::string> names = model.reportNames();
+    EXPECT_EQ(std::vector<std::string>(names.end() - 2, names.end()),
+              (std::vector<std::string>{"nhc_side_f", "nhc_side_d"}));
+  }
   const std::vector<int> angles{6, 7, 8, 19, 20, 21};  // degrees: differences wrap
   std::mt19937 rng(11);
   for (int trial = 0; trial < 6; ++trial) {
     Eigen::VectorXd x(n);
     x.head<10>() << so3::Log(so3::fromRollPitchYaw(testing::uniformVector(rng, 3, -1.2, 1.2))),
         testing::uniformVector(rng, 6, -50, 50), 100.0;
-    x.tail(StrapdownIns::kConstants) = testing::uniformVector(rng, StrapdownIns::kConstants, -0.05, 0.05);
+    x.tail(nb) = testing::uniformVector(rng, nb, -0.05, 0.05);
     x.segment(10, nc - 10) = testing::uniformVector(rng, nc - 10, -0.01, 0.01);
     const Eigen::MatrixXd A = testing::uniformVector(rng, n * n, -0.03, 0.03).reshaped(n, n);
     const Eigen::MatrixXd cov = A * A.transpose();
@@ -115,7 +187,8 @@ TEST(StrapdownIns, ReportsAntennaVehicleAttitudeAndConstantsWithFirstOrderSds) {
     for (int i = 0; i < m; ++i)
       EXPECT_NEAR(sd[i], numeric[i], (i < 3 ? 1e-3 : 1e-6) * numeric[i] + 1e-12)
           << model.reportNames()[static_cast<std::size_t>(i)] << " (gyro bias walk " << walk << ")";
-    const Eigen::VectorXd xc = x.head(nc), xb = x.tail(StrapdownIns::kConstants);
+    const Eigen::VectorXd xc = x.head(nc), xb = x.tail(nb);
+    EXPECT_EQ(value.tail(nb - StrapdownIns::kConstants), xb.tail(nb - StrapdownIns::kConstants));
     const Eigen::Vector3d bias = xb.head<3>() + (walk > 0 ? Eigen::Vector3d(xc.tail<3>()) : Eigen::Vector3d::Zero());
     EXPECT_LT((value.segment<3>(9) - bias).norm(), 1e-15);
     const geodesy::Geodetic g = model.frame().local().toGeodetic(model.h(StrapdownIns::kGnss, xc, xb));
@@ -163,7 +236,10 @@ TEST(StrapdownIns, TrackPosReadsBackAsTheReportedAntenna) {
 }
 
 TEST(StrapdownIns, RoundTripsThroughItsIniForm) {
-  const StrapdownIns model(driveParams(0.01));
+  StrapdownIns::Params params = driveParams(0.01);
+  params.nhc_point << 0.1, 0.8, 0.0, 0.05;
+  params.nhc_point_sd << 0.0, 1.0, 0.5, 0.0;
+  const StrapdownIns model(params);
   io::IniDocument ini;
   io::writeModel(model, ini);
   const auto again = io::makeModel(io::IniDocument::parse(ini.toString(), "ins.ini"));
@@ -175,6 +251,9 @@ TEST(StrapdownIns, RoundTripsThroughItsIniForm) {
   const auto& p = dynamic_cast<const StrapdownIns&>(*again).params();
   EXPECT_NEAR(p.anchor.lat, model.params().anchor.lat, 1e-15);
   EXPECT_LT((p.mount_rpy - model.params().mount_rpy).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(p.nhc_point, params.nhc_point);
+  EXPECT_EQ(p.nhc_point_sd, params.nhc_point_sd);
+  EXPECT_EQ(again->names().constants, model.names().constants);
 }
 
 // [prior] gyro_bias, accel_bias, gyro_scale, accel_scale, delay, clock_rate:
@@ -512,6 +591,40 @@ TEST(StrapdownIns, StandingFixesGiveZeroVelocityAndTheGyrosMeanReading) {
   EXPECT_NEAR(static_cast<double>(nhc), 271.1 * 10, 2);
 }
 
+// The drive's constraints hold at a point off the IMU ([prior] nhc_point_sd):
+// each 10 Hz zero carries the gyro's mean reading over its interval,
+// t ± 0.05 s, checked against the IMU rows themselves; at the IMU they
+// carry nothing.
+TEST(StrapdownIns, ConstraintsAtPointsCarryTheGyrosMeanReading) {
+  const std::string dir = GSSM_SOURCE_DIR "/datasets/gnss-ins-drive";
+  io::IniDocument ini = io::readScenario(dir);
+  ini.set("model", "imu_per_state", "1");  // the raw readings, one input each
+  ini.set("prior", "nhc_point_sd", "0 1 0 0");
+  for (bool points : {true, false}) {
+    if (!points) ini.set("prior", "nhc_point_sd", "0 0 0 0");
+    const auto model = io::makeModel(ini, dir);
+    io::Dataset ds;
+    io::readDatasetData(dir, *model, ds, io::BadRows::Throw, &ini);
+    std::size_t nhc = 0;
+    for (const Measurement& m : ds.measurements) {
+      if (m.channel != StrapdownIns::kNhc) continue;
+      ++nhc;
+      if (!points) {
+        EXPECT_EQ(m.regressors.size(), 0);
+        continue;
+      }
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int n = 0;
+      for (const Input& u : ds.inputs)
+        if (u.t >= m.t - 0.05 && u.t <= m.t + 0.05) sum += u.u.head<3>(), ++n;
+      ASSERT_GE(n, 9) << "at t = " << m.t;
+      ASSERT_EQ(m.regressors.size(), 3);
+      EXPECT_LT((m.regressors - sum / n).norm(), 1e-12) << "at t = " << m.t;
+    }
+    EXPECT_NEAR(static_cast<double>(nhc), 271.1 * 10, 2) << (points ? "at points" : "at the IMU");
+  }
+}
+
 // [dataset] gnss_velocity_channel: every used fix brings its own velocity
 // (NED, its σs) with the gyro's mean reading within ±window/2 of it and
 // the velocity's rate of change between its used neighbours, checked
@@ -599,6 +712,35 @@ TEST(StrapdownIns, BatchRecoversTheConstantsOfASimulatedDrive) {
       if (!ok) std::cout << "seed " << seed << " " << model.names().constants[static_cast<std::size_t>(i)] << ": "
                          << end.mean[j] << " vs " << d.constants[i] << " (σ " << sd << ")\n";
     }
+  }
+  std::cout << inside << " of " << total << " constants within 2σ\n";
+  EXPECT_GE(inside, 0.9 * total);
+}
+
+// The constraints' points of a simulated drive whose body rocks in roll
+// (0.05 rad at 0.5 Hz: the IMU then moves sideways by the roll rate times
+// its height over the side point): the batch holds each constant, the
+// points' too, within 2 reported σ of its truth in at least 90 % of the
+// (seed, constant) pairs, and it knows the side point's depth (σ well under
+// its 1 m prior).
+TEST(StrapdownIns, BatchRecoversTheConstraintsPointsOfARollingDrive) {
+  StrapdownIns::Params params = driveParams(0.02);
+  params.nhc_point_sd << 0.5, 1.0, 0.5, 0.5;
+  const StrapdownIns model(params);
+  const int nb = model.dims().nb, depth = StrapdownIns::kStates + model.nhcPointIndex(1);
+  int inside = 0, total = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const testing::SimulatedDrive d = testing::simulateDrive(model, 40.0, testing::normalSampler(900 + seed), 0.05);
+    const EstimateRow end = runOffline(model, {Method::Batch}, d.measurements, d.inputs).rows.back();
+    for (int i = 0; i < nb; ++i, ++total) {
+      const int j = StrapdownIns::kStates + i;
+      const double err = end.mean[j] - d.constants[i], sd = std::sqrt(end.covariance(j, j));
+      inside += std::abs(err) <= 2 * sd;
+      if (std::abs(err) > 2 * sd)
+        std::cout << "seed " << seed << " " << model.names().constants[static_cast<std::size_t>(i)] << ": "
+                  << end.mean[j] << " vs " << d.constants[i] << " (σ " << sd << ")\n";
+    }
+    EXPECT_LT(std::sqrt(end.covariance(depth, depth)), 0.1) << "seed " << seed;
   }
   std::cout << inside << " of " << total << " constants within 2σ\n";
   EXPECT_GE(inside, 0.9 * total);

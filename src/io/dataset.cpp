@@ -14,6 +14,7 @@
 #include "gssm/core/time.h"
 #include "gssm/io/csv.h"
 #include "io/gnss_measurements.h"
+#include "io/input_window.h"
 
 namespace gssm::io {
 
@@ -72,7 +73,9 @@ std::vector<IniKey> datasetIniKeys() {
       {"gnss_still_rates", "word", "", "while standing, the mean of the inputs' first components since the previous fix on this channel"},
       {"gnss_velocity_channel", "word", "", "each used fix's own velocity on this channel, with the inputs' mean reading around it and the velocity's rate of change"},
       {"gnss_velocity_window", "number", "0.1", "the span (s) around a velocity fix over which the inputs are averaged"},
-      {"zero_channels", "words", "", "channels measured as zero at zero_rate (vehicle constraints)"},
+      {"zero_channels", "words", "",
+       "channels measured as zero at zero_rate (vehicle constraints; a channel that reads known values gets the "
+       "inputs' mean over each zero's interval)"},
       {"zero_rate", "number", "0", "rate (Hz) of the zero_channels' pseudo-measurements"},
       {"zero_at_inputs", "bool", "false", "each zero measurement at the input reading nearest its time (no state of its own between readings)"}};
 }
@@ -487,7 +490,9 @@ double zeroTimeAtInputs(const Dataset& d, double t) {
 // of a step's end (on the GNSS/INS drive 2406 of 5521 steps were under 10
 // ms, down to 0.14 ms: a position's process noise ∝ dt³ then dwarfs the
 // data's information in rounding, and a batch ending in an outage did not
-// factor).
+// factor). A channel whose h reads known values (a vehicle constraint at a
+// point off the IMU: the body's rate) gets the mean of the inputs' first
+// ones over the zero's interval, t ± 0.5/rate (none without a reading).
 void addZeroMeasurements(const IniDocument& ini, const Model& model, Dataset& out) {
   const double rate = ini.getDouble("dataset", "zero_rate", 0.0);
   if (!(rate > 0) || !std::isfinite(rate))
@@ -506,7 +511,17 @@ void addZeroMeasurements(const IniDocument& ini, const Model& model, Dataset& ou
     if (at_inputs) t = zeroTimeAtInputs(out, t);
     if (!(t > last)) continue;  // at or before t0, or two on one reading (a gap in the inputs)
     last = t;
-    for (int c : channels) zeros.emplace_back(t, Eigen::VectorXd::Zero(model.channel(c).dim()), c);
+    for (int c : channels) {
+      Eigen::VectorXd known;  // a channel that reads the inputs: their mean over the zero's interval
+      if (const int k = model.channel(c).regressors; k > 0) {
+        auto first = std::lower_bound(out.inputs.begin(), out.inputs.end(), t - 0.5 / rate,
+                                      [](const Input& u, double x) { return u.t < x; });
+        const int n = sumInputs(first, out.inputs, t + 0.5 / rate, k, known);
+        if (n == 0) continue;  // no reading to read
+        known /= n;
+      }
+      zeros.emplace_back(t, Eigen::VectorXd::Zero(model.channel(c).dim()), c, Eigen::MatrixXd(), known);
+    }
   }
   std::vector<Measurement> merged;
   merged.reserve(out.measurements.size() + zeros.size());

@@ -9,6 +9,7 @@
 #include "gssm/io/csv.h"
 #include "gssm/io/number_text.h"
 #include "gssm/io/rtklib_pos.h"
+#include "io/input_window.h"
 
 namespace gssm::io {
 
@@ -54,16 +55,6 @@ struct StillFixes {
 };
 
 Eigen::Matrix3d neuToNed() { return Eigen::Vector3d(1, 1, -1).asDiagonal(); }
-
-// The sum of the inputs' first k components from `first` up to time `to`
-// (inclusive), and how many inputs it holds.
-int sumInputs(std::vector<Input>::const_iterator first, const std::vector<Input>& inputs, double to, int k,
-              Eigen::VectorXd& sum) {
-  sum.setZero(k);
-  int n = 0;
-  for (; first != inputs.end() && first->t <= to; ++first, ++n) sum += first->u.head(k);
-  return n;
-}
 
 // The mean of the inputs' first dim(channel) components over (from, to]
 // (the gyro's reading while the car stands still), as a measurement at `to`.

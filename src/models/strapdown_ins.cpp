@@ -1,6 +1,7 @@
 #include "gssm/models/strapdown_ins.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <sstream>
@@ -19,12 +20,21 @@ using so3::hat;
 
 int insStates(const StrapdownIns::Params& p) { return StrapdownIns::kStates + (p.gyro_bias_walk > 0 ? 3 : 0); }
 
+const char* const kNhcPointNames[4] = {"nhc_side_f", "nhc_side_d", "nhc_vert_f", "nhc_vert_r"};
+
+// Every INS's constants, then one per vehicle-constraint point with σ > 0.
+int insConstants(const StrapdownIns::Params& p) {
+  return StrapdownIns::kConstants + static_cast<int>((p.nhc_point_sd.array() > 0).count());
+}
+
 ModelNames insNames(const StrapdownIns::Params& p) {
   ModelNames n;
   n.state = {"att_x", "att_y", "att_z", "vn", "ve", "vd", "pn", "pe", "pd", "clock"};
   if (p.gyro_bias_walk > 0) n.state.insert(n.state.end(), {"bgw_x", "bgw_y", "bgw_z"});
   n.constants = {"bg_x", "bg_y", "bg_z", "ba_x", "ba_y", "ba_z", "lever_x", "lever_y", "lever_z",
                  "mount_roll", "mount_pitch", "mount_yaw", "imu_delay", "sg_x", "sg_y", "sg_z", "sa_x", "sa_y", "sa_z", "clock_rate"};
+  for (int i = 0; i < 4; ++i)
+    if (p.nhc_point_sd[i] > 0) n.constants.push_back(kNhcPointNames[i]);
   n.input = {"gx", "gy", "gz", "ax", "ay", "az"};
   if (p.imu_per_state > 1) {  // dt_j, then the reading j: packed_inputs.h
     std::vector<std::string> packed;
@@ -72,6 +82,8 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
     throw InvalidArgument("StrapdownIns: gnss_vel_latency must be >= 0 (s)");
   if (!(p.nhc_ekf_gate >= 0) || !std::isfinite(p.nhc_ekf_gate))
     throw InvalidArgument("StrapdownIns: nhc_ekf_gate must be >= 0 (0: no gate)");
+  if (!(p.nhc_point_sd.array() >= 0).all() || !p.nhc_point_sd.allFinite() || !p.nhc_point.allFinite())
+    throw InvalidArgument("StrapdownIns: nhc_point must be finite and nhc_point_sd >= 0 (0: held at its mean)");
   if (!(p.gyro_bias_walk >= 0) || !std::isfinite(p.gyro_bias_walk))
     throw InvalidArgument("StrapdownIns: gyro_bias_walk must be >= 0 (0: a constant gyro bias)");
   ModelNoise n;
@@ -92,7 +104,7 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   const Eigen::Vector3d down_in_body = R0.transpose() * Eigen::Vector3d::UnitZ();
   n.prior_state.covariance.topLeftCorner<3, 3>() +=
       p.start_heading_sd * p.start_heading_sd * down_in_body * down_in_body.transpose();
-  Eigen::VectorXd bmean = Eigen::VectorXd::Zero(StrapdownIns::kConstants), bsd(StrapdownIns::kConstants);
+  Eigen::VectorXd bmean = Eigen::VectorXd::Zero(insConstants(p)), bsd(insConstants(p));
   bmean.segment<3>(StrapdownIns::kGyroBias) = p.gyro_bias;
   bmean.segment<3>(StrapdownIns::kAccelBias) = p.accel_bias;
   bmean.segment<3>(StrapdownIns::kLever) = so3::fromRollPitchYaw(p.mount_rpy).transpose() * p.lever;  // IMU axes
@@ -103,6 +115,11 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   bsd << Eigen::Vector3d::Constant(p.gyro_bias_sd), Eigen::Vector3d::Constant(p.accel_bias_sd),
       Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd,
       Eigen::Vector3d::Constant(p.gyro_scale_sd), Eigen::Vector3d::Constant(p.accel_scale_sd), p.clock_rate_sd;
+  for (int i = 0, b = StrapdownIns::kConstants; i < 4; ++i)
+    if (p.nhc_point_sd[i] > 0) {
+      bmean[b] = p.nhc_point[i];
+      bsd[b++] = p.nhc_point_sd[i];
+    }
   n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
   return n;
 }
@@ -131,14 +148,23 @@ MeasurementChannel gnssVelocityChannel(const StrapdownIns::Params& p) {
 }  // namespace
 
 StrapdownIns::StrapdownIns(const Params& p)
-    : Model({insStates(p), kConstants, p.imu_per_state == 1 ? 6 : 7 * p.imu_per_state, 3}, insNames(p), insNoise(p)),
+    : Model({insStates(p), insConstants(p), p.imu_per_state == 1 ? 6 : 7 * p.imu_per_state, 3}, insNames(p),
+            insNoise(p)),
       p_(p),
       frame_(p.anchor),
-      mount0_(so3::fromRollPitchYaw(p.mount_rpy)) {
+      mount0_(so3::fromRollPitchYaw(p.mount_rpy)),
+      nhc_points_off_imu_(!p.nhc_point.isZero() || !p.nhc_point_sd.isZero()) {
+  for (int i = 0, b = kConstants; i < 4; ++i) nhc_point_index_[static_cast<std::size_t>(i)] = p.nhc_point_sd[i] > 0 ? b++ : -1;
   MeasurementChannel gnss =
       channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay, kClockRate});
   gnss.own_R_scale = p.gnss_sd_scale * p.gnss_sd_scale;
   MeasurementChannel nhc = channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11});
+  if (nhc_points_off_imu_) {  // the points turn with the body: the gyro's reading, its bias and scale
+    nhc.regressors = 3;
+    nhc.constants.insert(nhc.constants.end(), {0, 1, 2, 13, 14, 15});
+    for (int b = kConstants; b < insConstants(p); ++b) nhc.constants.push_back(b);
+    std::sort(nhc.constants.begin(), nhc.constants.end());
+  }
   nhc.loss = p.nhc_loss;
   nhc.ekf_gate = p.nhc_ekf_gate;
   setChannels({std::move(gnss), std::move(nhc),
@@ -213,7 +239,7 @@ Eigen::VectorXd StrapdownIns::stepResult(const Eigen::VectorXd& xc, const strapd
     }
   }
   if (J_f_xb) {
-    J_f_xb->setZero(nc, kConstants);
+    J_f_xb->setZero(nc, dims().nb);
     J_f_xb->block<9, 6>(0, kGyroBias) = Jb.leftCols<6>();  // b_g then b_a
     J_f_xb->block<9, 6>(0, kGyroScale) = Jb.rightCols<6>();  // s_g then s_a
   }
@@ -252,7 +278,10 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
                                 Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
   this->channel(channel);  // range check: throws, naming the channels
   if (channel == kGnss) return antenna(xc, xb, J_h_xc, J_h_xb);
-  if (channel == kNhc) return vehicleVelocity(xc, xb, J_h_xc, J_h_xb);
+  if (channel == kNhc && !nhcPointsOffImu()) return vehicleVelocity(xc, xb, Eigen::Vector3d::Zero(), J_h_xc, J_h_xb);
+  if (channel == kNhc)
+    throw InvalidArgument("StrapdownIns: channel 'nhc' holds at points off the IMU ([prior] nhc_point): it reads the "
+                          "gyro's mean reading there, evaluate it by hWith");
   if (channel == kZaru) return restingGyro(xc, xb, J_h_xc, J_h_xb);
   if (channel == kGnssVelocity)
     throw InvalidArgument("StrapdownIns: channel 'gnss_vel' reads the IMU's reading at the fix: evaluate it by hWith");
@@ -260,7 +289,7 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
     J_h_xc->setZero(3, dims().nc);
     J_h_xc->middleCols<3>(3).setIdentity();
   }
-  if (J_h_xb) J_h_xb->setZero(3, kConstants);
+  if (J_h_xb) J_h_xb->setZero(3, dims().nb);
   return xc.segment<3>(3);
 }
 
@@ -283,7 +312,7 @@ Eigen::VectorXd StrapdownIns::antenna(const Eigen::VectorXd& xc, const Eigen::Ve
     J_h_xc->col(kClock) = -xb[kClockRate] * v;
   }
   if (J_h_xb) {
-    J_h_xb->setZero(3, kConstants);
+    J_h_xb->setZero(3, dims().nb);
     J_h_xb->middleCols<3>(kLever) = R;
     J_h_xb->col(kDelay) = -v;
     J_h_xb->col(kClockRate) = -xc[kClock] * v;
@@ -291,25 +320,61 @@ Eigen::VectorXd StrapdownIns::antenna(const Eigen::VectorXd& xc, const Eigen::Ve
   return xc.segment<3>(6) + R * w - delay * v;
 }
 
-// The vehicle's velocity w = R_vb·Rᵀ·v, its right and down parts: with
-// u = Rᵀv, ∂/∂δθ = R_vb·[u]×, ∂/∂v = R_vb·Rᵀ, ∂/∂μ = −R_vb·[u]×·E.
+// The constraints' points (side f, d; vertical f, r) at the constants x_b.
+Eigen::Vector4d StrapdownIns::nhcPoint(const Eigen::VectorXd& xb) const {
+  Eigen::Vector4d r = p_.nhc_point;
+  for (int i = 0; i < 4; ++i)
+    if (nhcPointIndex(i) >= 0) r[i] = xb[nhcPointIndex(i)];
+  return r;
+}
+
+// The vehicle's velocity w = R_vb·Rᵀ·v at the IMU, its right and down
+// parts: with u = Rᵀv, ∂/∂δθ = R_vb·[u]×, ∂/∂v = R_vb·Rᵀ, ∂/∂μ =
+// −R_vb·[u]×·E; at points off the IMU, the body's turn there added
+// (addTurnAtPoints; gyro: the gyro's mean reading at the constraint).
 Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
-                                              Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+                                              const Eigen::Vector3d& gyro, Eigen::MatrixXd* J_h_xc,
+                                              Eigen::MatrixXd* J_h_xb) const {
   const Eigen::Matrix3d R = so3::Exp(xc.head<3>());
   Eigen::Matrix3d E;
   const Eigen::Matrix3d M = mounting(xb, &E);
   const Eigen::Vector3d u = R.transpose() * xc.segment<3>(3);
-  const Eigen::Vector3d w = M * u;
+  Eigen::Vector2d out = (M * u).tail<2>();
   if (J_h_xc) {
     J_h_xc->setZero(2, dims().nc);
     J_h_xc->leftCols<3>() = (M * hat(u)).bottomRows<2>();
     J_h_xc->middleCols<3>(3) = (M * R.transpose()).bottomRows<2>();
   }
   if (J_h_xb) {
-    J_h_xb->setZero(2, kConstants);
+    J_h_xb->setZero(2, dims().nb);
     J_h_xb->middleCols<3>(kMount) = (-M * hat(u) * E).bottomRows<2>();
   }
-  return w.tail<2>();
+  if (nhcPointsOffImu()) addTurnAtPoints(xc, xb, gyro, M, E, out, J_h_xc, J_h_xb);
+  return out;
+}
+
+// Ω×r at a point r from the IMU in vehicle axes, Ω = R_vb·ω the body's rate
+// (ω = (1 − s_g)∘ω̃ − b_g): sideways, r = (f, 0, d), Ω_z·f − Ω_x·d;
+// vertical, r = (f, r, 0), Ω_x·r − Ω_y·f. ∂Ω/∂μ = −R_vb·[ω]×·E,
+// ∂Ω/∂b_g = ∂Ω/∂β_g = −R_vb, ∂Ω/∂s_g = −R_vb·diag(ω̃).
+void StrapdownIns::addTurnAtPoints(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::Vector3d& gyro,
+                                   const Eigen::Matrix3d& M, const Eigen::Matrix3d& E, Eigen::Vector2d& out,
+                                   Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  const Eigen::Vector3d omega = gyro - xb.segment<3>(kGyroScale).cwiseProduct(gyro) - gyroBias(xc, xb);
+  const Eigen::Vector3d W = M * omega;
+  const Eigen::Vector4d r = nhcPoint(xb);
+  Eigen::Matrix<double, 2, 3> J_out_W;  // ∂(Ω×r)/∂Ω, its sideways and vertical rows
+  J_out_W << -r[1], 0, r[0], r[3], -r[2], 0;
+  out += J_out_W * W;
+  if (J_h_xc && gyroBiasWalks()) J_h_xc->middleCols<3>(kGyroWalk) = -J_out_W * M;
+  if (!J_h_xb) return;
+  J_h_xb->middleCols<3>(kMount) -= J_out_W * M * hat(omega) * E;
+  J_h_xb->middleCols<3>(kGyroBias) = -J_out_W * M;
+  J_h_xb->middleCols<3>(kGyroScale) = -J_out_W * M * gyro.asDiagonal();
+  Eigen::Matrix<double, 2, 4> J_out_r;  // ∂(Ω×r)/∂(f, d, f, r)
+  J_out_r << W.z(), -W.x(), 0, 0, 0, 0, -W.y(), W.x();
+  for (int i = 0; i < 4; ++i)
+    if (nhcPointIndex(i) >= 0) J_h_xb->col(nhcPointIndex(i)) = J_out_r.col(i);
 }
 
 // What the gyro reads while the car stands: its bias and the Earth's rate in
@@ -324,7 +389,7 @@ Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen
     if (gyroBiasWalks()) J_h_xc->middleCols<3>(kGyroWalk).setIdentity();
   }
   if (J_h_xb) {
-    J_h_xb->setZero(3, kConstants);
+    J_h_xb->setZero(3, dims().nb);
     J_h_xb->middleCols<3>(kGyroBias).setIdentity();
   }
   return gyroBias(xc, xb) + w;
@@ -342,6 +407,10 @@ Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen
 void StrapdownIns::hRegressedInto(int channel, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc,
                                   const Eigen::VectorXd& xb, Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc,
                                   Eigen::MatrixXd* J_h_xb) const {
+  if (channel == kNhc && nhcPointsOffImu()) {
+    out = vehicleVelocity(xc, xb, regressors, J_h_xc, J_h_xb);
+    return;
+  }
   if (channel != kGnssVelocity) return Model::hRegressedInto(channel, regressors, xc, xb, out, J_h_xc, J_h_xb);
   const Eigen::Vector3d gyro = regressors.head<3>(), a = regressors.tail<3>();
   const Eigen::Vector3d w = gyro - xb.segment<3>(kGyroScale).cwiseProduct(gyro) - gyroBias(xc, xb);
@@ -357,7 +426,7 @@ void StrapdownIns::hRegressedInto(int channel, const Eigen::VectorXd& regressors
     if (gyroBiasWalks()) J_h_xc->middleCols<3>(kGyroWalk) = R * hat(lever);
   }
   if (J_h_xb) {
-    J_h_xb->setZero(3, kConstants);
+    J_h_xb->setZero(3, dims().nb);
     J_h_xb->middleCols<3>(kGyroBias) = R * hat(lever);
     J_h_xb->middleCols<3>(kLever) = R * hat(w);
     J_h_xb->col(kDelay) = -a;
@@ -432,7 +501,12 @@ std::vector<ParamSpec> insParams() {
       vector("prior", "gyro_scale", "prior mean of each gyro axis's scale factor error (1 = 100 %; default 0)"),
       real("prior", "gyro_scale_sd", "prior σ of each gyro axis's scale factor error (1 = 100 %)"),
       vector("prior", "accel_scale", "prior mean of each accelerometer axis's scale factor error (default 0)"),
-      real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error")};
+      real("prior", "accel_scale_sd", "prior σ of each accelerometer axis's scale factor error"),
+      vector("prior", "nhc_point",
+             "where the vehicle constraints hold, from the IMU in vehicle axes (m): the sideways one's point "
+             "forward and down, the vertical one's forward and right (default 0 0 0 0: at the IMU)"),
+      vector("prior", "nhc_point_sd",
+             "their prior σs (m): each > 0 is a constant node, learnt with the others; 0 holds it at its mean")};
   for (auto& l : lossParams("model", "nhc_", "the vehicle constraints (nhc: a bump or a skid breaks them)"))
     p.push_back(l);
   p.push_back(param::real("model", "nhc_ekf_gate",
@@ -562,6 +636,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   for (auto [key, value] : modelReals(p)) *value = in.real("model", key, *value);
   for (auto [key, value] : calibrationPriors(p))
     if (in.has("prior", key)) *value = in.vector("prior", key, 3);
+  for (auto [key, value] : {std::pair{"nhc_point", &p.nhc_point}, {"nhc_point_sd", &p.nhc_point_sd}})
+    if (in.has("prior", key)) *value = in.vector("prior", key, 4);
   p.delay = in.real("prior", "delay", p.delay);
   p.clock_rate = in.real("prior", "clock_rate", p.clock_rate);
   p.nhc_loss = readLoss(in, "model", "nhc_");
@@ -596,6 +672,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("prior", "start_velocity", p.start_velocity);
   out.vector("prior", "start_position", p.start_position);
   for (auto [key, value] : calibrationPriors(p)) out.vector("prior", key, *value);
+  out.vector("prior", "nhc_point", p.nhc_point);
+  out.vector("prior", "nhc_point_sd", p.nhc_point_sd);
   out.real("prior", "delay", p.delay);
   out.real("prior", "clock_rate", p.clock_rate);
   for (auto [key, value] : angleSds(p)) out.real("prior", key, *value / kDeg);

@@ -16,21 +16,25 @@ constexpr int kTheta = 0, kVel = 3;
 }  // namespace
 
 std::vector<std::string> StrapdownIns::reportNames() const {
-  return {"lat",     "lon",     "height",  "vn",      "ve",      "vd",        "roll",       "pitch",
-          "yaw",     "bg_x",    "bg_y",    "bg_z",    "ba_x",    "ba_y",      "ba_z",       "lever_f",
-          "lever_r", "lever_d", "imu_delay", "mount_roll", "mount_pitch", "mount_yaw", "sg_x", "sg_y", "sg_z",
-          "sa_x", "sa_y", "sa_z", "clock_rate"};
+  std::vector<std::string> names{"lat",       "lon",        "height",      "vn",        "ve",     "vd",
+                                 "roll",      "pitch",      "yaw",         "bg_x",      "bg_y",   "bg_z",
+                                 "ba_x",      "ba_y",       "ba_z",        "lever_f",   "lever_r", "lever_d",
+                                 "imu_delay", "mount_roll", "mount_pitch", "mount_yaw", "sg_x",   "sg_y",
+                                 "sg_z",      "sa_x",       "sa_y",        "sa_z",      "clock_rate"};
+  for (int b = kConstants; b < dims().nb; ++b) names.push_back(this->names().constants[static_cast<std::size_t>(b)]);
+  return names;  // the constraints' points (m) as they are
 }
 
 // Rows of J (outputs × stacked tangent) and values, in reportNames' order.
 void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance, Eigen::VectorXd& value,
                           Eigen::VectorXd& sd) const {
   const int nc = dims().nc;
-  const Eigen::VectorXd xc = mean.head(nc), xb = mean.tail(kConstants);
-  const int n = nc + kConstants, b = nc;  // b: where x_b starts in the stacked state
-  constexpr int kOut = 29;
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(kOut, n);
-  value.resize(kOut);
+  const int nb = dims().nb;
+  const Eigen::VectorXd xc = mean.head(nc), xb = mean.tail(nb);
+  const int n = nc + nb, b = nc;  // b: where x_b starts in the stacked state
+  const int outputs = 29 + nb - kConstants;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(outputs, n);
+  value.resize(outputs);
   // The antenna in the frame, then geodetic (deg, deg, m).
   Eigen::MatrixXd J_xc, J_xb;
   const Eigen::Vector3d ned = antenna(xc, xb, &J_xc, &J_xb);
@@ -39,7 +43,7 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
                                kDegPerRad / ((geodesy::transverseRadius(g.lat) + g.height) * std::cos(g.lat)), -1.0);
   value.head<3>() << g.lat * kDegPerRad, g.lon * kDegPerRad, g.height;
   J.block(0, 0, 3, nc) = to_geo.asDiagonal() * J_xc;
-  J.block(0, b, 3, kConstants) = to_geo.asDiagonal() * J_xb;
+  J.block(0, b, 3, nb) = to_geo.asDiagonal() * J_xb;
   value.segment<3>(3) = xc.segment<3>(kVel);
   J.block<3, 3>(3, kVel).setIdentity();
   // The vehicle: R_nv = R·R_vbᵀ, perturbed R_nv·Exp(R_vb·(δθ − E·δμ)).
@@ -67,6 +71,10 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   J.block<6, 6>(22, b + kGyroScale).setIdentity();
   value[28] = xb[kClockRate];
   J(28, b + kClockRate) = 1;
+  for (int i = kConstants; i < nb; ++i) {
+    value[29 + i - kConstants] = xb[i];
+    J(29 + i - kConstants, b + i) = 1;
+  }
   sd = (J * covariance).cwiseProduct(J).rowwise().sum().cwiseSqrt();
 }
 

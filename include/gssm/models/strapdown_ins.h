@@ -29,7 +29,8 @@
 //
 // Channels: `gnss` (the antenna's NED position at the fix's time,
 // p + R_nb·ℓ − (d + ρ·c)·v), `nhc`
-// (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z),
+// (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z
+// at the IMU, or at the points Params::nhc_point from it),
 // `zupt` (the velocity, zero while standing), `zaru` (the gyro's mean
 // reading while standing: b_g + R_nbᵀ·ω_ie), `gnss_vel` (the antenna's NED
 // velocity at the fix's time, v + R_nb·(ω×ℓ) − δ·a: it reads the IMU's mean
@@ -38,6 +39,7 @@
 // maps the IMU's axes to the vehicle's (forward, right, down); R_vb0 is its
 // nominal value.
 #include <Eigen/Core>
+#include <array>
 
 #include "gssm/model/model.h"
 #include "gssm/models/geodesy.h"
@@ -62,6 +64,16 @@ class StrapdownIns final : public Model {
     double gnss_vel_latency = 0;
     double nhc_sd = 0.1;                       ///< σ of the vehicle's sideways velocity at the IMU (m/s)
     double nhc_down_sd = 0.1;                  ///< σ of its vertical velocity (m/s)
+    /// Where the vehicle constraints hold, from the IMU in vehicle axes (m):
+    /// the sideways one's point forward and down (a body rolls about a
+    /// centre near the ground, the rear axle does not slide), the vertical
+    /// one's point forward and right (the body pitches about a point
+    /// between the axles), in that order. Prior means, and their σs: a
+    /// component with σ > 0 is a constant node (`nhc_side_f`,
+    /// `nhc_side_d`, `nhc_vert_f`, `nhc_vert_r`), one with σ 0 is held at
+    /// its mean. With any point off the IMU the `nhc` channel reads the
+    /// gyro's mean reading at the constraint (Measurement::regressors).
+    Eigen::Vector4d nhc_point{0, 0, 0, 0}, nhc_point_sd{0, 0, 0, 0};
     double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)
     double zaru_sd = 0.005;                    ///< σ of the gyro's mean reading while standing (rad/s)
     /// Robust loss on the vehicle constraints (`nhc`): a bump or a skid
@@ -138,13 +150,22 @@ class StrapdownIns final : public Model {
     return frame_.local().toNed({lat, lon, height});
   }
 
-  // Where each part of x_b starts.
+  // Where each part of x_b starts: the constants every INS has, then the
+  // vehicle constraints' points whose σ > 0 (nhcPointIndex).
   static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kGyroScale = 13,
                        kAccelScale = 16, kClockRate = 19, kConstants = 20;
   // In x_c: the navigation states (kStates of them), then β_g when the
   // gyro bias walks (dims().nc = kStates + 3).
   static constexpr int kClock = 9, kStates = 10, kGyroWalk = 10;
   bool gyroBiasWalks() const { return p_.gyro_bias_walk > 0; }
+  /// Where component i of Params::nhc_point is in x_b (−1: held at its mean).
+  int nhcPointIndex(int i) const { return nhc_point_index_[static_cast<std::size_t>(i)]; }
+  /// The constraints' points off the IMU (any nhc_point or σ not 0): the
+  /// `nhc` channel then reads the gyro's mean reading.
+  bool nhcPointsOffImu() const { return nhc_points_off_imu_; }
+  /// The constraints' points at the constants x_b, as Params::nhc_point
+  /// (side f, d; vertical f, r; m, vehicle axes from the IMU).
+  Eigen::Vector4d nhcPoint(const Eigen::VectorXd& xb) const;
   /// The gyro bias at state x_c: b_g (+ β_g when it walks).
   Eigen::Vector3d gyroBias(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) const {
     Eigen::Vector3d b = xb.segment<3>(kGyroBias);
@@ -164,11 +185,16 @@ class StrapdownIns final : public Model {
                           Eigen::MatrixXd* J_h_xb) const;
   Eigen::VectorXd restingGyro(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                               Eigen::MatrixXd* J_h_xb) const;
-  Eigen::VectorXd vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
-                                  Eigen::MatrixXd* J_h_xb) const;
+  Eigen::VectorXd vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::Vector3d& gyro,
+                                  Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const;
+  void addTurnAtPoints(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::Vector3d& gyro,
+                       const Eigen::Matrix3d& M, const Eigen::Matrix3d& E, Eigen::Vector2d& out,
+                       Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const;
   Params p_;
   strapdown::NavFrame frame_;
   Eigen::Matrix3d mount0_;  // R_vb0
+  std::array<int, 4> nhc_point_index_;
+  bool nhc_points_off_imu_;
 };
 
 }  // namespace gssm::models
