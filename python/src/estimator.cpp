@@ -324,7 +324,8 @@ py::class_<PyEstimator> bindStreamingEstimator(py::module_& m) {
           py::arg("regressors") = py::none(),
           "measurement y at time t on `channel` (name or index; default the model's first), with its own noise "
           "covariance R when given, and the known values h reads on a channel that takes any (Channel.regressors: "
-          "strapdown_ins's gnss_vel: the gyro's mean reading and the velocity's rate of change, NED, at the fix)")
+          "strapdown_ins's gnss_vel: the gyro's mean reading and the velocity's rate of change, NED, at the fix; its nhc "
+          "at points off the IMU: the gyro's mean reading)")
       .def("current", [](PyEstimator& e) { return e.est->current(); }, "newest state and constants, joint covariance")
       .def(
           "smoothed", [](PyEstimator& e, std::int64_t k) { return e.est->smoothed(k); }, py::arg("k"),

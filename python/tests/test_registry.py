@@ -138,3 +138,23 @@ def test_strapdown_ins_from_its_registration():
     y, J_x, J_b = m.h(x, lever, "gnss_vel", jacobians=True, regressors=reading)
     assert J_x.shape == (3, 10) and J_b.shape == (3, 20)
     np.testing.assert_allclose(np.linalg.norm(y - x[3:6]), 0.5, rtol=1e-12)
+
+
+def test_strapdown_ins_constraints_at_a_point_below_the_imu():
+    """The vehicle constraints at points off the IMU ([prior] nhc_point_sd):
+    each offset with a sigma is one more constant, and `nhc` then reads the
+    gyro's reading: rolling at 0.5 rad/s about a centre 1 m below the IMU,
+    the IMU moves sideways at 0.5 m/s, which the constraint's point does not."""
+    m = gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], prior_nhc_point_sd=[0.0, 1.0, 0.0, 0.0])
+    assert m.nb == 21 and m.constant_names[-1] == "nhc_side_d"
+    assert [c.regressors for c in m.channels] == [0, 3, 0, 0, 6]
+    x, b = np.array(m.prior_state[0], dtype=float), np.zeros(21)
+    x[:3] = 0.0  # IMU axes = NED = vehicle axes (mount_rpy 0)
+    x[3:6] = [0.0, 0.5, 0.0]  # the IMU moving right at 0.5 m/s
+    rolling = np.array([0.5, 0.0, 0.0])
+    np.testing.assert_allclose(m.h(x, b, "nhc", regressors=rolling), [0.5, 0.0], atol=1e-12)  # at the IMU
+    b[20] = 1.0  # the point 1 m below: there the roll cancels it
+    np.testing.assert_allclose(m.h(x, b, "nhc", regressors=rolling), [0.0, 0.0], atol=1e-12)
+    with pytest.raises(gssm.InvalidArgument, match="carries 0 known values"):
+        m.h(x, b, "nhc")
+    assert gssm.models.from_ini(m.to_ini()).to_ini() == m.to_ini()
