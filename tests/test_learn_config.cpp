@@ -106,5 +106,19 @@ TEST(LearnConfig, LikelihoodChannelsAreChannelNames) {
   }
 }
 
+// [learn] likelihood_spacing reaches the options (s); a negative one is
+// refused, naming the file, line and key.
+TEST(LearnConfig, LikelihoodSpacingIsReadInSeconds) {
+  EXPECT_EQ(learnSettings(IniDocument::parse(kScenario, "cv.ini")).options.likelihood_spacing, 0.0);
+  const std::string text = std::string(kScenario) + "likelihood_spacing = 3\n";
+  EXPECT_EQ(learnSettings(IniDocument::parse(text, "spaced.ini")).options.likelihood_spacing, 3.0);
+  try {
+    learnSettings(IniDocument::parse(std::string(kScenario) + "likelihood_spacing = -1\n", "neg.ini"));
+    FAIL() << "a negative spacing must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("neg.ini:17: [learn] likelihood_spacing"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace gssm::io

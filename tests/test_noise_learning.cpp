@@ -113,6 +113,45 @@ TEST(NoiseLearning, LikelihoodOfTheCountedChannelsGivenTheRest) {
   EXPECT_THROW(predictionErrorLogLikelihood(two, both, {}, 0.0, counted), InvalidArgument);
 }
 
+// likelihood_spacing: learning from a log whose counted channel's
+// measurements are spaced out equals learning from that log thinned by
+// hand (every third of channel 0's, each channel-1 measurement kept, since
+// it is not counted); 0 is every measurement; a negative spacing is refused.
+TEST(NoiseLearning, LikelihoodSpacingLearnsFromTheCountedMeasurementsSpacedOut) {
+  const SimulatedRun run = simulateRun(cvWithBias(0.04, 0.01, 1.0), 300, 21);
+  models::LinearSystem sys = testing::trackWithBias(1, 1, 1, 1.0, 0.5, 1.0);
+  sys.channels.push_back({"aux", Eigen::RowVector2d(1, 0), Eigen::MatrixXd::Ones(1, 1), Eigen::MatrixXd::Constant(1, 1, 4.0), {}});
+  const models::LinearModel two(sys);
+  std::vector<Measurement> both, by_hand;
+  for (std::size_t i = 0; i < run.measurements.size(); ++i) {
+    const Measurement& m = run.measurements[i];
+    const Measurement aux(m.t, m.y + Eigen::VectorXd::Constant(1, 0.5), 1);
+    both.push_back(m);
+    both.push_back(aux);
+    if (i % 3 == 0) by_hand.push_back(m);
+    by_hand.push_back(aux);
+  }
+  NoiseLearningOptions o;
+  o.parameters = {"Q"};
+  o.ekf.likelihood_channels = {0};
+  const NoiseLearningReport every = learnNoise(two, both, {}, 0.0, o);
+  const NoiseLearningReport thinned = learnNoise(two, by_hand, {}, 0.0, o);
+  o.likelihood_spacing = 2.5;  // the steps are 1 s: every third kept
+  const NoiseLearningReport spaced = learnNoise(two, both, {}, 0.0, o);
+  ASSERT_TRUE(spaced.converged) << spaced.toString();
+  ASSERT_EQ(spaced.parameters.size(), thinned.parameters.size());
+  for (std::size_t i = 0; i < spaced.parameters.size(); ++i) {
+    EXPECT_EQ(spaced.parameters[i].value, thinned.parameters[i].value) << spaced.parameters[i].name();
+    EXPECT_NE(spaced.parameters[i].value, every.parameters[i].value) << spaced.parameters[i].name();
+  }
+  EXPECT_EQ(spaced.final_log_likelihood, thinned.final_log_likelihood);
+  EXPECT_EQ(spaced.measurements, by_hand.size());
+  o.likelihood_spacing = -1;
+  std::string why;
+  EXPECT_FALSE(o.validate(&why));
+  EXPECT_NE(why.find("likelihood_spacing"), std::string::npos) << why;
+}
+
 // The linear run the EM comparisons learn from, from σ = 1: the learner's
 // options, and EM's maximum from the same start.
 struct EmCase {

@@ -31,7 +31,10 @@ std::vector<IniKey> learnIniKeyDocs() {
       {"prior_iterations", "integer", std::to_string(o.prior_iterations), "EM E-steps for the constants' prior σs"},
       {"prior_tolerance", "number", number(o.prior_tolerance), "EM converged when no σ changes by more than this, relative"},
       {"likelihood_channels", "words", "(all)",
-       "the channels whose innovations the likelihood counts; the others condition it"}};
+       "the channels whose innovations the likelihood counts; the others condition it"},
+      {"likelihood_spacing", "number", number(o.likelihood_spacing),
+       "the counted channels' measurements at least this far apart (s), the others left out of the learning "
+       "passes: each is predicted over that span (0: every measurement, one step ahead)"}};
 }
 
 std::vector<std::string> learnIniKeys() { return iniKeyNames(learnIniKeyDocs()); }
@@ -54,6 +57,7 @@ LearnSettings learnSettings(const IniDocument& ini) {
   o.standard_errors = ini.getBool("learn", "standard_errors", o.standard_errors);
   o.prior_iterations = static_cast<int>(ini.getInt("learn", "prior_iterations", o.prior_iterations));
   o.prior_tolerance = ini.getDouble("learn", "prior_tolerance", o.prior_tolerance);
+  o.likelihood_spacing = ini.getDouble("learn", "likelihood_spacing", o.likelihood_spacing);
   o.batch = batchOptions(ini);  // the E-steps solve as the run's batch does
   std::string why;
   if (!o.validate(&why)) {

@@ -38,11 +38,31 @@ bool NoiseLearningOptions::validate(std::string* why) const {
   if (!(search_range > 1) || !std::isfinite(search_range)) return fail("search_range must be a factor > 1");
   if (prior_iterations < 1) return fail("prior_iterations must be >= 1");
   if (!(prior_tolerance > 0) || prior_tolerance >= 1) return fail("prior_tolerance must be in (0, 1)");
+  if (!(likelihood_spacing >= 0) || !std::isfinite(likelihood_spacing))
+    return fail("likelihood_spacing must be >= 0 (s; 0: every measurement)");
   if (std::string b; !batch.validate(&b)) return fail(b);
   return true;  // the EKF options are checked against the model when the filter is made
 }
 
 namespace {
+// likelihood_spacing: the counted channels' measurements at least `spacing`
+// apart per channel (the first kept), the others as they are.
+std::vector<Measurement> spacedOut(const std::vector<Measurement>& measurements, const NoiseLearningOptions& o) {
+  const std::vector<int>& counted = o.ekf.likelihood_channels;
+  std::map<int, double> last;  // per counted channel, the last kept time
+  std::vector<Measurement> out;
+  for (const Measurement& m : measurements) {
+    const bool spaced = counted.empty() || std::find(counted.begin(), counted.end(), m.channel) != counted.end();
+    if (spaced) {
+      const auto it = last.find(m.channel);
+      if (it != last.end() && m.t - it->second < o.likelihood_spacing) continue;
+      last[m.channel] = m.t;
+    }
+    out.push_back(m);
+  }
+  return out;
+}
+
 // The likelihood over a schedule computed once (learning evaluates hundreds).
 internal::LikelihoodTerms logLikelihoodAlong(const Model& model, const std::vector<ScheduledStep>& schedule,
                                              const std::vector<Measurement>& measurements,
@@ -366,13 +386,15 @@ ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParamete
 }
 }  // namespace internal
 
-NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Measurement>& measurements,
+NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Measurement>& all,
                                const std::vector<Input>& inputs, double t0, const NoiseLearningOptions& o) {
   std::string why;
   if (!o.validate(&why)) throw InvalidArgument(why);
   if (family.names.empty() || static_cast<Eigen::Index>(family.names.size()) != family.given.size() || !family.make)
     throw InvalidArgument("learnNoise: a NoiseFamily needs one name and one given σ per parameter, and make");
   const auto started = std::chrono::steady_clock::now();
+  std::vector<Measurement> spaced;  // likelihood_spacing's; without it the log itself (no copy)
+  const std::vector<Measurement>& measurements = o.likelihood_spacing > 0 ? (spaced = spacedOut(all, o)) : all;
   NoiseLearningReport r;
   r.parameters = family.parameters;
   for (std::size_t i = r.parameters.size(); i < family.names.size(); ++i) {  // undescribed: [model] <name>

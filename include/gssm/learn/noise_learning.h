@@ -93,6 +93,13 @@ struct NoiseLearningOptions {
   double prior_tolerance = 1e-3;
   /// The batch solver of the E-steps.
   BatchSolverOptions batch;
+  /// > 0: the likelihood channels' measurements (ekf.likelihood_channels;
+  /// none named: every channel's) kept at least this far apart in time (s),
+  /// per channel, the others left out of the learning passes: each counted
+  /// measurement is then predicted over that span of inputs and the other
+  /// channels, the horizon an estimator bridges in a gap, not one step (0:
+  /// every measurement). docs/DESIGN.md §10.
+  double likelihood_spacing = 0;
   /// The filter the likelihood is computed with (its gates are not applied:
   /// a gated Gaussian likelihood grows without bound as σ → 0).
   ExtendedKalmanFilterOptions ekf;
