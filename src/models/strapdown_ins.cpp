@@ -112,9 +112,10 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   bmean.segment<3>(StrapdownIns::kGyroScale) = p.gyro_scale;
   bmean.segment<3>(StrapdownIns::kAccelScale) = p.accel_scale;
   bmean(StrapdownIns::kClockRate) = p.clock_rate;
-  bsd << Eigen::Vector3d::Constant(p.gyro_bias_sd), Eigen::Vector3d::Constant(p.accel_bias_sd),
-      Eigen::Vector3d::Constant(p.lever_sd), Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd,
-      Eigen::Vector3d::Constant(p.gyro_scale_sd), Eigen::Vector3d::Constant(p.accel_scale_sd), p.clock_rate_sd;
+  bsd.head(StrapdownIns::kConstants) << Eigen::Vector3d::Constant(p.gyro_bias_sd),
+      Eigen::Vector3d::Constant(p.accel_bias_sd), Eigen::Vector3d::Constant(p.lever_sd),
+      Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd, Eigen::Vector3d::Constant(p.gyro_scale_sd),
+      Eigen::Vector3d::Constant(p.accel_scale_sd), p.clock_rate_sd;  // then the constraints' points'
   for (int i = 0, b = StrapdownIns::kConstants; i < 4; ++i)
     if (p.nhc_point_sd[i] > 0) {
       bmean[b] = p.nhc_point[i];
