@@ -22,7 +22,15 @@ int insStates(const StrapdownIns::Params& p) { return StrapdownIns::kStates + (p
 
 const char* const kNhcPointNames[4] = {"nhc_side_f", "nhc_side_d", "nhc_vert_f", "nhc_vert_r"};
 
-// Every INS's constants, then one per vehicle-constraint point with σ > 0.
+// Where each component of nhc_point is in x_b: after every INS's
+// constants, one per component with σ > 0 in turn (−1: held at its mean).
+std::array<int, 4> nhcPointIndices(const StrapdownIns::Params& p) {
+  std::array<int, 4> index;
+  for (int i = 0, b = StrapdownIns::kConstants; i < 4; ++i)
+    index[static_cast<std::size_t>(i)] = p.nhc_point_sd[i] > 0 ? b++ : -1;
+  return index;
+}
+
 int insConstants(const StrapdownIns::Params& p) {
   return StrapdownIns::kConstants + static_cast<int>((p.nhc_point_sd.array() > 0).count());
 }
@@ -116,10 +124,11 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
       Eigen::Vector3d::Constant(p.accel_bias_sd), Eigen::Vector3d::Constant(p.lever_sd),
       Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd, Eigen::Vector3d::Constant(p.gyro_scale_sd),
       Eigen::Vector3d::Constant(p.accel_scale_sd), p.clock_rate_sd;  // then the constraints' points'
-  for (int i = 0, b = StrapdownIns::kConstants; i < 4; ++i)
-    if (p.nhc_point_sd[i] > 0) {
-      bmean[b] = p.nhc_point[i];
-      bsd[b++] = p.nhc_point_sd[i];
+  const std::array<int, 4> point = nhcPointIndices(p);
+  for (std::size_t i = 0; i < 4; ++i)
+    if (point[i] >= 0) {
+      bmean[point[i]] = p.nhc_point[static_cast<Eigen::Index>(i)];
+      bsd[point[i]] = p.nhc_point_sd[static_cast<Eigen::Index>(i)];
     }
   n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
   return n;
@@ -154,15 +163,16 @@ StrapdownIns::StrapdownIns(const Params& p)
       p_(p),
       frame_(p.anchor),
       mount0_(so3::fromRollPitchYaw(p.mount_rpy)),
+      nhc_point_index_(nhcPointIndices(p)),
       nhc_points_off_imu_(!p.nhc_point.isZero() || !p.nhc_point_sd.isZero()) {
-  for (int i = 0, b = kConstants; i < 4; ++i) nhc_point_index_[static_cast<std::size_t>(i)] = p.nhc_point_sd[i] > 0 ? b++ : -1;
   MeasurementChannel gnss =
       channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay, kClockRate});
   gnss.own_R_scale = p.gnss_sd_scale * p.gnss_sd_scale;
   MeasurementChannel nhc = channelOf("nhc", {"nhc_right", "nhc_down"}, Eigen::Vector2d(p.nhc_sd, p.nhc_down_sd), {9, 10, 11});
   if (nhc_points_off_imu_) {  // the points turn with the body: the gyro's reading, its bias and scale
     nhc.regressors = 3;
-    nhc.constants.insert(nhc.constants.end(), {0, 1, 2, 13, 14, 15});
+    nhc.constants.insert(nhc.constants.end(),
+                         {kGyroBias, kGyroBias + 1, kGyroBias + 2, kGyroScale, kGyroScale + 1, kGyroScale + 2});
     for (int b = kConstants; b < insConstants(p); ++b) nhc.constants.push_back(b);
     std::sort(nhc.constants.begin(), nhc.constants.end());
   }

@@ -13,6 +13,7 @@ namespace gssm::models {
 namespace {
 constexpr double kDegPerRad = 180.0 / M_PI;  // rad → deg
 constexpr int kTheta = 0, kVel = 3;
+constexpr int kFixedOutputs = 29;  // every INS's report; the constraints' points follow
 }  // namespace
 
 std::vector<std::string> StrapdownIns::reportNames() const {
@@ -32,7 +33,7 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   const int nb = dims().nb;
   const Eigen::VectorXd xc = mean.head(nc), xb = mean.tail(nb);
   const int n = nc + nb, b = nc;  // b: where x_b starts in the stacked state
-  const int outputs = 29 + nb - kConstants;
+  const int outputs = kFixedOutputs + nb - kConstants;
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(outputs, n);
   value.resize(outputs);
   // The antenna in the frame, then geodetic (deg, deg, m).
@@ -72,8 +73,8 @@ void StrapdownIns::report(const Eigen::VectorXd& mean, const Eigen::MatrixXd& co
   value[28] = xb[kClockRate];
   J(28, b + kClockRate) = 1;
   for (int i = kConstants; i < nb; ++i) {
-    value[29 + i - kConstants] = xb[i];
-    J(29 + i - kConstants, b + i) = 1;
+    value[kFixedOutputs + i - kConstants] = xb[i];
+    J(kFixedOutputs + i - kConstants, b + i) = 1;
   }
   sd = (J * covariance).cwiseProduct(J).rowwise().sum().cwiseSqrt();
 }
