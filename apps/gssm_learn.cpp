@@ -30,9 +30,10 @@ int main(int argc, char** argv) {
     options.batch.threads = options.threads;
     const gssm::io::LearnResult r = gssm::io::learnDataset(data, out, cli.get("config"), options);
     std::cout << r.report.toString();
+    if (r.batch_report) std::cout << "the batch's own noise ([batch.*]):\n" << r.batch_report->toString();
     const std::string label = r.config.getString("scenario", "name", data);
     std::cout << "figure: " << plot.functions().write_learning_figure(r.report, out, label) << "\n";
     for (const auto& f : r.files) std::cout << "gssm-learn: wrote " << f << "\n";
-    return r.report.converged ? 0 : 4;
+    return r.report.converged && (!r.batch_report || r.batch_report->converged) ? 0 : 4;
   });
 }

@@ -47,6 +47,29 @@ TEST(IniDocument, ErrorsNameFileLineSectionKeyAndValue) {
   expectThrowsNaming<InputError>([&] { ini.getDouble("m", "R"); }, {"missing", "'R'", "[m]"});
 }
 
+// [<prefix>.<S>] gives one reader its own values of [S]'s keys: set over
+// them (new keys added), the other sections and readers untouched, each
+// overriding key's line kept for errors; a [<prefix>.<S>] whose [S] does
+// not exist is refused by its line (a misspelt name would do nothing).
+TEST(IniDocument, AReadersOwnSectionOverridesAnothersKeys) {
+  const auto ini = IniDocument::parse(
+      "[model]\nq = 1\nr = 2\n[channel.gps]\nr = 3\n[batch.model]\nq = 10\ns = 5\n[batch.channel.gps]\nr = 30\n", "f.ini");
+  EXPECT_TRUE(ini.hasOverrides("batch"));
+  EXPECT_FALSE(ini.hasOverrides("ekf"));
+  EXPECT_FALSE(ini.hasOverrides("channel.gp"));  // a prefix is a whole name
+  const IniDocument b = ini.overriddenBy("batch");
+  EXPECT_EQ(b.getDouble("model", "q"), 10.0);
+  EXPECT_EQ(b.getDouble("model", "r"), 2.0);
+  EXPECT_EQ(b.getDouble("model", "s"), 5.0);
+  EXPECT_EQ(b.getDouble("channel.gps", "r"), 30.0);
+  EXPECT_EQ(b.lineOf("model", "q"), 7);
+  EXPECT_EQ(ini.getDouble("model", "q"), 1.0);  // the document itself as it was
+  EXPECT_EQ(ini.overriddenBy("ekf").getDouble("model", "q"), 1.0);
+  expectThrowsNaming<InputError>(
+      [] { IniDocument::parse("[model]\nq = 1\n[batch.modle]\nq = 2\n", "g.ini").overriddenBy("batch"); },
+      {"g.ini:3", "[batch.modle]", "[modle]"});
+}
+
 TEST(IniDocument, WriteThenParseRoundTripsBits) {
   IniDocument a;
   a.set("s", "x", 0.1 + 0.2);

@@ -120,5 +120,49 @@ TEST(LearnConfig, LikelihoodSpacingIsReadInSeconds) {
   }
 }
 
+// [learn] batch_likelihood_spacing: the noise learnt again with that
+// spacing from the scenario as learnt for the other methods, into
+// [batch.model] (the batch's own values, IniDocument::overriddenBy). Checked
+// against learning run by hand: the plain learning's values in [model], and
+// the spaced learning from them in [batch.model]; the two differ (the
+// spacing leaves out half the measurements), so the check can fail.
+TEST(LearnConfig, TheBatchsOwnNoiseIsLearntWithItsSpacingIntoItsSection) {
+  const IniDocument ini = IniDocument::load(writeFile("cvb.ini", std::string(kScenario) + "batch_likelihood_spacing = 2\n"));
+  const LearnSettings s = learnSettings(ini);
+  ASSERT_TRUE(s.batch_likelihood_spacing.has_value());
+  EXPECT_EQ(*s.batch_likelihood_spacing, 2.0);
+  EXPECT_FALSE(learnSettings(IniDocument::parse(kScenario, "cv.ini")).batch_likelihood_spacing.has_value());
+  const auto model = makeModel(ini);
+  Dataset d;
+  d.measurements = simulate(*model, SimulationSpec{}, testing::normalSampler(5)).measurements;
+  const auto out = std::filesystem::temp_directory_path() / "gssm_learn_batch";
+  const LearnResult r = learnScenarioNoise(*model, ini, d, out.string(), s);
+  ASSERT_TRUE(r.batch_report.has_value());
+  EXPECT_TRUE(std::filesystem::exists(out / "learn-batch.json"));
+  EXPECT_EQ(r.files.back(), (out / "learn-batch.json").string());
+
+  const NoiseLearningReport online = learnNoise(*model, d.measurements, {}, 0.0, s.options);
+  NoiseLearningOptions spaced = s.options;
+  spaced.likelihood_spacing = 2;
+  const NoiseLearningReport batch = learnNoise(*online.model, d.measurements, {}, 0.0, spaced);
+  const ParamValues in_model = ParamValues::of(*makeModel(r.config));
+  const ParamValues in_batch = ParamValues::of(*makeModel(r.config.overriddenBy("batch")));
+  for (const char* key : {"Q", "R"}) {
+    EXPECT_TRUE(in_model.matrix("model", key).isApprox(ParamValues::of(*online.model).matrix("model", key), 1e-12)) << key;
+    EXPECT_TRUE(in_batch.matrix("model", key).isApprox(ParamValues::of(*batch.model).matrix("model", key), 1e-12)) << key;
+  }
+  EXPECT_GT((in_model.matrix("model", "Q") - in_batch.matrix("model", "Q")).norm(), 1e-3);
+  const IniDocument file = IniDocument::load((out / "scenario.ini").string());
+  EXPECT_TRUE(file.has("batch.model", "Q") && file.has("batch.model", "R"));
+  EXPECT_FALSE(learnSettings(file).enabled);
+
+  try {
+    learnSettings(IniDocument::parse(std::string(kScenario) + "batch_likelihood_spacing = -1\n", "neg.ini"));
+    FAIL() << "a negative spacing must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("neg.ini:17: [learn] batch_likelihood_spacing"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace gssm::io

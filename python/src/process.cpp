@@ -89,6 +89,9 @@ void bindProcessResult(py::module_& m) {
       .def_property_readonly("learnt", [](const PyProcessResult& r) -> py::object {
         return r.result->learnt ? py::cast(*r.result->learnt) : py::none();
       }, "the noise learning's gssm.LearnReport, when it ran")
+      .def_property_readonly("learnt_batch", [](const PyProcessResult& r) -> py::object {
+        return r.result->learnt_batch ? py::cast(*r.result->learnt_batch) : py::none();
+      }, "the batch's own noise ([learn] batch_likelihood_spacing), when learnt: its gssm.LearnReport")
       .def("_add_files", [](PyProcessResult& r, const std::vector<std::string>& f) {
         r.result->files.insert(r.result->files.end(), f.begin(), f.end());
       })

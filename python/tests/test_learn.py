@@ -98,3 +98,30 @@ def test_learn_a_model_written_in_python_through_its_factory():
         assert abs(p.value - truth) < 3 * p.standard_error, (p.name, p.value, p.standard_error)
     with pytest.raises(gssm.InvalidArgument, match="sigmas="):
         gssm.learn(walk, data)
+
+
+def test_the_batchs_own_noise_is_what_the_batch_runs_with(repo, tmp_path):
+    """[learn] batch_likelihood_spacing: the batch's noise learnt again, into
+    [batch.model]; the batch then runs as it would with those values in
+    [model] (checked by a run that has them there and learns nothing)."""
+    data = os.path.join(repo, "datasets", "plaza2")
+    text = open(os.path.join(data, "scenario.ini"), encoding="utf-8-sig").read()
+    config = tmp_path / "own.ini"
+    config.write_text(text.replace("[learn]\n", "[learn]\nbatch_likelihood_spacing = 5\n", 1))
+    own = gssm.process(data, str(tmp_path / "own"), method="batch", config=str(config), figures=False)
+    assert own.learnt is not None and own.learnt_batch is not None
+    assert os.path.exists(tmp_path / "own" / "learn-batch.json")
+    learnt = open(tmp_path / "own" / "scenario.ini").read()
+    head, batch_section = learnt.split("\n[batch.model]\n")
+    values = dict(line.split(" = ") for line in batch_section.strip().splitlines() if " = " in line)
+    online = {p.name: p.value for p in own.learnt.parameters}
+    assert set(values) == set(online) and any(abs(float(values[k]) - online[k]) > 1e-3 * online[k] for k in online)
+    lines = [l for l in head.splitlines() if not any(l.startswith(k + " = ") for k in values)]
+    at = lines.index("[model]") + 1
+    moved = tmp_path / "moved.ini"
+    moved.write_text("\n".join(lines[:at] + [k + " = " + v for k, v in values.items()] + lines[at:]) + "\n")
+    plain = gssm.process(data, str(tmp_path / "plain"), method="batch", config=str(moved), figures=False, learn=False)
+    a, b = own.runs[0], plain.runs[0]
+    assert a.mean.shape == b.mean.shape
+    ratio = np.max(np.abs(a.mean - b.mean) / np.maximum(b.sd, 1e-15))  # 1184 sd apart if [batch.model] were ignored
+    assert ratio < 1e-3

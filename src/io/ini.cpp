@@ -295,6 +295,30 @@ void IniDocument::set(const std::string& section, const std::string& key,
   s.entries.push_back({key, value, 0});
 }
 
+bool IniDocument::hasOverrides(const std::string& prefix) const {
+  for (const auto& s : sections_)
+    if (s.name.rfind(prefix + ".", 0) == 0) return true;
+  return false;
+}
+
+IniDocument IniDocument::overriddenBy(const std::string& prefix) const {
+  IniDocument out = *this;
+  for (const auto& s : sections_) {
+    if (s.name.rfind(prefix + ".", 0) != 0) continue;
+    const std::string target = s.name.substr(prefix.size() + 1);
+    if (!hasSection(target))
+      throw InputError(source_ + ":" + std::to_string(s.line) + ": [" + s.name + "] overrides the keys of [" + target +
+                       "], which this file does not have");
+    Section& t = out.sectionFor(target);
+    for (const auto& e : s.entries) {
+      auto it = std::find_if(t.entries.begin(), t.entries.end(), [&](const Entry& x) { return x.key == e.key; });
+      if (it != t.entries.end()) *it = e;
+      else t.entries.push_back(e);
+    }
+  }
+  return out;
+}
+
 void IniDocument::set(const std::string& section, const std::string& key, double value) {
   set(section, key, formatDouble(value));
 }

@@ -1,11 +1,13 @@
 #include "gssm/io/learn_config.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 
 #include "gssm/core/error.h"
+#include "gssm/estimator/method.h"
 #include "gssm/io/config.h"
 #include "gssm/io/json_text.h"
 #include "io/byte_order_mark.h"
@@ -34,7 +36,10 @@ std::vector<IniKey> learnIniKeyDocs() {
        "the channels whose innovations the likelihood counts; the others condition it"},
       {"likelihood_spacing", "number", number(o.likelihood_spacing),
        "the counted channels' measurements at least this far apart (s), the others left out of the learning "
-       "passes: each is predicted over that span (0: every measurement, one step ahead)"}};
+       "passes: each is predicted over that span (0: every measurement, one step ahead)"},
+      {"batch_likelihood_spacing", "number", "(none)",
+       "learn the batch's own noise again with this likelihood_spacing (s), into [batch.<section>] (none: the "
+       "batch runs with the other methods' noise)"}};
 }
 
 std::vector<std::string> learnIniKeys() { return iniKeyNames(learnIniKeyDocs()); }
@@ -58,6 +63,11 @@ LearnSettings learnSettings(const IniDocument& ini) {
   o.prior_iterations = static_cast<int>(ini.getInt("learn", "prior_iterations", o.prior_iterations));
   o.prior_tolerance = ini.getDouble("learn", "prior_tolerance", o.prior_tolerance);
   o.likelihood_spacing = ini.getDouble("learn", "likelihood_spacing", o.likelihood_spacing);
+  if (ini.has("learn", "batch_likelihood_spacing")) {
+    s.batch_likelihood_spacing = ini.getDouble("learn", "batch_likelihood_spacing");
+    if (!(*s.batch_likelihood_spacing >= 0) || !std::isfinite(*s.batch_likelihood_spacing))
+      throw InputError(ini.where("learn", "batch_likelihood_spacing") + ": must be >= 0 s");
+  }
   o.batch = batchOptions(ini);  // the E-steps solve as the run's batch does
   std::string why;
   if (!o.validate(&why)) {
@@ -71,13 +81,15 @@ LearnSettings learnSettings(const IniDocument& ini) {
 
 namespace {
 // The INI text of each learnt key's new value ("0.55", "[0.1 0; 0 0.2]").
-std::map<std::pair<std::string, std::string>, std::string> learntValues(const NoiseLearningReport& r) {
+// In [prefix.section] when a prefix is given.
+std::map<std::pair<std::string, std::string>, std::string> learntValues(const NoiseLearningReport& r,
+                                                                        const std::string& prefix) {
   std::map<std::pair<std::string, std::string>, std::string> out;
   IniDocument scratch;
   for (const auto& p : r.parameters) {
     if (p.index < 0) scratch.set(p.section, p.key, p.value);
     else scratch.set(p.section, p.key, r.values.matrix(p.section, p.key));
-    out[{p.section, p.key}] = scratch.getString(p.section, p.key);
+    out[{prefix.empty() ? p.section : prefix + "." + p.section, p.key}] = scratch.getString(p.section, p.key);
   }
   return out;
 }
@@ -110,9 +122,12 @@ std::string header(const NoiseLearningReport& r) {
 }
 }  // namespace
 
-std::string learntScenarioText(const IniDocument& input, const NoiseLearningReport& r) {
+std::string learntScenarioText(const IniDocument& input, const NoiseLearningReport& r,
+                               const std::string& section_prefix) {
   std::vector<std::string> lines = linesOf(input);
   std::map<int, std::vector<std::string>> after;  // lines to insert after a line (0: at the end)
+  std::map<std::string, std::vector<std::string>> added;  // sections the file lacks, with their keys
+  std::vector<std::string> added_order;
   auto put = [&](const std::string& section, const std::string& key, const std::string& value) {
     const int line = input.lineOf(section, key);
     if (line > 0 && line <= static_cast<int>(lines.size())) {
@@ -120,17 +135,21 @@ std::string learntScenarioText(const IniDocument& input, const NoiseLearningRepo
     } else if (const int last = input.lastLineOf(section); last > 0) {
       after[last].push_back(key + " = " + value);
     } else {
-      after[0].push_back("[" + section + "]"), after[0].push_back(key + " = " + value);
+      if (!added.count(section)) added_order.push_back(section);
+      added[section].push_back(key + " = " + value);
     }
   };
-  for (const auto& [where, value] : learntValues(r)) put(where.first, where.second, value);
+  for (const auto& [where, value] : learntValues(r, section_prefix)) put(where.first, where.second, value);
   put("learn", "enabled", "false");  // learnt already: the file reproduces the run as it is
   std::string out = header(r);
   for (std::size_t i = 0; i < lines.size(); ++i) {
     out += lines[i] + "\n";
     for (const auto& l : after[static_cast<int>(i + 1)]) out += l + "\n";
   }
-  for (const auto& l : after[0]) out += (l.front() == '[' ? "\n" : "") + l + "\n";
+  for (const auto& section : added_order) {
+    out += "\n[" + section + "]\n";
+    for (const auto& l : added[section]) out += l + "\n";
+  }
   return out;
 }
 
@@ -190,9 +209,12 @@ void readLikelihoodChannels(const IniDocument& input, const Model& model, NoiseL
 }
 }  // namespace
 
-LearnResult learnAndWrite(const Model& model, const IniDocument& input, const Dataset& dataset,
-                          const std::string& out_dir, const NoiseLearningOptions& given) {
-  NoiseLearningOptions options = given;
+namespace {
+// Learns `model`'s noise as `input` says and writes OUT/scenario.ini (the
+// values in [section], or [prefix.section]) and OUT/<json_name>.
+LearnResult learnAndWriteAs(const Model& model, const IniDocument& input, const Dataset& dataset,
+                            const std::string& out_dir, NoiseLearningOptions options, const std::string& prefix,
+                            const std::string& json_name) {
   if (options.ekf.likelihood_channels.empty()) readLikelihoodChannels(input, model, options);
   std::error_code ec;
   if (!dataset.dir.empty() && fs::exists(out_dir) && fs::equivalent(out_dir, dataset.dir, ec))
@@ -202,12 +224,38 @@ LearnResult learnAndWrite(const Model& model, const IniDocument& input, const Da
   out.report = learnNoise(model, dataset.measurements, dataset.inputs, dataset.t0, options);
   fs::create_directories(out_dir);
   const std::string ini = (fs::path(out_dir) / "scenario.ini").string();
-  const std::string text = learntScenarioText(input, out.report);
+  const std::string text = learntScenarioText(input, out.report, prefix);
   std::ofstream(ini, std::ios::binary) << text;
   out.config = IniDocument::parse(text, ini);
-  const std::string json = (fs::path(out_dir) / "learn.json").string();
+  const std::string json = (fs::path(out_dir) / json_name).string();
   std::ofstream(json, std::ios::binary) << learnReportJson(out.report, dataset.dir);
   out.files = {ini, json};
+  return out;
+}
+}  // namespace
+
+LearnResult learnAndWrite(const Model& model, const IniDocument& input, const Dataset& dataset,
+                          const std::string& out_dir, const NoiseLearningOptions& options) {
+  return learnAndWriteAs(model, input, dataset, out_dir, options, "", "learn.json");
+}
+
+LearnResult learnBatchNoiseAndWrite(const IniDocument& learnt, const Dataset& dataset, const std::string& out_dir,
+                                    const NoiseLearningOptions& options) {
+  const std::string batch = methodName(Method::Batch);
+  const std::unique_ptr<Model> model = makeModel(learnt.overriddenBy(batch), dataset.dir);
+  return learnAndWriteAs(*model, learnt, dataset, out_dir, options, batch, "learn-batch.json");
+}
+
+LearnResult learnScenarioNoise(const Model& model, const IniDocument& input, const Dataset& dataset,
+                               const std::string& out_dir, const LearnSettings& settings) {
+  LearnResult out = learnAndWrite(model, input, dataset, out_dir, settings.options);
+  if (!settings.batch_likelihood_spacing) return out;
+  NoiseLearningOptions options = settings.options;
+  options.likelihood_spacing = *settings.batch_likelihood_spacing;
+  LearnResult batch = learnBatchNoiseAndWrite(out.config, dataset, out_dir, options);
+  out.config = std::move(batch.config);
+  out.files.push_back(batch.files.back());
+  out.batch_report = std::move(batch.report);
   return out;
 }
 
@@ -217,7 +265,9 @@ LearnResult learnDataset(const std::string& data_dir, const std::string& out_dir
   const std::unique_ptr<Model> model = makeModel(ini, data_dir);
   Dataset dataset;
   readDatasetData(data_dir, *model, dataset, BadRows::Throw, &ini);
-  return learnAndWrite(*model, ini, dataset, out_dir, options ? *options : learnSettings(ini).options);
+  LearnSettings settings = learnSettings(ini);
+  if (options) settings.options = *options;
+  return learnScenarioNoise(*model, ini, dataset, out_dir, settings);
 }
 
 }  // namespace gssm::io

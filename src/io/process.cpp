@@ -101,10 +101,68 @@ void readData(const ProcessOptions& o, const Model& model, ProcessResult& r, con
     throw InputError(r.status.partial ? r.status.stopped_at : o.data_dir + ": no measurements");
 }
 
+// What a method runs with: the scenario's model and options, or for a
+// method with its own values ([<method>.<section>]) those made from the
+// scenario as it reads it; the batch's own noise ([learn]
+// batch_likelihood_spacing) is learnt in its job, beside the other methods.
+struct MethodSetup {
+  std::shared_ptr<const Model> model;
+  EstimatorOptions options;
+  /// Where a batch starts: learning's last E-step (a batch solve under σ
+  /// within the learning tolerance), when it ran one; null: the EKF pass.
+  const Values* start = nullptr;
+  std::optional<LearnSettings> own_noise;  ///< learnt first, into `learnt`
+  std::optional<LearnResult> learnt;
+};
+
+EstimatorOptions runOptions(const ProcessOptions& o, const ProcessResult& r, const IniDocument& config,
+                            const Model& model) {
+  EstimatorOptions options = estimatorOptions(config, model);
+  options.t0 = r.dataset.t0;
+  if (o.window) options.fixed_lag.window = options.paper_window.window = *o.window;
+  // The batch linearizes on every thread even beside the other methods: the
+  // OS shares the cores while they run, and its second half takes the core
+  // they leave (the drive: its batch is the last to finish, 0.89x the
+  // methods' wall time). The same bits on one thread or two.
+  options.batch.threads = static_cast<int>(o.threads);
+  return options;
+}
+
+std::vector<MethodSetup> methodSetups(const ProcessOptions& o, const ProcessResult& r, const std::vector<Method>& methods,
+                                      const std::optional<LearnSettings>& batch_noise) {
+  for (const auto& info : gssm::methods())  // a misspelt [<method>.<section>] is refused even if its method does not run
+    if (r.config.hasOverrides(methodName(info.method))) r.config.overriddenBy(methodName(info.method));
+  std::vector<MethodSetup> setups;
+  for (const Method method : methods) {
+    const std::string name = methodName(method);
+    MethodSetup m{r.model, {}, r.learnt && !r.learnt->posterior.empty() ? &r.learnt->posterior : nullptr, {}, {}};
+    const IniDocument config = r.config.hasOverrides(name) ? r.config.overriddenBy(name) : r.config;
+    if (r.config.hasOverrides(name)) m.model = makeModel(config, o.data_dir);
+    m.options = runOptions(o, r, config, *m.model);
+    if (method == Method::Batch && batch_noise) m.own_noise = batch_noise, m.start = nullptr;
+    setups.push_back(std::move(m));
+  }
+  return setups;
+}
+
+// The batch's own noise, learnt from the scenario as learnt for the others
+// (OUT/scenario.ini gets its [batch.<section>]); the setup then runs it.
+void learnOwnNoise(const ProcessOptions& o, const ProcessResult& r, MethodSetup& m) {
+  if (!m.own_noise) return;
+  NoiseLearningOptions options = m.own_noise->options;
+  options.likelihood_spacing = *m.own_noise->batch_likelihood_spacing;
+  m.learnt = learnBatchNoiseAndWrite(r.config, r.dataset, o.out_dir, options);
+  m.model = m.learnt->report.model;
+  m.options = runOptions(o, r, m.learnt->config.overriddenBy(methodName(Method::Batch)), *m.model);
+  m.start = m.learnt->report.posterior.empty() ? nullptr : &m.learnt->report.posterior;
+}
+
 // One method's run, its estimates written as it goes (with checkpoints, the
 // records the metrics need too).
-OfflineRun runMethod(const ProcessOptions& o, const Model& model, const ProcessResult& r, EstimatorOptions options,
-                     Method method, const ProcessCallbacks& cb) {
+OfflineRun runMethod(const ProcessOptions& o, const MethodSetup& setup, const ProcessResult& r, Method method,
+                     const ProcessCallbacks& cb) {
+  const Model& model = *setup.model;
+  EstimatorOptions options = setup.options;
   options.method = method;
   const bool streaming = methodInfo(method).streaming;
   RunFiles files(o.out_dir, model, method, streaming && (o.checkpoint_every > 0 || !o.resume.empty()));
@@ -118,11 +176,8 @@ OfflineRun runMethod(const ProcessOptions& o, const Model& model, const ProcessR
   }
   std::function<void(std::size_t, std::size_t)> progress;
   if (cb.progress) progress = [&cb, method](std::size_t done, std::size_t total) { cb.progress(method, done, total); };
-  // The batch starts where learning's last E-step left the run (a batch
-  // solve under σ within the learning tolerance): a few iterations, no EKF.
-  const Values* start = r.learnt && !r.learnt->posterior.empty() ? &r.learnt->posterior : nullptr;
   OfflineRun run = runOffline(model, options, r.dataset.measurements, r.dataset.inputs, progress, checkpoints,
-                              r.dataset.rows, start);
+                              r.dataset.rows, setup.start);
   if (!streaming)
     for (const auto& row : run.rows) files.row(row);
   files.finish();
@@ -151,9 +206,11 @@ struct MeasuredRun {
   OfflineRun run;
   RunMetrics metrics;
 };
-MeasuredRun runAndMeasure(const ProcessOptions& o, const Model& model, const ProcessResult& r,
-                          const EstimatorOptions& options, Method method, const ProcessCallbacks& cb) {
-  MeasuredRun m{runMethod(o, model, r, options, method, cb), {}};
+MeasuredRun runAndMeasure(const ProcessOptions& o, MethodSetup& setup, const ProcessResult& r, Method method,
+                          const ProcessCallbacks& cb) {
+  learnOwnNoise(o, r, setup);
+  const Model& model = *setup.model;
+  MeasuredRun m{runMethod(o, setup, r, method, cb), {}};
   m.metrics = computeMetrics(model, m.run, r.dataset.truth ? &*r.dataset.truth : nullptr);
   if (r.dataset.constants_reference) compareToReference(model, r, m.run, m.metrics);
   if (!r.dataset.withheld.empty()) scoreWithheld(model, r.dataset, m.run, m.metrics);
@@ -164,8 +221,8 @@ MeasuredRun runAndMeasure(const ProcessOptions& o, const Model& model, const Pro
 // (MethodInfo::cost_rank: the cheap ones fill in at the end). A method that
 // throws lets the others finish; the first error, in the methods' order, is
 // rethrown.
-std::vector<MeasuredRun> runConcurrently(const ProcessOptions& o, const Model& model, const ProcessResult& r,
-                                         const EstimatorOptions& options, const std::vector<Method>& methods,
+std::vector<MeasuredRun> runConcurrently(const ProcessOptions& o, std::vector<MethodSetup>& setups,
+                                         const ProcessResult& r, const std::vector<Method>& methods,
                                          const ProcessCallbacks& cb) {
   std::vector<std::size_t> queue(methods.size());
   std::iota(queue.begin(), queue.end(), std::size_t{0});
@@ -182,7 +239,7 @@ std::vector<MeasuredRun> runConcurrently(const ProcessOptions& o, const Model& m
   std::vector<MeasuredRun> runs(methods.size());
   std::vector<std::exception_ptr> errors(methods.size());
   const auto failed = runJobs(queue.size(), o.threads, [&](std::size_t k) {
-    runs[queue[k]] = runAndMeasure(o, model, r, options, methods[queue[k]], serialized);
+    runs[queue[k]] = runAndMeasure(o, setups[queue[k]], r, methods[queue[k]], serialized);
   });
   for (std::size_t k = 0; k < queue.size(); ++k) errors[queue[k]] = failed[k];  // back in the methods' order
   for (const auto& e : errors)
@@ -209,10 +266,13 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   r.model = model;
   const std::vector<Method> methods = methodsToRun(o, *model, r.config);
   readData(o, *model, r, cb);
+  std::optional<LearnSettings> batch_noise;  // learnt in the batch's job, beside the other methods
   if (LearnSettings learn = learnSettings(r.config); o.learn.value_or(learn.enabled)) {
     // learning runs alone: its passes and batch solves may use every thread
     learn.options.threads = learn.options.batch.threads = static_cast<int>(o.threads);
-    LearnResult learnt = learnAndWrite(*model, r.config, r.dataset, o.out_dir, learn.options);
+    if (learn.batch_likelihood_spacing) batch_noise = learn;
+    learn.batch_likelihood_spacing.reset();
+    LearnResult learnt = learnScenarioNoise(*model, r.config, r.dataset, o.out_dir, learn);
     r.config = std::move(learnt.config);
     model = r.model = learnt.report.model;
     r.files.insert(r.files.end(), learnt.files.begin(), learnt.files.end());
@@ -220,19 +280,18 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
     if (cb.learnt) cb.learnt(*r.learnt);
   }
   fs::create_directories(o.out_dir);
-  EstimatorOptions options = estimatorOptions(r.config, *model);
-  options.t0 = r.dataset.t0;
-  if (o.window) options.fixed_lag.window = options.paper_window.window = *o.window;
-  // The batch linearizes on every thread even beside the other methods: the
-  // OS shares the cores while they run, and its second half takes the core
-  // they leave (the drive: its batch is the last to finish, 0.89x the
-  // methods' wall time). The same bits on one thread or two.
-  options.batch.threads = static_cast<int>(o.threads);
+  std::vector<MethodSetup> setups = methodSetups(o, r, methods, batch_noise);
   std::vector<MeasuredRun> concurrent;
-  if (o.threads > 1 && methods.size() > 1) concurrent = runConcurrently(o, *model, r, options, methods, cb);
+  if (o.threads > 1 && methods.size() > 1) concurrent = runConcurrently(o, setups, r, methods, cb);
   for (std::size_t i = 0; i < methods.size(); ++i) {
     const Method method = methods[i];
-    MeasuredRun m = concurrent.empty() ? runAndMeasure(o, *model, r, options, method, cb) : std::move(concurrent[i]);
+    MeasuredRun m = concurrent.empty() ? runAndMeasure(o, setups[i], r, method, cb) : std::move(concurrent[i]);
+    if (setups[i].learnt) {  // the batch's own noise: OUT/scenario.ini holds it now
+      r.config = setups[i].learnt->config;
+      r.files.push_back(setups[i].learnt->files.back());
+      r.learnt_batch = setups[i].learnt->report;
+      if (cb.learnt) cb.learnt(*r.learnt_batch);
+    }
     r.runs.push_back(std::move(m.run));
     r.metrics.push_back(std::move(m.metrics));
     r.files.push_back((fs::path(o.out_dir) / RunFiles::estimatesName(method)).string());
@@ -251,6 +310,8 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   std::ofstream(json) << r.metrics_json;
   r.files.push_back(json);
   r.label = r.config.getString("scenario", "name", fs::path(o.data_dir).filename().string());
+  EstimatorOptions options = estimatorOptions(r.config, *model);
+  options.t0 = r.dataset.t0;
   r.dead_reckoning = deadReckoning(*model, r, options);
   return r;
 }

@@ -50,6 +50,16 @@ class IniDocument {
   std::string toString() const;
   void save(const std::string& path) const;
 
+  /// Whether the document has a section `[prefix.S]` (one reader's own
+  /// values of another section's keys, e.g. [batch.model]).
+  bool hasOverrides(const std::string& prefix) const;
+  /// A copy with every key of each `[prefix.S]` set in [S] (its line
+  /// kept, so that an error about it points there): how the reader named
+  /// `prefix` sees the document. InputError naming the line of a
+  /// `[prefix.S]` whose [S] the document does not have (a misspelt name
+  /// would otherwise change nothing, silently).
+  IniDocument overriddenBy(const std::string& prefix) const;
+
   /// Throws InputError if a section has a key not in `allowed` (catches typos).
   void requireOnlyKeys(const std::string& section, const std::vector<std::string>& allowed) const;
 

@@ -22,6 +22,10 @@ namespace gssm::io {
 struct LearnSettings {
   bool enabled = false;
   NoiseLearningOptions options;
+  /// [learn] batch_likelihood_spacing: the batch's own noise, learnt again
+  /// with the counted measurements this far apart (s; 0: every one), into
+  /// `[batch.section]`; none: the batch runs with the other methods' noise.
+  std::optional<double> batch_likelihood_spacing;
 };
 /// Reads [learn]; InputError naming file:line for a bad or unknown key.
 LearnSettings learnSettings(const IniDocument& ini);
@@ -35,7 +39,10 @@ std::vector<std::string> learnIniKeys();
 /// not have is added to its section), [learn] enabled = false (so that the
 /// file reproduces the run without learning again), and a comment at the top
 /// with the learning's summary and its log-likelihood trace.
-std::string learntScenarioText(const IniDocument& input, const NoiseLearningReport& report);
+/// With `section_prefix` ("batch"), the values go to `[prefix.section]`
+/// instead: one method's own values (IniDocument::overriddenBy).
+std::string learntScenarioText(const IniDocument& input, const NoiseLearningReport& report,
+                               const std::string& section_prefix = "");
 /// learn.json: every parameter (given, start, learnt, standard error,
 /// identifiable, note), the log-likelihood trace and the counts.
 std::string learnReportJson(const NoiseLearningReport& report, const std::string& dataset);
@@ -43,7 +50,9 @@ std::string learnReportJson(const NoiseLearningReport& report, const std::string
 struct LearnResult {
   NoiseLearningReport report;
   IniDocument config;              ///< the learnt scenario.ini, parsed
-  std::vector<std::string> files;  ///< OUT/scenario.ini, OUT/learn.json
+  std::vector<std::string> files;  ///< OUT/scenario.ini, OUT/learn.json (and learn-batch.json)
+  /// The batch's own noise, when [learn] batch_likelihood_spacing asked for it.
+  std::optional<NoiseLearningReport> batch_report;
 };
 
 /// Learns the noise of `model` (read from `input` over `dataset`) and writes
@@ -54,6 +63,24 @@ struct LearnResult {
 /// folder (its scenario.ini would be overwritten).
 LearnResult learnAndWrite(const Model& model, const IniDocument& input, const Dataset& dataset,
                           const std::string& out_dir, const NoiseLearningOptions& options);
+
+/// The batch's own noise ([learn] batch_likelihood_spacing): learnt over
+/// `dataset` from `learnt` (the scenario as learnt for the other methods)
+/// as the batch reads it (`[batch.section]` over `[section]`: a warm start
+/// there is where it starts) with `options` (their likelihood_spacing the
+/// batch's); its values written to `[batch.section]` of
+/// out_dir/scenario.ini, its report to out_dir/learn-batch.json. The
+/// smoother bridges a gap from both ends, and the likelihood of every
+/// measurement can serve it where one of a horizon serves the online
+/// methods (docs/DESIGN.md §10).
+LearnResult learnBatchNoiseAndWrite(const IniDocument& learnt, const Dataset& dataset, const std::string& out_dir,
+                                    const NoiseLearningOptions& options);
+
+/// Both of the above as `settings` ask: the noise, then the batch's own
+/// when settings.batch_likelihood_spacing is given (config and files then
+/// include it).
+LearnResult learnScenarioNoise(const Model& model, const IniDocument& input, const Dataset& dataset,
+                               const std::string& out_dir, const LearnSettings& settings);
 
 /// What gssm-learn runs: reads data_dir with its scenario.ini (or `config`;
 /// a bad row is an InputError naming file:line:column: learning from part of

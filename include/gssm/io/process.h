@@ -51,6 +51,9 @@ struct ProcessResult {
   DatasetStatus status;            ///< rows skipped, or where a bad row stopped it (partial)
   /// The noise learning, when it ran (config and model are then the learnt ones).
   std::optional<NoiseLearningReport> learnt;
+  /// The batch's own noise ([learn] batch_likelihood_spacing), when learnt;
+  /// it runs with `[batch.section]` over `[section]` (IniDocument::overriddenBy).
+  std::optional<NoiseLearningReport> learnt_batch;
   std::vector<OfflineRun> runs;    ///< one per method, in order
   std::vector<RunMetrics> metrics; ///< of each run
   /// Rows at inputs on a model with px, py: the EKF on the inputs alone.
