@@ -154,8 +154,8 @@ std::string iniReferenceMarkdown() {
         "listed here is refused with its file and line.\n\nOne method's own values: a section "
         "`[<method>.<section>]` (`[batch.model]`) sets keys of `[<section>]` for that method alone (`ekf`, "
         "`batch`, `incremental`, `fixed-lag`, `paper-window`); `[learn] batch_likelihood_spacing` learns the "
-        "batch's noise into `[batch.model]`. A `[<method>.<section>]` whose `[<section>]` the file lacks is "
-        "refused.\n\n## Every scenario\n";
+        "batch's noise into `[batch.model]`. They may change numbers, not the model's states or channels; a "
+        "`[<method>.<section>]` whose `[<section>]` the file lacks is refused.\n\n## Every scenario\n";
   for (const auto& s : commonIniSections()) table(s);
   for (const ModelType* t : modelTypes()) {
     md << "\n## Model `" << t->name << "` (`gssm.models." << t->class_name << "`)\n\n" << t->summary << "\n";

@@ -128,16 +128,42 @@ EstimatorOptions runOptions(const ProcessOptions& o, const ProcessResult& r, con
   return options;
 }
 
+// A method's own values change the model's numbers, not its states or
+// channels: the dataset was read for the scenario's model (a channel's
+// regressors, the rows' layout), and the methods' outputs are compared.
+std::shared_ptr<const Model> sameStructure(std::unique_ptr<Model> own, const Model& shared, const std::string& method) {
+  const auto layout = [](const Model& m) {
+    std::vector<int> v{m.dims().nc, m.dims().nb, m.dims().nu, m.dims().ny};
+    for (int c = 0; c < m.numChannels(); ++c) v.push_back(m.channel(c).dim()), v.push_back(m.channel(c).regressors);
+    return v;
+  };
+  if (layout(*own) != layout(shared))
+    throw InputError("[" + method + ".*]: a method's own values may change the model's numbers, not its states or "
+                     "channels (with them " + method + "'s model has " + std::to_string(own->dims().nb) +
+                     " constants and " + std::to_string(own->dims().nc) + " states, the scenario's " +
+                     std::to_string(shared.dims().nb) + " and " + std::to_string(shared.dims().nc) +
+                     ", or its channels differ)");
+  return own;
+}
+
+// Every method's own values ([<method>.<section>]) checked before anything
+// runs, whether its method runs or not: a misspelt section, or values
+// that change the model's structure, refused.
+void checkMethodOverrides(const IniDocument& config, const Model& shared, const std::string& data_dir) {
+  for (const auto& info : gssm::methods()) {
+    const std::string name = methodName(info.method);
+    if (config.hasOverrides(name)) sameStructure(makeModel(config.overriddenBy(name), data_dir), shared, name);
+  }
+}
+
 std::vector<MethodSetup> methodSetups(const ProcessOptions& o, const ProcessResult& r, const std::vector<Method>& methods,
                                       const std::optional<LearnSettings>& batch_noise) {
-  for (const auto& info : gssm::methods())  // a misspelt [<method>.<section>] is refused even if its method does not run
-    if (r.config.hasOverrides(methodName(info.method))) r.config.overriddenBy(methodName(info.method));
   std::vector<MethodSetup> setups;
   for (const Method method : methods) {
     const std::string name = methodName(method);
     MethodSetup m{r.model, {}, r.learnt && !r.learnt->posterior.empty() ? &r.learnt->posterior : nullptr, {}, {}};
     const IniDocument config = r.config.hasOverrides(name) ? r.config.overriddenBy(name) : r.config;
-    if (r.config.hasOverrides(name)) m.model = makeModel(config, o.data_dir);
+    if (r.config.hasOverrides(name)) m.model = sameStructure(makeModel(config, o.data_dir), *r.model, name);
     m.options = runOptions(o, r, config, *m.model);
     if (method == Method::Batch && batch_noise) m.own_noise = batch_noise, m.start = nullptr;
     setups.push_back(std::move(m));
@@ -265,6 +291,7 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   std::shared_ptr<const Model> model(makeModel(r.config, o.data_dir));
   r.model = model;
   const std::vector<Method> methods = methodsToRun(o, *model, r.config);
+  checkMethodOverrides(r.config, *model, o.data_dir);
   readData(o, *model, r, cb);
   std::optional<LearnSettings> batch_noise;  // learnt in the batch's job, beside the other methods
   if (LearnSettings learn = learnSettings(r.config); o.learn.value_or(learn.enabled)) {

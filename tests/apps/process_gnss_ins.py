@@ -79,3 +79,18 @@ check(abs(abs(pitch) - 6.79) < 1.5 and abs(yaw - 185.35) < 1.5,
 pos = os.path.join(out, "track-batch.pos")
 check(os.path.exists(pos) and sum(1 for line in open(pos) if not line.startswith("%")) == len(rows),
       "the smoothed track as an RTKLIB .pos, an epoch per row")
+
+# A method's own values ([batch.model]) may change numbers, not the model's
+# structure, and a misspelt section is refused by its line; either before
+# anything is learnt or run.
+scenario = open(os.path.join(data, "scenario.ini"), encoding="utf-8-sig").read()
+for name, extra, want in (("structure", "\n[batch.prior]\nnhc_point_sd = 0 1 0 0\n",
+                           "[batch.*]: a method's own values may change the model's numbers, not its states"),
+                          ("misspelt", "\n[batch.modle]\ngyro_sd = 0.002\n", "[batch.modle] overrides the keys of [modle]")):
+    bad = os.path.join(work, "own-%s.ini" % name)
+    with open(bad, "w") as f:
+        f.write(scenario + extra)
+    r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--config", bad, "--out",
+                        os.path.join(work, "own-" + name)], capture_output=True, text=True)
+    check(r.returncode != 0 and want in r.stderr and "noise learnt" not in r.stdout,
+          "a batch's own %s refused before learning: %s" % (name, r.stderr.strip()[-200:]))
