@@ -134,8 +134,8 @@ void learnConstantsPrior(const std::string& type_name, std::vector<LearntParamet
     p.method = "em";
   }
   standardErrorsOfQ(q, theta, params);  // from Q's curvature: no filter pass, so always
-  r.values = std::move(values);
-  r.model = model;
+  r.values = withSigmas(base, params, sigmasOf(theta));  // the σs the parameters report, to the bit
+  r.model = r.values.build(type_name);
   r.posterior = std::move(x);
   r.parameters.insert(r.parameters.end(), params.begin(), params.end());
   r.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -4,6 +4,7 @@
 // posterior of x_b is N(m, P); the M-step maximizes the expected log prior
 //   Q(σ) = −½ (log det Σ(σ) + tr(Σ(σ)⁻¹ (P + (m − μ(σ))(m − μ(σ))ᵀ)))
 // over log σ, with μ, Σ the prior of x_b the model builds from σ.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,14 @@ namespace gssm::internal {
 /// The values with the chosen σs set: a Real directly; a Matrix as D M D
 /// with D = diag(σ_new / σ_given) on its learnt entries (correlations kept).
 ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParameter>& ps, const Eigen::VectorXd& sigmas);
+
+/// σ = exp(θ), element by element with std::exp: the value a LearntParameter
+/// reports and the learnt scenario.ini holds, to the bit (Eigen's vectorized
+/// exp can differ in the last bit, and a model built from it would not be
+/// the one the written file rebuilds).
+inline Eigen::VectorXd sigmasOf(const Eigen::VectorXd& theta) {
+  return theta.unaryExpr([](double t) { return std::exp(t); });
+}
 
 /// Learns `params` (σs of the constants' prior of model type `type_name`)
 /// starting from r.values, by EM; appends them to r.parameters and sets

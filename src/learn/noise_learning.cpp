@@ -433,7 +433,7 @@ NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Meas
     theta = with_eps;
   }
   finish(obj, theta, o, r);
-  r.model = family.make(theta.head(n).array().exp().matrix());
+  r.model = family.make(internal::sigmasOf(theta.head(n)));
   r.evaluations = obj.evaluations;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return r;

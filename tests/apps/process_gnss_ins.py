@@ -94,3 +94,14 @@ for name, extra, want in (("structure", "\n[batch.prior]\nnhc_point_sd = 0 1 0 0
                         os.path.join(work, "own-" + name)], capture_output=True, text=True)
     check(r.returncode != 0 and want in r.stderr and "noise learnt" not in r.stdout,
           "a batch's own %s refused before learning: %s" % (name, r.stderr.strip()[-200:]))
+
+# OUT/scenario.ini reproduces the run: both learnt noise sets, to the bit
+# (a model built from a σ the file does not hold would not be the one the
+# file rebuilds).
+again = os.path.join(work, "again")
+r = subprocess.run([os.path.join(bin_dir, "gssm-process"), "--data", data, "--config", os.path.join(out, "scenario.ini"),
+                    "--out", again], capture_output=True, text=True)
+same = [m for m in sorted(methods)
+        if r.returncode == 0 and open(os.path.join(out, "estimates-%s.csv" % m)).read() ==
+        open(os.path.join(again, "estimates-%s.csv" % m)).read()]
+check(same == sorted(methods), "OUT/scenario.ini run again gives every method's estimates to the bit (%s)" % ", ".join(same))
