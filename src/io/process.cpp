@@ -110,6 +110,8 @@ struct MethodSetup {
   EstimatorOptions options;
   /// Where a batch starts: learning's last E-step (a batch solve under σ
   /// within the learning tolerance), when it ran one; null: the EKF pass.
+  /// It may point into `learnt`: the setups are complete before any job
+  /// runs and are not moved while they run.
   const Values* start = nullptr;
   std::optional<LearnSettings> own_noise;  ///< learnt first, into `learnt`
   std::optional<LearnResult> learnt;
