@@ -246,13 +246,19 @@ LearnResult learnBatchNoiseAndWrite(const IniDocument& learnt, const Dataset& da
   return learnAndWriteAs(*model, learnt, dataset, out_dir, options, batch, "learn-batch.json");
 }
 
+std::optional<NoiseLearningOptions> batchNoiseOptions(const LearnSettings& settings) {
+  if (!settings.batch_likelihood_spacing) return std::nullopt;
+  NoiseLearningOptions options = settings.options;
+  options.likelihood_spacing = *settings.batch_likelihood_spacing;
+  return options;
+}
+
 LearnResult learnScenarioNoise(const Model& model, const IniDocument& input, const Dataset& dataset,
                                const std::string& out_dir, const LearnSettings& settings) {
   LearnResult out = learnAndWrite(model, input, dataset, out_dir, settings.options);
-  if (!settings.batch_likelihood_spacing) return out;
-  NoiseLearningOptions options = settings.options;
-  options.likelihood_spacing = *settings.batch_likelihood_spacing;
-  LearnResult batch = learnBatchNoiseAndWrite(out.config, dataset, out_dir, options);
+  const std::optional<NoiseLearningOptions> options = batchNoiseOptions(settings);
+  if (!options) return out;
+  LearnResult batch = learnBatchNoiseAndWrite(out.config, dataset, out_dir, *options);
   out.config = std::move(batch.config);
   out.files.push_back(batch.files.back());
   out.batch_report = std::move(batch.report);

@@ -113,7 +113,7 @@ struct MethodSetup {
   /// It may point into `learnt`: the setups are complete before any job
   /// runs and are not moved while they run.
   const Values* start = nullptr;
-  std::optional<LearnSettings> own_noise;  ///< learnt first, into `learnt`
+  std::optional<NoiseLearningOptions> own_noise;  ///< learnt first with these, into `learnt`
   std::optional<LearnResult> learnt;
 };
 
@@ -133,19 +133,18 @@ EstimatorOptions runOptions(const ProcessOptions& o, const ProcessResult& r, con
 // A method's own values change the model's numbers, not its states or
 // channels: the dataset was read for the scenario's model (a channel's
 // regressors, the rows' layout), and the methods' outputs are compared.
-std::shared_ptr<const Model> sameStructure(std::unique_ptr<Model> own, const Model& shared, const std::string& method) {
+void requireSameStructure(const Model& own, const Model& shared, const std::string& method) {
   const auto layout = [](const Model& m) {
     std::vector<int> v{m.dims().nc, m.dims().nb, m.dims().nu, m.dims().ny};
     for (int c = 0; c < m.numChannels(); ++c) v.push_back(m.channel(c).dim()), v.push_back(m.channel(c).regressors);
     return v;
   };
-  if (layout(*own) != layout(shared))
+  if (layout(own) != layout(shared))
     throw InputError("[" + method + ".*]: a method's own values may change the model's numbers, not its states or "
-                     "channels (with them " + method + "'s model has " + std::to_string(own->dims().nb) +
-                     " constants and " + std::to_string(own->dims().nc) + " states, the scenario's " +
+                     "channels (with them " + method + "'s model has " + std::to_string(own.dims().nb) +
+                     " constants and " + std::to_string(own.dims().nc) + " states, the scenario's " +
                      std::to_string(shared.dims().nb) + " and " + std::to_string(shared.dims().nc) +
                      ", or its channels differ)");
-  return own;
 }
 
 // Every method's own values ([<method>.<section>]) checked before anything
@@ -154,18 +153,20 @@ std::shared_ptr<const Model> sameStructure(std::unique_ptr<Model> own, const Mod
 void checkMethodOverrides(const IniDocument& config, const Model& shared, const std::string& data_dir) {
   for (const auto& info : gssm::methods()) {
     const std::string name = methodName(info.method);
-    if (config.hasOverrides(name)) sameStructure(makeModel(config.overriddenBy(name), data_dir), shared, name);
+    if (config.hasOverrides(name)) requireSameStructure(*makeModel(config.overriddenBy(name), data_dir), shared, name);
   }
 }
 
+// Their structure was checked before the run (checkMethodOverrides).
 std::vector<MethodSetup> methodSetups(const ProcessOptions& o, const ProcessResult& r, const std::vector<Method>& methods,
-                                      const std::optional<LearnSettings>& batch_noise) {
+                                      const std::optional<NoiseLearningOptions>& batch_noise) {
   std::vector<MethodSetup> setups;
   for (const Method method : methods) {
     const std::string name = methodName(method);
     MethodSetup m{r.model, {}, r.learnt && !r.learnt->posterior.empty() ? &r.learnt->posterior : nullptr, {}, {}};
-    const IniDocument config = r.config.hasOverrides(name) ? r.config.overriddenBy(name) : r.config;
-    if (r.config.hasOverrides(name)) m.model = sameStructure(makeModel(config, o.data_dir), *r.model, name);
+    const bool own = r.config.hasOverrides(name);
+    const IniDocument config = own ? r.config.overriddenBy(name) : r.config;
+    if (own) m.model = makeModel(config, o.data_dir);
     m.options = runOptions(o, r, config, *m.model);
     if (method == Method::Batch && batch_noise) m.own_noise = batch_noise, m.start = nullptr;
     setups.push_back(std::move(m));
@@ -177,9 +178,7 @@ std::vector<MethodSetup> methodSetups(const ProcessOptions& o, const ProcessResu
 // (OUT/scenario.ini gets its [batch.<section>]); the setup then runs it.
 void learnOwnNoise(const ProcessOptions& o, const ProcessResult& r, MethodSetup& m) {
   if (!m.own_noise) return;
-  NoiseLearningOptions options = m.own_noise->options;
-  options.likelihood_spacing = *m.own_noise->batch_likelihood_spacing;
-  m.learnt = learnBatchNoiseAndWrite(r.config, r.dataset, o.out_dir, options);
+  m.learnt = learnBatchNoiseAndWrite(r.config, r.dataset, o.out_dir, *m.own_noise);
   m.model = m.learnt->report.model;
   m.options = runOptions(o, r, m.learnt->config.overriddenBy(methodName(Method::Batch)), *m.model);
   m.start = m.learnt->report.posterior.empty() ? nullptr : &m.learnt->report.posterior;
@@ -295,11 +294,11 @@ ProcessResult processDataset(const ProcessOptions& o, const ProcessCallbacks& cb
   const std::vector<Method> methods = methodsToRun(o, *model, r.config);
   checkMethodOverrides(r.config, *model, o.data_dir);
   readData(o, *model, r, cb);
-  std::optional<LearnSettings> batch_noise;  // learnt in the batch's job, beside the other methods
+  std::optional<NoiseLearningOptions> batch_noise;  // learnt in the batch's job, beside the other methods
   if (LearnSettings learn = learnSettings(r.config); o.learn.value_or(learn.enabled)) {
     // learning runs alone: its passes and batch solves may use every thread
     learn.options.threads = learn.options.batch.threads = static_cast<int>(o.threads);
-    if (learn.batch_likelihood_spacing) batch_noise = learn;
+    batch_noise = batchNoiseOptions(learn);
     learn.batch_likelihood_spacing.reset();
     LearnResult learnt = learnScenarioNoise(*model, r.config, r.dataset, o.out_dir, learn);
     r.config = std::move(learnt.config);

@@ -76,6 +76,10 @@ LearnResult learnAndWrite(const Model& model, const IniDocument& input, const Da
 LearnResult learnBatchNoiseAndWrite(const IniDocument& learnt, const Dataset& dataset, const std::string& out_dir,
                                     const NoiseLearningOptions& options);
 
+/// The options the batch's own noise is learnt with: `settings`' options at
+/// its batch_likelihood_spacing; none when that is not given.
+std::optional<NoiseLearningOptions> batchNoiseOptions(const LearnSettings& settings);
+
 /// Both of the above as `settings` ask: the noise, then the batch's own
 /// when settings.batch_likelihood_spacing is given (config and files then
 /// include it).
