@@ -44,22 +44,38 @@ inline Eigen::Vector3d driveStartRpy(const Eigen::Vector3d& mount_rpy) {
   return so3::rollPitchYaw(R_nv * so3::fromRollPitchYaw(mount_rpy));
 }
 
-/// The IMU's velocity in vehicle axes for the vehicle's forward speed and
-/// its rate Ω (vehicle axes): the constraints hold at the model's points
-/// (Params::nhc_point, the truth's where they are constants), so the IMU
-/// moves sideways by −(Ω×r_side)_y and vertically by −(Ω×r_vert)_z.
+/// The IMU's velocity in vehicle axes for the vehicle's forward speed, its
+/// rate Ω and the specific force F (vehicle axes): the constraints hold at
+/// the model's points (Params::nhc_point, the truth's where they are
+/// constants) in axes turned by its give (Params::nhc_compliance), so the
+/// IMU moves sideways by −(Ω×r_side)_y − k_s·F_r·speed and vertically by
+/// −(Ω×r_vert)_z − k_v·F_f·speed.
 inline Eigen::Vector3d imuVelocityInVehicle(const models::StrapdownIns& model, const Eigen::VectorXd& constants,
-                                            double speed, const Eigen::Vector3d& Omega) {
+                                            double speed, const Eigen::Vector3d& Omega, const Eigen::Vector3d& F) {
   const Eigen::Vector4d r = model.nhcPoint(constants);
+  const Eigen::Vector2d k = model.nhcCompliance(constants);
   const Eigen::Vector3d side = Omega.cross(Eigen::Vector3d(r[0], 0, r[1]));
   const Eigen::Vector3d vert = Omega.cross(Eigen::Vector3d(r[2], r[3], 0));
-  return {speed, -side.y(), -vert.z()};
+  return {speed, -side.y() - k[0] * F.y() * speed, -vert.z() - k[1] * F.x() * speed};
+}
+
+/// The accelerometer reading whose specific force, as the model corrects it
+/// ((1 − s_a)∘f̃ − b_a, then R_vb), is F in vehicle axes.
+inline Eigen::Vector3d accelReadingFor(const Eigen::VectorXd& constants, const Eigen::Matrix3d& R_vb,
+                                       const Eigen::Vector3d& F) {
+  using Ins = models::StrapdownIns;
+  return (R_vb.transpose() * F + constants.segment<3>(Ins::kAccelBias))
+      .cwiseQuotient(Eigen::Vector3d::Ones() - constants.segment<3>(Ins::kAccelScale));
 }
 
 /// Drives `seconds` with `model` (its T the IMU interval); the constants
 /// drawn from the model's prior, the start its prior mean; the body rocks
-/// in roll by roll_amplitude (rad) while driving. A constraint at points
-/// off the IMU carries the step's gyro reading (Measurement::regressors).
+/// in roll by roll_amplitude (rad) while driving. A constraint that reads
+/// the IMU (Measurement::regressors) carries the step's gyro reading and
+/// an accelerometer reading of the path's specific force (the vehicle's
+/// acceleration along its nominal path less gravity, smooth: the body's
+/// give follows it, and a give following the jittering readings would feed
+/// back on itself).
 inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double seconds, const NormalSampler& draw,
                                     double roll_amplitude = 0.0) {
   SimulatedDrive d;
@@ -69,6 +85,7 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
   Eigen::Matrix3d R_nv;
   double speed;
   vehicleAt(0, R_nv, speed, roll_amplitude);
+  Eigen::Vector3d path_velocity = R_nv * Eigen::Vector3d(speed, 0, 0);
   Eigen::VectorXd x(models::StrapdownIns::kStates);
   x << so3::Log(R_nv * R_vb), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0;
   d.states.push_back(x);
@@ -84,7 +101,10 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
     const Eigen::Vector3d w_ie = model.frame().earthRate();
     const Eigen::Vector3d gyro = so3::Log(R.transpose() * so3::Exp(w_ie * T) * R_next) / T;
     const Eigen::Vector3d v = x.segment<3>(3);
-    const Eigen::Vector3d v_next = R_nv * imuVelocityInVehicle(model, d.constants, speed, R_vb * gyro);
+    const Eigen::Vector3d path_next = R_nv * Eigen::Vector3d(speed, 0, 0);
+    const Eigen::Vector3d F = R_nv.transpose() * ((path_next - path_velocity) / T - model.frame().gravity(x.segment<3>(6)));
+    path_velocity = path_next;
+    const Eigen::Vector3d v_next = R_nv * imuVelocityInVehicle(model, d.constants, speed, R_vb * gyro, F);
     const Eigen::Vector3d accel =
         R.transpose() * ((v_next - v) / T - model.frame().gravity(x.segment<3>(6)) + 2 * w_ie.cross(v));
     Eigen::VectorXd u(6);
@@ -106,9 +126,10 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
     if (n % per_constraint == 0) {
       const bool standing = tn < 5.0;
       const int c = standing ? Ins::kZupt : Ins::kNhc;
-      const bool reads_rate = model.channel(c).regressors > 0;
-      d.measurements.push_back({tn, Eigen::VectorXd::Zero(model.channel(c).dim()), c, {},
-                                reads_rate ? Eigen::VectorXd(u.head<3>()) : Eigen::VectorXd()});
+      Eigen::VectorXd reading(model.channel(c).regressors);
+      if (reading.size() >= 3) reading.head<3>() = u.head<3>();
+      if (reading.size() == 6) reading.tail<3>() = accelReadingFor(d.constants, R_vb, F);
+      d.measurements.push_back({tn, Eigen::VectorXd::Zero(model.channel(c).dim()), c, {}, reading});
     }
   }
   return d;

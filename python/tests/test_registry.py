@@ -158,3 +158,23 @@ def test_strapdown_ins_constraints_at_a_point_below_the_imu():
     with pytest.raises(gssm.InvalidArgument, match="carries 0 known values"):
         m.h(x, b, "nhc")
     assert gssm.models.from_ini(m.to_ini()).to_ini() == m.to_ini()
+
+
+def test_strapdown_ins_constraints_with_the_bodys_give():
+    """The body's give ([prior] nhc_compliance): the constraints hold in axes
+    turned by k_v times the forward specific force about right, so a car at
+    10 m/s braking or climbing with 2 m/s^2 forward at k_v = 0.005 shows
+    0.1 m/s down in the body's axes and none in the turned ones; `nhc` then
+    reads the gyro's and the accelerometer's readings."""
+    m = gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], prior_nhc_compliance=[0.0, 0.005])
+    assert m.nb == 20 and [c.regressors for c in m.channels][1] == 6
+    x, b = np.array(m.prior_state[0], dtype=float), np.zeros(20)
+    x[:3] = 0.0  # IMU axes = NED = vehicle axes (mount_rpy 0)
+    x[3:6] = [10.0, 0.0, 0.0]
+    reading = np.array([0.0, 0.0, 0.0, 2.0, 0.0, -9.8])
+    np.testing.assert_allclose(m.h(x, b, "nhc", regressors=reading), [0.0, 0.1], atol=1e-12)
+    x[5] = -0.1  # rising against the body's axes as it pitches: level in the turned ones
+    np.testing.assert_allclose(m.h(x, b, "nhc", regressors=reading), [0.0, 0.0], atol=1e-12)
+    learnt = gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], prior_nhc_compliance_sd=[0.01, 0.01])
+    assert learnt.constant_names[-2:] == ["nhc_side_k", "nhc_vert_k"]
+    assert gssm.models.from_ini(learnt.to_ini()).to_ini() == learnt.to_ini()

@@ -20,19 +20,28 @@ using so3::hat;
 
 int insStates(const StrapdownIns::Params& p) { return StrapdownIns::kStates + (p.gyro_bias_walk > 0 ? 3 : 0); }
 
-const char* const kNhcPointNames[4] = {"nhc_side_f", "nhc_side_d", "nhc_vert_f", "nhc_vert_r"};
+const char* const kNhcShapeNames[6] = {"nhc_side_f", "nhc_side_d", "nhc_vert_f", "nhc_vert_r", "nhc_side_k", "nhc_vert_k"};
 
-// Where each component of nhc_point is in x_b: after every INS's
-// constants, one per component with σ > 0 in turn (−1: held at its mean).
-std::array<int, 4> nhcPointIndices(const StrapdownIns::Params& p) {
-  std::array<int, 4> index;
-  for (int i = 0, b = StrapdownIns::kConstants; i < 4; ++i)
-    index[static_cast<std::size_t>(i)] = p.nhc_point_sd[i] > 0 ? b++ : -1;
+// The constraints' optional constants in x_b's order: the points' four,
+// then the body's give's two (their prior means, their σs).
+Eigen::Matrix<double, 6, 1> nhcShapeMeans(const StrapdownIns::Params& p) {
+  return (Eigen::Matrix<double, 6, 1>() << p.nhc_point, p.nhc_compliance).finished();
+}
+Eigen::Matrix<double, 6, 1> nhcShapeSds(const StrapdownIns::Params& p) {
+  return (Eigen::Matrix<double, 6, 1>() << p.nhc_point_sd, p.nhc_compliance_sd).finished();
+}
+
+// Where each of them is in x_b: after every INS's constants, one per
+// component with σ > 0 in turn (−1: held at its mean).
+std::array<int, 6> nhcShapeIndices(const StrapdownIns::Params& p) {
+  std::array<int, 6> index;
+  const Eigen::Matrix<double, 6, 1> sd = nhcShapeSds(p);
+  for (int i = 0, b = StrapdownIns::kConstants; i < 6; ++i) index[static_cast<std::size_t>(i)] = sd[i] > 0 ? b++ : -1;
   return index;
 }
 
 int insConstants(const StrapdownIns::Params& p) {
-  return StrapdownIns::kConstants + static_cast<int>((p.nhc_point_sd.array() > 0).count());
+  return StrapdownIns::kConstants + static_cast<int>((nhcShapeSds(p).array() > 0).count());
 }
 
 ModelNames insNames(const StrapdownIns::Params& p) {
@@ -41,8 +50,9 @@ ModelNames insNames(const StrapdownIns::Params& p) {
   if (p.gyro_bias_walk > 0) n.state.insert(n.state.end(), {"bgw_x", "bgw_y", "bgw_z"});
   n.constants = {"bg_x", "bg_y", "bg_z", "ba_x", "ba_y", "ba_z", "lever_x", "lever_y", "lever_z",
                  "mount_roll", "mount_pitch", "mount_yaw", "imu_delay", "sg_x", "sg_y", "sg_z", "sa_x", "sa_y", "sa_z", "clock_rate"};
-  for (int i = 0; i < 4; ++i)
-    if (p.nhc_point_sd[i] > 0) n.constants.push_back(kNhcPointNames[i]);
+  const Eigen::Matrix<double, 6, 1> shape_sd = nhcShapeSds(p);
+  for (int i = 0; i < 6; ++i)
+    if (shape_sd[i] > 0) n.constants.push_back(kNhcShapeNames[i]);
   n.input = {"gx", "gy", "gz", "ax", "ay", "az"};
   if (p.imu_per_state > 1) {  // dt_j, then the reading j: packed_inputs.h
     std::vector<std::string> packed;
@@ -92,6 +102,9 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
     throw InvalidArgument("StrapdownIns: nhc_ekf_gate must be >= 0 (0: no gate)");
   if (!(p.nhc_point_sd.array() >= 0).all() || !p.nhc_point_sd.allFinite() || !p.nhc_point.allFinite())
     throw InvalidArgument("StrapdownIns: nhc_point must be finite and nhc_point_sd >= 0 (0: held at its mean)");
+  if (!(p.nhc_compliance_sd.array() >= 0).all() || !p.nhc_compliance_sd.allFinite() || !p.nhc_compliance.allFinite())
+    throw InvalidArgument(
+        "StrapdownIns: nhc_compliance must be finite and nhc_compliance_sd >= 0 (0: held at its mean)");
   if (!(p.gyro_bias_walk >= 0) || !std::isfinite(p.gyro_bias_walk))
     throw InvalidArgument("StrapdownIns: gyro_bias_walk must be >= 0 (0: a constant gyro bias)");
   ModelNoise n;
@@ -123,12 +136,12 @@ ModelNoise insNoise(const StrapdownIns::Params& p) {
   bsd.head(StrapdownIns::kConstants) << Eigen::Vector3d::Constant(p.gyro_bias_sd),
       Eigen::Vector3d::Constant(p.accel_bias_sd), Eigen::Vector3d::Constant(p.lever_sd),
       Eigen::Vector3d::Constant(p.mount_sd), p.delay_sd, Eigen::Vector3d::Constant(p.gyro_scale_sd),
-      Eigen::Vector3d::Constant(p.accel_scale_sd), p.clock_rate_sd;  // then the constraints' points'
-  const std::array<int, 4> point = nhcPointIndices(p);
-  for (std::size_t i = 0; i < 4; ++i)
-    if (point[i] >= 0) {
-      bmean[point[i]] = p.nhc_point[static_cast<Eigen::Index>(i)];
-      bsd[point[i]] = p.nhc_point_sd[static_cast<Eigen::Index>(i)];
+      Eigen::Vector3d::Constant(p.accel_scale_sd), p.clock_rate_sd;  // then the constraints' points' and give's
+  const std::array<int, 6> shape = nhcShapeIndices(p);
+  for (std::size_t i = 0; i < 6; ++i)
+    if (shape[i] >= 0) {
+      bmean[shape[i]] = nhcShapeMeans(p)[static_cast<Eigen::Index>(i)];
+      bsd[shape[i]] = nhcShapeSds(p)[static_cast<Eigen::Index>(i)];
     }
   n.prior_constants = {bmean, Eigen::MatrixXd(bsd.cwiseAbs2().asDiagonal())};
   return n;
@@ -163,8 +176,11 @@ StrapdownIns::StrapdownIns(const Params& p)
       p_(p),
       frame_(p.anchor),
       mount0_(so3::fromRollPitchYaw(p.mount_rpy)),
-      nhc_point_index_(nhcPointIndices(p)),
-      nhc_points_off_imu_(!p.nhc_point.isZero() || !p.nhc_point_sd.isZero()) {
+      nhc_points_off_imu_(!p.nhc_point.isZero() || !p.nhc_point_sd.isZero()),
+      nhc_compliant_(!p.nhc_compliance.isZero() || !p.nhc_compliance_sd.isZero()) {
+  const std::array<int, 6> shape = nhcShapeIndices(p);
+  std::copy(shape.begin(), shape.begin() + 4, nhc_point_index_.begin());
+  std::copy(shape.begin() + 4, shape.end(), nhc_compliance_index_.begin());
   MeasurementChannel gnss =
       channelOf("gnss", {"gnss_n", "gnss_e", "gnss_d"}, Eigen::Vector3d::Constant(p.gnss_sd), {6, 7, 8, kDelay, kClockRate});
   gnss.own_R_scale = p.gnss_sd_scale * p.gnss_sd_scale;
@@ -173,9 +189,14 @@ StrapdownIns::StrapdownIns(const Params& p)
     nhc.regressors = 3;
     nhc.constants.insert(nhc.constants.end(),
                          {kGyroBias, kGyroBias + 1, kGyroBias + 2, kGyroScale, kGyroScale + 1, kGyroScale + 2});
-    for (int b = kConstants; b < insConstants(p); ++b) nhc.constants.push_back(b);
-    std::sort(nhc.constants.begin(), nhc.constants.end());
   }
+  if (nhc_compliant_) {  // the give follows the specific force: the accelerometer's reading too
+    nhc.regressors = 6;
+    nhc.constants.insert(nhc.constants.end(),
+                         {kAccelBias, kAccelBias + 1, kAccelBias + 2, kAccelScale, kAccelScale + 1, kAccelScale + 2});
+  }
+  for (int b = kConstants; b < insConstants(p); ++b) nhc.constants.push_back(b);
+  std::sort(nhc.constants.begin(), nhc.constants.end());
   nhc.loss = p.nhc_loss;
   nhc.ekf_gate = p.nhc_ekf_gate;
   setChannels({std::move(gnss), std::move(nhc),
@@ -289,10 +310,11 @@ Eigen::VectorXd StrapdownIns::h(int channel, const Eigen::VectorXd& xc, const Ei
                                 Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
   this->channel(channel);  // range check: throws, naming the channels
   if (channel == kGnss) return antenna(xc, xb, J_h_xc, J_h_xb);
-  if (channel == kNhc && !nhcPointsOffImu()) return vehicleVelocity(xc, xb, Eigen::Vector3d::Zero(), J_h_xc, J_h_xb);
+  if (channel == kNhc && this->channel(kNhc).regressors == 0)
+    return vehicleVelocity(xc, xb, Eigen::VectorXd(), J_h_xc, J_h_xb);
   if (channel == kNhc)
-    throw InvalidArgument("StrapdownIns: channel 'nhc' holds at points off the IMU ([prior] nhc_point): it reads the "
-                          "gyro's mean reading there, evaluate it by hWith");
+    throw InvalidArgument("StrapdownIns: channel 'nhc' holds at points off the IMU or with the body's give ([prior] "
+                          "nhc_point, nhc_compliance): it reads the IMU's mean reading there, evaluate it by hWith");
   if (channel == kZaru) return restingGyro(xc, xb, J_h_xc, J_h_xb);
   if (channel == kGnssVelocity)
     throw InvalidArgument("StrapdownIns: channel 'gnss_vel' reads the IMU's reading at the fix: evaluate it by hWith");
@@ -340,17 +362,19 @@ Eigen::Vector4d StrapdownIns::nhcPoint(const Eigen::VectorXd& xb) const {
 }
 
 // The vehicle's velocity w = R_vb·Rᵀ·v at the IMU, its right and down
-// parts: with u = Rᵀv, ∂/∂δθ = R_vb·[u]×, ∂/∂v = R_vb·Rᵀ, ∂/∂μ =
-// −R_vb·[u]×·E; at points off the IMU, the body's turn there added
-// (addTurnAtPoints; gyro: the gyro's mean reading at the constraint).
+// parts: with u = Rᵀv, ∂w/∂δθ = R_vb·[u]×, ∂w/∂v = R_vb·Rᵀ, ∂w/∂μ =
+// −R_vb·[u]×·E; with the body's give, in axes turned by it
+// (addCompliance); at points off the IMU, the body's turn there added
+// (addTurnAtPoints). reading: the IMU's mean reading at the constraint
+// (gyro, then accelerometer; as many as the channel reads).
 Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
-                                              const Eigen::Vector3d& gyro, Eigen::MatrixXd* J_h_xc,
+                                              const Eigen::VectorXd& reading, Eigen::MatrixXd* J_h_xc,
                                               Eigen::MatrixXd* J_h_xb) const {
   const Eigen::Matrix3d R = so3::Exp(xc.head<3>());
   Eigen::Matrix3d E;
   const Eigen::Matrix3d M = mounting(xb, &E);
-  const Eigen::Vector3d u = R.transpose() * xc.segment<3>(3);
-  Eigen::Vector2d out = (M * u).tail<2>();
+  const Eigen::Vector3d u = R.transpose() * xc.segment<3>(3), w = M * u;
+  Eigen::Vector2d out = w.tail<2>();
   if (J_h_xc) {
     J_h_xc->setZero(2, dims().nc);
     J_h_xc->leftCols<3>() = (M * hat(u)).bottomRows<2>();
@@ -360,8 +384,47 @@ Eigen::VectorXd StrapdownIns::vehicleVelocity(const Eigen::VectorXd& xc, const E
     J_h_xb->setZero(2, dims().nb);
     J_h_xb->middleCols<3>(kMount) = (-M * hat(u) * E).bottomRows<2>();
   }
-  if (nhcPointsOffImu()) addTurnAtPoints(xc, xb, gyro, M, E, out, J_h_xc, J_h_xb);
+  if (nhcCompliant()) addCompliance(R, xb, reading.segment<3>(3), u, M, E, out, J_h_xc, J_h_xb);
+  if (nhcPointsOffImu()) addTurnAtPoints(xc, xb, reading.head<3>(), M, E, out, J_h_xc, J_h_xb);
   return out;
+}
+
+// The body's give (Params::nhc_compliance): the constraints hold in axes
+// turned by k_s·F_r about down and k_v·F_f about right, F = R_vb·f the
+// specific force in vehicle axes (f = (1 − s_a)∘f̃ − b_a), so sideways
+// k_s·F_r·w_f and vertically k_v·F_f·w_f are added (to first order in the
+// small angles). ∂F/∂μ = −R_vb·[f]×·E, ∂F/∂b_a = −R_vb,
+// ∂F/∂s_a = −R_vb·diag(f̃); w_f = (R_vb·u)_x as in vehicleVelocity (R:
+// the attitude).
+void StrapdownIns::addCompliance(const Eigen::Matrix3d& R, const Eigen::VectorXd& xb, const Eigen::Vector3d& accel,
+                                 const Eigen::Vector3d& u, const Eigen::Matrix3d& M, const Eigen::Matrix3d& E,
+                                 Eigen::Vector2d& out, Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const {
+  const Eigen::Vector3d f = accel - xb.segment<3>(kAccelScale).cwiseProduct(accel) - xb.segment<3>(kAccelBias);
+  const Eigen::Vector3d F = M * f;
+  const Eigen::Vector2d k = nhcCompliance(xb);
+  const double w_f = M.row(0).dot(u);
+  const Eigen::Vector2d J_out_wf(k[0] * F.y(), k[1] * F.x());
+  out += J_out_wf * w_f;
+  if (J_h_xc) {
+    J_h_xc->leftCols<3>() += J_out_wf * (M * hat(u)).row(0);
+    J_h_xc->middleCols<3>(3) += J_out_wf * (M * R.transpose()).row(0);
+  }
+  if (!J_h_xb) return;
+  J_h_xb->middleCols<3>(kMount) -= J_out_wf * (M * hat(u) * E).row(0);
+  Eigen::Matrix<double, 2, 3> J_out_F;
+  J_out_F << 0, k[0] * w_f, 0, k[1] * w_f, 0, 0;
+  J_h_xb->middleCols<3>(kMount) -= J_out_F * M * hat(f) * E;
+  J_h_xb->middleCols<3>(kAccelBias) = -J_out_F * M;
+  J_h_xb->middleCols<3>(kAccelScale) = -J_out_F * M * accel.asDiagonal();
+  if (nhcComplianceIndex(0) >= 0) J_h_xb->col(nhcComplianceIndex(0)) = Eigen::Vector2d(F.y() * w_f, 0);
+  if (nhcComplianceIndex(1) >= 0) J_h_xb->col(nhcComplianceIndex(1)) = Eigen::Vector2d(0, F.x() * w_f);
+}
+
+Eigen::Vector2d StrapdownIns::nhcCompliance(const Eigen::VectorXd& xb) const {
+  Eigen::Vector2d k = p_.nhc_compliance;
+  for (int i = 0; i < 2; ++i)
+    if (nhcComplianceIndex(i) >= 0) k[i] = xb[nhcComplianceIndex(i)];
+  return k;
 }
 
 // Ω×r at a point r from the IMU in vehicle axes, Ω = R_vb·ω the body's rate
@@ -418,7 +481,7 @@ Eigen::VectorXd StrapdownIns::restingGyro(const Eigen::VectorXd& xc, const Eigen
 void StrapdownIns::hRegressedInto(int channel, const Eigen::VectorXd& regressors, const Eigen::VectorXd& xc,
                                   const Eigen::VectorXd& xb, Eigen::VectorXd& out, Eigen::MatrixXd* J_h_xc,
                                   Eigen::MatrixXd* J_h_xb) const {
-  if (channel == kNhc && nhcPointsOffImu()) {
+  if (channel == kNhc && this->channel(kNhc).regressors > 0) {
     out = vehicleVelocity(xc, xb, regressors, J_h_xc, J_h_xb);
     return;
   }
@@ -517,7 +580,13 @@ std::vector<ParamSpec> insParams() {
              "where the vehicle constraints hold, from the IMU in vehicle axes (m): the sideways one's point "
              "forward and down, the vertical one's forward and right (default 0 0 0 0: at the IMU)"),
       vector("prior", "nhc_point_sd",
-             "their prior σs (m): each > 0 is a constant node, learnt with the others; 0 holds it at its mean")};
+             "their prior σs (m): each > 0 is a constant node, learnt with the others; 0 holds it at its mean"),
+      vector("prior", "nhc_compliance",
+             "the body's give on its tyres and springs (rad per m/s²): the constraints' axes turn from the body's by "
+             "k_s·(lateral specific force) about down, a slip angle, and by k_v·(forward specific force) about "
+             "right, a pitch on the springs; k_s k_v (default 0 0: none)"),
+      vector("prior", "nhc_compliance_sd",
+             "their prior σs (rad per m/s²): each > 0 is a constant node; 0 holds it at its mean")};
   for (auto& l : lossParams("model", "nhc_", "the vehicle constraints (nhc: a bump or a skid breaks them)"))
     p.push_back(l);
   p.push_back(param::real("model", "nhc_ekf_gate",
@@ -649,6 +718,8 @@ StrapdownIns::Params readIns(const ParamSource& in) {
     if (in.has("prior", key)) *value = in.vector("prior", key, 3);
   for (auto [key, value] : {std::pair{"nhc_point", &p.nhc_point}, {"nhc_point_sd", &p.nhc_point_sd}})
     if (in.has("prior", key)) *value = in.vector("prior", key, 4);
+  for (auto [key, value] : {std::pair{"nhc_compliance", &p.nhc_compliance}, {"nhc_compliance_sd", &p.nhc_compliance_sd}})
+    if (in.has("prior", key)) *value = in.vector("prior", key, 2);
   p.delay = in.real("prior", "delay", p.delay);
   p.clock_rate = in.real("prior", "clock_rate", p.clock_rate);
   p.nhc_loss = readLoss(in, "model", "nhc_");
@@ -685,6 +756,8 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   for (auto [key, value] : calibrationPriors(p)) out.vector("prior", key, *value);
   out.vector("prior", "nhc_point", p.nhc_point);
   out.vector("prior", "nhc_point_sd", p.nhc_point_sd);
+  out.vector("prior", "nhc_compliance", p.nhc_compliance);
+  out.vector("prior", "nhc_compliance_sd", p.nhc_compliance_sd);
   out.real("prior", "delay", p.delay);
   out.real("prior", "clock_rate", p.clock_rate);
   for (auto [key, value] : angleSds(p)) out.real("prior", key, *value / kDeg);

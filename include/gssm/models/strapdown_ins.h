@@ -30,7 +30,8 @@
 // Channels: `gnss` (the antenna's NED position at the fix's time,
 // p + R_nb·ℓ − (d + ρ·c)·v), `nhc`
 // (the vehicle's sideways and vertical velocity, zero: [R_vb·R_nbᵀ·v]_y,z
-// at the IMU, or at the points Params::nhc_point from it),
+// at the IMU, or at the points Params::nhc_point from it, in axes turned
+// by the body's give Params::nhc_compliance),
 // `zupt` (the velocity, zero while standing), `zaru` (the gyro's mean
 // reading while standing: b_g + R_nbᵀ·ω_ie), `gnss_vel` (the antenna's NED
 // velocity at the fix's time, v + R_nb·(ω×ℓ) − δ·a: it reads the IMU's mean
@@ -74,6 +75,18 @@ class StrapdownIns final : public Model {
     /// its mean. With any point off the IMU the `nhc` channel reads the
     /// gyro's mean reading at the constraint (Measurement::regressors).
     Eigen::Vector4d nhc_point{0, 0, 0, 0}, nhc_point_sd{0, 0, 0, 0};
+    /// The body's give on its tyres and springs (rad per m/s²): the car's
+    /// body turns against its path in proportion to the specific force
+    /// the tyres carry, so the constraints hold in axes turned from the
+    /// body's by k_s·F_r about down (the slip angle under a lateral
+    /// force) and by k_v·F_f about right (the pitch on the springs as the
+    /// car brakes, accelerates or climbs), F = R_vb·f the specific force
+    /// in vehicle axes: sideways k_s·F_r·w_f and vertically k_v·F_f·w_f
+    /// are added to the velocity w at the constraints' points, in that
+    /// order (k_s, k_v). Prior means and σs as nhc_point's: σ > 0 makes a
+    /// constant node (`nhc_side_k`, `nhc_vert_k`). With either in use the
+    /// `nhc` channel reads the IMU's mean reading (gyro, accelerometer).
+    Eigen::Vector2d nhc_compliance{0, 0}, nhc_compliance_sd{0, 0};
     double zupt_sd = 0.01;                     ///< σ of the velocity while standing (m/s)
     double zaru_sd = 0.005;                    ///< σ of the gyro's mean reading while standing (rad/s)
     /// Robust loss on the vehicle constraints (`nhc`): a bump or a skid
@@ -151,7 +164,8 @@ class StrapdownIns final : public Model {
   }
 
   // Where each part of x_b starts: the constants every INS has, then the
-  // vehicle constraints' points whose σ > 0 (nhcPointIndex).
+  // vehicle constraints' points whose σ > 0 (nhcPointIndex), then the
+  // body's give whose σ > 0 (nhcComplianceIndex).
   static constexpr int kGyroBias = 0, kAccelBias = 3, kLever = 6, kMount = 9, kDelay = 12, kGyroScale = 13,
                        kAccelScale = 16, kClockRate = 19, kConstants = 20;
   // In x_c: the navigation states (kStates of them), then β_g when the
@@ -166,6 +180,13 @@ class StrapdownIns final : public Model {
   /// The constraints' points at the constants x_b, as Params::nhc_point
   /// (side f, d; vertical f, r; m, vehicle axes from the IMU).
   Eigen::Vector4d nhcPoint(const Eigen::VectorXd& xb) const;
+  /// Where component i of Params::nhc_compliance is in x_b (−1: held at its mean).
+  int nhcComplianceIndex(int i) const { return nhc_compliance_index_[static_cast<std::size_t>(i)]; }
+  /// The body's give in use (any nhc_compliance or σ not 0): the `nhc`
+  /// channel then reads the accelerometer's mean reading too.
+  bool nhcCompliant() const { return nhc_compliant_; }
+  /// The give (k_s, k_v) at the constants x_b, as Params::nhc_compliance.
+  Eigen::Vector2d nhcCompliance(const Eigen::VectorXd& xb) const;
   /// The gyro bias at state x_c: b_g (+ β_g when it walks).
   Eigen::Vector3d gyroBias(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb) const {
     Eigen::Vector3d b = xb.segment<3>(kGyroBias);
@@ -185,16 +206,21 @@ class StrapdownIns final : public Model {
                           Eigen::MatrixXd* J_h_xb) const;
   Eigen::VectorXd restingGyro(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, Eigen::MatrixXd* J_h_xc,
                               Eigen::MatrixXd* J_h_xb) const;
-  Eigen::VectorXd vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::Vector3d& gyro,
-                                  Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const;
+  Eigen::VectorXd vehicleVelocity(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb,
+                                  const Eigen::VectorXd& reading, Eigen::MatrixXd* J_h_xc,
+                                  Eigen::MatrixXd* J_h_xb) const;
   void addTurnAtPoints(const Eigen::VectorXd& xc, const Eigen::VectorXd& xb, const Eigen::Vector3d& gyro,
                        const Eigen::Matrix3d& M, const Eigen::Matrix3d& E, Eigen::Vector2d& out,
                        Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const;
+  void addCompliance(const Eigen::Matrix3d& R, const Eigen::VectorXd& xb, const Eigen::Vector3d& accel,
+                     const Eigen::Vector3d& u, const Eigen::Matrix3d& M, const Eigen::Matrix3d& E,
+                     Eigen::Vector2d& out, Eigen::MatrixXd* J_h_xc, Eigen::MatrixXd* J_h_xb) const;
   Params p_;
   strapdown::NavFrame frame_;
   Eigen::Matrix3d mount0_;  // R_vb0
   std::array<int, 4> nhc_point_index_;
-  bool nhc_points_off_imu_;
+  std::array<int, 2> nhc_compliance_index_;
+  bool nhc_points_off_imu_, nhc_compliant_;
 };
 
 }  // namespace gssm::models
