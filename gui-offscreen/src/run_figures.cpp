@@ -8,6 +8,8 @@
 
 #include "gssm/core/angles.h"
 #include "gssm/core/time.h"
+#include "gssm/io/config.h"
+#include "gssm/io/number_text.h"
 #include "gssm/plot/figure.h"
 
 namespace gssm::plot {
@@ -26,9 +28,9 @@ Eigen::Index truthColumn(const Truth* truth, Eigen::Index stacked) {
 
 namespace {
 // One run's estimate of stacked state idx (minus the truth, for a
-// time-series state) with its 3σ band.
+// time-series state) with its band of ±k σ.
 void addStateSeries(Figure& f, const OfflineRun& run, Color c, const Truth* truth, Eigen::Index idx,
-                    Eigen::Index tcol, bool constant, bool angle) {
+                    Eigen::Index tcol, bool constant, bool angle, double k) {
   Series s{display(run.method), {}, {}, c, 2, false};
   Band b{{}, {}, {}, c, 0.15};
   std::optional<TimeMatcher> match;
@@ -47,8 +49,8 @@ void addStateSeries(Figure& f, const OfflineRun& run, Color c, const Truth* trut
     s.x.push_back(row.t);
     s.y.push_back(v);
     b.x.push_back(row.t);
-    b.lo.push_back(v - 3 * sd);
-    b.hi.push_back(v + 3 * sd);
+    b.lo.push_back(v - k * sd);
+    b.hi.push_back(v + k * sd);
   }
   f.bands.push_back(std::move(b));
   f.series.push_back(std::move(s));
@@ -56,7 +58,7 @@ void addStateSeries(Figure& f, const OfflineRun& run, Color c, const Truth* trut
 
 // A constant's estimates (with its truth), or a time-series state's errors.
 Figure stateFigure(const Model& model, const std::vector<OfflineRun>& runs, const Truth* truth, std::size_t i,
-                   const std::string& label) {
+                   const std::string& label, double k) {
   const auto names = model.stackedStateNames();
   const auto idx = static_cast<Eigen::Index>(i);
   const bool constant = static_cast<int>(i) >= model.dims().nc;
@@ -64,12 +66,13 @@ Figure stateFigure(const Model& model, const std::vector<OfflineRun>& runs, cons
   const auto& angles = model.angleStates();
   const bool angle = std::find(angles.begin(), angles.end(), static_cast<int>(idx)) != angles.end();
   Figure f;
-  f.title = constant ? names[i] + ": estimate and 3-sigma band (" + label + ")"
-                     : names[i] + " error: estimate - truth, with 3-sigma band (" + label + ")";
+  const std::string band = io::formatDouble(k) + "-sigma band";
+  f.title = constant ? names[i] + ": estimate and " + band + " (" + label + ")"
+                     : names[i] + " error: estimate - truth, with " + band + " (" + label + ")";
   f.xlabel = "time t (s)";
   f.ylabel = constant ? names[i] : names[i] + " error";
   for (std::size_t r = 0; r < runs.size(); ++r)
-    addStateSeries(f, runs[r], paletteColor(r), truth, idx, tcol, constant, angle);
+    addStateSeries(f, runs[r], paletteColor(r), truth, idx, tcol, constant, angle, k);
   if (constant && tcol >= 0) {
     Series t{"truth", truth->times, {}, Color{0, 0, 0}, 1, true};
     for (const auto& z : truth->states) t.y.push_back(z[tcol]);
@@ -176,7 +179,7 @@ std::optional<Figure> latencyFigure(const std::vector<OfflineRun>& runs, const s
 
 std::vector<FigureJob> runFigureJobs(const Model& model, const std::vector<OfflineRun>& runs, const Truth* truth,
                                      const std::string& dir, const std::string& scenario_label,
-                                     const std::optional<PlanView>& plan) {
+                                     const std::optional<PlanView>& plan, double band_sigmas) {
   namespace fs = std::filesystem;
   std::vector<FigureJob> jobs;
   const auto add = [&](std::function<Figure()> make, const std::string& name) {
@@ -186,7 +189,9 @@ std::vector<FigureJob> runFigureJobs(const Model& model, const std::vector<Offli
   for (std::size_t i = 0; i < names.size(); ++i) {
     const bool constant = static_cast<int>(i) >= model.dims().nc;
     if (!constant && truthColumn(truth, static_cast<Eigen::Index>(i)) < 0) continue;  // an error needs the truth
-    add([&model, &runs, truth, i, scenario_label] { return stateFigure(model, runs, truth, i, scenario_label); },
+    add([&model, &runs, truth, i, scenario_label, band_sigmas] {
+          return stateFigure(model, runs, truth, i, scenario_label, band_sigmas);
+        },
         "fig-" + names[i] + (constant ? "" : "-error") + ".png");
   }
   if (plan) {
@@ -206,8 +211,8 @@ std::vector<FigureJob> runFigureJobs(const Model& model, const std::vector<Offli
 std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
                                          const Truth* truth, const std::string& dir,
                                          const std::string& scenario_label, const std::optional<PlanView>& plan,
-                                         int threads) {
-  const std::vector<FigureJob> jobs = runFigureJobs(model, runs, truth, dir, scenario_label, plan);
+                                         int threads, double band_sigmas) {
+  const std::vector<FigureJob> jobs = runFigureJobs(model, runs, truth, dir, scenario_label, plan, band_sigmas);
   drawPngs(jobs, threads);
   std::vector<std::string> written;
   for (const auto& j : jobs) written.push_back(j.path);
@@ -248,7 +253,8 @@ std::vector<std::string> writeProcessFigures(const io::ProcessResult& r, const s
   // One list, drawn `threads` at a time: the run figures, the learning's,
   // the constants against their reference.
   std::vector<FigureJob> jobs =
-      runFigureJobs(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan);
+      runFigureJobs(model, r.runs, r.dataset.truth ? &*r.dataset.truth : nullptr, dir, r.label, plan,
+                    io::figureBandSigmas(r.config));
   if (r.learnt) jobs.push_back(learningFigureJob(*r.learnt, dir, r.label));
   for (auto& job : withheldFigureJobs(r, dir)) jobs.push_back(std::move(job));
   if (r.dataset.constants_reference && !r.runs.empty() && model.dims().nb > 0) {

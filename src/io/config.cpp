@@ -174,7 +174,9 @@ std::vector<IniKey> scenarioIniKeys() {
           {"seed", "integer", "1", "the random seed gssm-simulate drew the data with (a record)"},
           {"steps", "integer", "", "simulated steps (gssm-simulate, gssm-montecarlo)"},
           {"measure_every", "integer", "1", "a simulated measurement every this many steps"},
-          {"channels", "word", "default", "simulated measurements on the default channel, or cycle (every channel in turn)"}};
+          {"channels", "word", "default", "simulated measurements on the default channel, or cycle (every channel in turn)"},
+          {"band_sigmas", "number", "3",
+           "the figures' bands: each estimate ± this many standard deviations"}};
 }
 
 std::vector<IniKey> truthIniKeys() {
@@ -191,6 +193,15 @@ std::vector<IniKey> truthIniKeys() {
 void requireScenarioKeys(const IniDocument& ini) {
   ini.requireOnlyKeys("scenario", iniKeyNames(scenarioIniKeys()));
   ini.requireOnlyKeys("truth", iniKeyNames(truthIniKeys()));
+  figureBandSigmas(ini);  // a bad width refused before the run, not after it
+}
+
+double figureBandSigmas(const IniDocument& ini) {
+  const double k = ini.getDouble("scenario", "band_sigmas", 3.0);
+  if (!(k > 0) || !std::isfinite(k))
+    throw InputError(ini.where("scenario", "band_sigmas") + ": the figures' band width must be a positive number of "
+                     "standard deviations");
+  return k;
 }
 
 SimulationSpec simulationSpec(const IniDocument& ini, const Model& model) {

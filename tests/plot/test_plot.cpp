@@ -1,12 +1,19 @@
 #include <gtest/gtest.h>
 #include <mrpt/img/CImage.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 
+#include "gssm/core/error.h"
+#include "gssm/io/config.h"
+#include "gssm/io/ini.h"
+#include "gssm/io/number_text.h"
+#include "gssm/models/radar2d.h"
 #include "gssm/plot/figure.h"
+#include "gssm/plot/run_figures.h"
 #include "gssm/plot/ticks.h"
 
 using namespace gssm::plot;
@@ -121,4 +128,42 @@ TEST(Figure, FiguresDrawnInParallelAreTheFilesDrawnOneAfterAnother) {
     EXPECT_EQ(a, bytes((root / "three" / ("fig-" + std::to_string(k) + ".png")).string())) << k;
   }
   fs::remove_all(root);
+}
+
+// A constant's figure draws its band at ±k σ of each row ([scenario]
+// band_sigmas; 3 by default), the width named in the title; a width that is
+// not a positive number is refused, naming the file and key.
+TEST(RunFigures, AConstantsBandIsAsWideAsAsked) {
+  const gssm::models::Radar2D model{gssm::models::Radar2D::Params{}};
+  gssm::OfflineRun run;
+  run.method = gssm::Method::Batch;
+  for (int r = 0; r < 5; ++r) {
+    gssm::EstimateRow row;
+    row.t = r;
+    row.mean = Eigen::VectorXd::Constant(3, 1.0 + r);
+    row.covariance = Eigen::MatrixXd::Identity(3, 3) * (0.25 + r);
+    run.rows.push_back(row);
+  }
+  const std::vector<gssm::OfflineRun> runs{run};
+  for (double k : {3.0, 2.0}) {
+    const auto jobs = runFigureJobs(model, runs, nullptr, "/tmp", "test", std::nullopt, k);
+    const auto constant = std::find_if(jobs.begin(), jobs.end(), [](const FigureJob& j) {
+      return j.path.find("fig-h.png") != std::string::npos;
+    });
+    ASSERT_NE(constant, jobs.end());
+    const Figure f = constant->make();
+    EXPECT_NE(f.title.find(gssm::io::formatDouble(k) + "-sigma band"), std::string::npos) << f.title;
+    ASSERT_EQ(f.bands.size(), 1u);
+    for (std::size_t r = 0; r < 5; ++r)
+      EXPECT_NEAR(f.bands[0].hi[r] - f.bands[0].lo[r], 2 * k * std::sqrt(0.25 + static_cast<double>(r)), 1e-12);
+  }
+  const auto ini = gssm::io::IniDocument::parse("[scenario]\nband_sigmas = 0\n", "bands.ini");
+  EXPECT_THROW(
+      try { gssm::io::figureBandSigmas(ini); } catch (const gssm::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("bands.ini:2"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("band_sigmas"), std::string::npos) << e.what();
+        throw;
+      },
+      gssm::InputError);
+  EXPECT_EQ(gssm::io::figureBandSigmas(gssm::io::IniDocument::parse("[scenario]\n", "none.ini")), 3.0);
 }

@@ -66,8 +66,12 @@ SimulationSpec simulationSpec(const IniDocument& ini, const Model& model);
 /// [scenario]'s and [truth]'s keys, with type, default and meaning.
 std::vector<IniKey> scenarioIniKeys();
 std::vector<IniKey> truthIniKeys();
-/// Refuses a key of [scenario] or [truth] not in those tables (file and line).
+/// Refuses a key of [scenario] or [truth] not in those tables (file and
+/// line), and a bad [scenario] band_sigmas.
 void requireScenarioKeys(const IniDocument& ini);
+/// [scenario] band_sigmas (default 3): the figures' bands, estimate ± this
+/// many σ; throws InputError (file and line) unless positive and finite.
+double figureBandSigmas(const IniDocument& ini);
 
 /// A Monte Carlo scenario from INI documents, with the models it points to.
 struct LoadedScenario {

@@ -27,19 +27,21 @@ struct PlanView {
   std::vector<std::pair<std::string, std::vector<Eigen::Vector2d>>> paths;
 };
 
-/// Writes `fig-<constant>.png`, `fig-<state>-error.png` (with truth),
-/// fig-trajectory.png (with a plan view) and fig-latency.png into `dir`,
-/// drawing up to `threads` at a time (savePngs); returns the paths written.
+/// Writes `fig-<constant>.png`, `fig-<state>-error.png` (with truth; each
+/// with its band of ±band_sigmas σ), fig-trajectory.png (with a plan view)
+/// and fig-latency.png into `dir`, drawing up to `threads` at a time
+/// (savePngs); returns the paths written.
 std::vector<std::string> writeRunFigures(const Model& model, const std::vector<OfflineRun>& runs,
                                          const Truth* truth, const std::string& dir,
                                          const std::string& scenario_label,
-                                         const std::optional<PlanView>& plan = std::nullopt, int threads = 1);
+                                         const std::optional<PlanView>& plan = std::nullopt, int threads = 1,
+                                         double band_sigmas = 3);
 
 /// The figures writeRunFigures draws, to draw (drawPngs); the arguments
 /// must outlive them.
 std::vector<FigureJob> runFigureJobs(const Model& model, const std::vector<OfflineRun>& runs, const Truth* truth,
                                      const std::string& dir, const std::string& scenario_label,
-                                     const std::optional<PlanView>& plan = std::nullopt);
+                                     const std::optional<PlanView>& plan = std::nullopt, double band_sigmas = 3);
 
 /// fig-constants-vs-reference.png, to draw: the run's final constants ±2σ,
 /// in the reference's terms along `truth` (Model::comparableConstants),
@@ -49,7 +51,8 @@ FigureJob constantsReferenceFigureJob(const Model& model, const OfflineRun& run,
                                       const Truth* truth, const std::string& dir, const std::string& label);
 
 /// The figures of a processed dataset (gssm-process's, gssm.process's):
-/// writeRunFigures with a plan view when the model has px and py (its
+/// writeRunFigures, its bands as wide as the run's config asks ([scenario]
+/// band_sigmas), with a plan view when the model has px and py (its
 /// landmarks, and the dead reckoning when the rows are at inputs), and the
 /// learning's log-likelihood figure when the noise was learnt, and the
 /// constants against their calibration reference when the dataset has one
