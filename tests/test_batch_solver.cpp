@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <iostream>
 #include <random>
 
 #include "gssm/solvers/batch_solver.h"
@@ -23,18 +24,17 @@ namespace {
 using gssm::testing::normalSampler;
 using gssm::testing::radarPaperRun;
 
-// Dense information matrix JᵀJ and gradient Jᵀr assembled independently of
-// the solver, from each factor's Jacobian blocks.
-void denseNormalEquations(const FactorGraph& graph, const Values& x, Eigen::MatrixXd& H,
-                          Eigen::VectorXd& g) {
+// The dense Jacobian J and residual r assembled independently of the
+// solver, from each factor's Jacobian blocks.
+void denseJacobian(const FactorGraph& graph, const Values& x, Eigen::MatrixXd& J, Eigen::VectorXd& r_all) {
   std::map<Key, Eigen::Index> off;
   Eigen::Index n = 0;
   for (const auto& kv : x) {
     off[kv.first] = n;
     n += kv.second.size();
   }
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(0, n);
-  Eigen::VectorXd r_all(0);
+  J = Eigen::MatrixXd::Zero(0, n);
+  r_all.resize(0);
   for (const auto& f : graph) {
     Eigen::VectorXd r;
     std::vector<Eigen::MatrixXd> Jb;
@@ -47,9 +47,41 @@ void denseNormalEquations(const FactorGraph& graph, const Values& x, Eigen::Matr
     r_all.conservativeResize(r_all.size() + r.size());
     r_all.tail(r.size()) = r;
   }
-  H = J.transpose() * J;
-  g = J.transpose() * r_all;
 }
+
+// Dense information matrix JᵀJ and gradient Jᵀr, the same way.
+void denseNormalEquations(const FactorGraph& graph, const Values& x, Eigen::MatrixXd& H,
+                          Eigen::VectorXd& g) {
+  Eigen::MatrixXd J;
+  Eigen::VectorXd r;
+  denseJacobian(graph, x, J, r);
+  H = J.transpose() * J;
+  g = J.transpose() * r;
+}
+
+// A scalar factor a·x_i + c·x_j − y (σ = 1 after scaling), on one or two
+// variables: a stiff link between states, or a state and a constant seen
+// together.
+class ScalarFactor final : public Factor {
+ public:
+  ScalarFactor(std::vector<Key> keys, Eigen::VectorXd coefficients, double y)
+      : Factor(std::move(keys), 1), a_(std::move(coefficients)), y_(y) {}
+  void linearizeAt(const Eigen::VectorXd* const* x, Eigen::VectorXd& r,
+                   std::vector<Eigen::MatrixXd>* J) const override {
+    double v = -y_;
+    for (Eigen::Index i = 0; i < a_.size(); ++i) v += a_[i] * (*x[i])[0];
+    r = Eigen::VectorXd::Constant(1, v);
+    if (J) {
+      J->resize(static_cast<std::size_t>(a_.size()));
+      for (Eigen::Index i = 0; i < a_.size(); ++i) (*J)[static_cast<std::size_t>(i)] = Eigen::MatrixXd::Constant(1, 1, a_[i]);
+    }
+  }
+  std::string describe() const override { return "scalar"; }
+
+ private:
+  Eigen::VectorXd a_;
+  double y_;
+};
 
 // Priors at the truth (the paper's, 143σ off, leave residuals so large that
 // the Gauss–Newton model overstates every step's decrease) and a process
@@ -800,4 +832,57 @@ TEST(BatchSolver, AChangeThatLeavesAVariableUndeterminedIsRefusedAndChangesNothi
   unchanged();
   BatchSolver fresh;
   EXPECT_THROW(fresh.stepAfterChange(GraphChange{}, x), InvalidArgument) << "no factorization yet";
+}
+
+// A chain of states tied together 10⁶ times more tightly than the data see
+// them, each seen with a constant whose coefficient varies by 5 %: the
+// constant's variance is what little of the data the chain's common motion
+// leaves, and JᵀJ, squaring J's condition number, loses its digits. With
+// covariance_by_qr the batch's covariances (the constant's, a state's and
+// their cross term) equal a dense Householder QR of J, R⁻¹R⁻ᵀ; the normal
+// equations' do not, which is why the option exists.
+TEST(BatchSolver, CovariancesByQrKeepWhatTheNormalEquationsLose) {
+  const int steps = 400;
+  FactorGraph graph;
+  Values x;
+  std::mt19937 rng(17);
+  std::normal_distribution<double> noise;
+  const Key b = Key::constants();
+  for (int k = 0; k <= steps; ++k) {
+    x.insert(Key::state(k), Eigen::VectorXd::Zero(1));
+    if (k > 0)
+      graph.add(std::make_shared<ScalarFactor>(std::vector<Key>{Key::state(k - 1), Key::state(k)},
+                                               Eigen::Vector2d(-1e6, 1e6), noise(rng)));
+    graph.add(std::make_shared<ScalarFactor>(std::vector<Key>{Key::state(k), b},
+                                             Eigen::Vector2d(1.0, 1.0 + 0.05 * std::sin(0.3 * k)), noise(rng)));
+  }
+  x.insert(b, Eigen::VectorXd::Zero(1));
+  graph.add(std::make_shared<ScalarFactor>(std::vector<Key>{b}, Eigen::VectorXd::Constant(1, 1e-3), 0.0));
+  Eigen::MatrixXd J;
+  Eigen::VectorXd r;
+  denseJacobian(graph, x, J, r);  // linear: the same at any x
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(J);
+  const Eigen::MatrixXd R = qr.matrixQR().topRows(J.cols()).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(J.cols(), J.cols()));
+  const Eigen::MatrixXd reference = Rinv * Rinv.transpose();  // states 0 … steps, then b
+  const Eigen::Index ib = steps + 1, ik = steps / 2;
+  double worst_normal = 0;
+  for (bool by_qr : {false, true}) {
+    BatchSolverOptions options;
+    options.covariance_by_qr = by_qr;
+    BatchSolver solver(options);
+    Values v = x;
+    ASSERT_TRUE(solver.solve(graph, v).converged);
+    const Eigen::MatrixXd P = solver.jointMarginalCovariance({Key::state(ik), b});
+    const double errors[] = {std::abs(P(1, 1) / reference(ib, ib) - 1), std::abs(P(0, 0) / reference(ik, ik) - 1),
+                             std::abs(P(0, 1) / reference(ik, ib) - 1)};
+    const double worst = *std::max_element(std::begin(errors), std::end(errors));
+    std::cout << (by_qr ? "QR" : "normal equations") << ": worst relative error " << worst << "\n";
+    if (by_qr) {
+      EXPECT_LT(worst, 1e-8) << "b " << P(1, 1) << " vs " << reference(ib, ib);
+    } else {
+      worst_normal = worst;
+    }
+  }
+  EXPECT_GT(worst_normal, 1e-5) << "the normal equations lost nothing here: the test shows no difference";
 }

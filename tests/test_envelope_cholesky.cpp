@@ -17,8 +17,9 @@ using gssm::internal::EnvelopeCholesky;
 namespace {
 // A random SPD matrix with the pattern of a chain of `steps` states of size
 // nc (each coupled to the next) and nb constants coupled to all, plus the
-// first row of each column's envelope.
-Eigen::MatrixXd chainMatrix(std::mt19937& rng, int steps, int nc, int nb, std::vector<int>& first) {
+// first row of each column's envelope (and J, H = JᵀJ, with its rows).
+Eigen::MatrixXd chainMatrix(std::mt19937& rng, int steps, int nc, int nb, std::vector<int>& first,
+                            Eigen::MatrixXd* J_out = nullptr) {
   std::normal_distribution<double> g;
   const int n = steps * nc + nb;
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3 * n, n);
@@ -33,6 +34,10 @@ Eigen::MatrixXd chainMatrix(std::mt19937& rng, int steps, int nc, int nb, std::v
     }
   for (int c = 0; c < n; ++c, ++row) J(row % J.rows(), c) += 1.0;  // every column reached
   const Eigen::MatrixXd H = J.transpose() * J + 1e-3 * Eigen::MatrixXd::Identity(n, n);
+  if (J_out) {
+    *J_out = Eigen::MatrixXd(J.rows() + n, n);
+    *J_out << J, std::sqrt(1e-3) * Eigen::MatrixXd::Identity(n, n);
+  }
   first.assign(static_cast<std::size_t>(n), 0);
   for (int j = 0; j < n; ++j) {
     int f = j;
@@ -52,10 +57,26 @@ void fill(EnvelopeCholesky& c, const Eigen::MatrixXd& H, const std::vector<int>&
     for (Eigen::Index i = first[static_cast<std::size_t>(j)]; i <= j; ++i) c.values()[c.position(i, j)] = H(i, j);
 }
 
-void expectMatchesDense(const Eigen::MatrixXd& H, const std::vector<int>& first, std::mt19937& rng) {
+// Factors H = JᵀJ from J's rows, in order (addRow), their zeros left out.
+Eigen::Index factorByRows(EnvelopeCholesky& c, const Eigen::MatrixXd& J) {
+  c.beginRows();
+  std::vector<int> cols;
+  std::vector<double> vals;
+  for (Eigen::Index r = 0; r < J.rows(); ++r) {
+    cols.clear(), vals.clear();
+    for (Eigen::Index j = 0; j < J.cols(); ++j)
+      if (J(r, j) != 0) cols.push_back(static_cast<int>(j)), vals.push_back(J(r, j));
+    c.addRow(cols.data(), vals.data(), static_cast<int>(cols.size()));
+  }
+  return c.finishRows();
+}
+
+// With J: factored from its rows (a QR), not from H.
+void expectMatchesDense(const Eigen::MatrixXd& H, const std::vector<int>& first, std::mt19937& rng,
+                        const Eigen::MatrixXd* J = nullptr) {
   EnvelopeCholesky c;
   fill(c, H, first);
-  ASSERT_EQ(c.factorize(), -1);
+  ASSERT_EQ(J ? factorByRows(c, *J) : c.factorize(), -1);
   std::normal_distribution<double> g;
   Eigen::VectorXd b(H.rows());
   for (Eigen::Index i = 0; i < b.size(); ++i) b[i] = g(rng);
@@ -102,6 +123,34 @@ TEST(EnvelopeCholesky, ChainsWithAConstantsBorderMatchTheDenseFactorization) {
     SCOPED_TRACE(::testing::Message() << steps << " steps, nc " << nc << ", nb " << nb);
     expectMatchesDense(H, first, rng);
   }
+}
+
+// The factor from J's rows (a Givens QR, R = U) gives the same solves,
+// blocks and selected inverse; rows in any order give the same factor.
+TEST(EnvelopeCholesky, FactorFromTheJacobiansRowsMatchesTheDenseFactorization) {
+  std::mt19937 rng(4);
+  for (auto [steps, nc, nb] : {std::tuple{1, 1, 0}, {50, 1, 2}, {40, 3, 2}, {30, 2, 0}, {10, 4, 5}, {60, 6, 25}}) {
+    std::vector<int> first;
+    Eigen::MatrixXd J;
+    const Eigen::MatrixXd H = chainMatrix(rng, steps, nc, nb, first, &J);
+    SCOPED_TRACE(::testing::Message() << steps << " steps, nc " << nc << ", nb " << nb);
+    expectMatchesDense(H, first, rng, &J);
+    EnvelopeCholesky in_order, reversed;
+    fill(in_order, H, first);
+    fill(reversed, H, first);
+    ASSERT_EQ(factorByRows(in_order, J), -1);
+    ASSERT_EQ(factorByRows(reversed, J.colwise().reverse()), -1);
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(H.rows(), 2);
+    EXPECT_LT((in_order.solve(B) - reversed.solve(B)).norm(), 1e-9 * (1 + in_order.solve(B).norm()));
+  }
+  // A column no row reaches has no pivot: named.
+  std::vector<int> first;
+  Eigen::MatrixXd J;
+  const Eigen::MatrixXd H = chainMatrix(rng, 10, 2, 1, first, &J);
+  J.col(7).setZero();
+  EnvelopeCholesky c;
+  fill(c, H, first);
+  EXPECT_EQ(factorByRows(c, J), 7);
 }
 
 TEST(EnvelopeCholesky, AGeneralProfileMatchesTheDenseFactorization) {

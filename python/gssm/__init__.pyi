@@ -50,6 +50,7 @@ class BatchOptions:
     initial_lambda: float
     max_lambda: float
     newton_polish_steps: int
+    covariance_by_qr: bool
     def __init__(self) -> None: ...
 
 class EstimatorOptions:

@@ -39,6 +39,21 @@ class EnvelopeCholesky {
   /// Factors H as it stands in values() (left untouched). Returns -1 on
   /// success, else the first column whose pivot is not positive and finite.
   Eigen::Index factorize();
+  /// Factors H = JᵀJ from J's rows instead, without forming H: a QR of J
+  /// by Givens rotations, row by row, whose R is U (R's pattern is the
+  /// envelope's; rows best given in the order of their first column, a
+  /// chain's time order: each then rotates only through the band above
+  /// it). Forming H squares J's condition number: a stiff chain beside a
+  /// constant it nearly hides (an INS's IMU factors and its lever arm) loses
+  /// digits of that constant's variance in H, which no factorization of H
+  /// gets back (docs/DESIGN.md §5). beginRows(); addRow() for each row;
+  /// finishRows() returns -1, or the first column J leaves without a pivot.
+  /// values() is left as it was.
+  void beginRows();
+  /// One row of J: `count` entries at ascending columns, each column's
+  /// envelope reaching the row's first column.
+  void addRow(const int* columns, const double* values, int count);
+  Eigen::Index finishRows();
   /// Solves H x = b in place.
   void solveInPlace(Eigen::VectorXd& b) const { solveInPlace(b.data()); }
   /// Solves H X = B (n × m).
@@ -82,6 +97,15 @@ class EnvelopeCholesky {
   // A panel this wide over this many rows above it takes their Gram matrix.
   static constexpr std::ptrdiff_t kGramColumns = 8, kGramRows = 32;
   static constexpr std::ptrdiff_t kPanelGroup = 4;  // a panel's columns taken together down the rows above it
+  // The row QR's state: each row's columns (CSR: the columns j ≥ k whose
+  // envelope reaches row k), which pivot rows hold a row yet, the row
+  // being merged (dense) and its nonzero columns still to visit (a heap).
+  std::vector<std::ptrdiff_t> row_begin_;
+  std::vector<int> row_columns_;
+  std::vector<char> row_started_, queued_;
+  std::vector<double> work_;
+  std::vector<int> pending_;
+  void rotateInto(std::ptrdiff_t k);
   // inverse_: h_ holds H⁻¹ on the envelope, not H (values() must refill it).
   bool factored_ = false, inverse_ = false;
   // The selected inverse's sweep: rows from inverse_from_ on are done; the

@@ -475,6 +475,46 @@ struct BatchSolver::Impl {
     return selected->lookup(i, j, out);
   }
 
+  // The factor from J's rows at x instead of H's (BatchSolverOptions::
+  // covariance_by_qr): every factor's reweighted rows, in the graph's
+  // order (a chain's time order: each row rotates only through the band
+  // above it). On the envelope only; `diag`: H's diagonal, to name a
+  // column that has no pivot.
+  void factorByRows(const FactorGraph& graph, const Values& x, const Eigen::VectorXd& diag) {
+    selected.reset();
+    envelope_inverse = envelope_block_used = false;
+    Scratch& s = scratch[0];
+    const auto first = x.begin();
+    std::vector<std::pair<int, double>> row;
+    std::vector<int> cols;
+    std::vector<double> vals;
+    envelope.beginRows();
+    for (std::size_t fi = 0; fi < graph.size(); ++fi) {
+      const Factor& f = *graph[fi];
+      std::vector<Eigen::MatrixXd>& J = s.jacobians[factor_shape[fi]];
+      const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
+      for (std::size_t a = 0; a < count; ++a) s.x[a] = &(first + factor_vars[b + a])->second;
+      f.linearizeRobustAt(s.x.data(), s.r, &J);
+      for (Eigen::Index i = 0; i < s.r.size(); ++i) {
+        row.clear();
+        for (std::size_t a = 0; a < count; ++a) {
+          const Eigen::Index o = offset[factor_vars[b + a]];
+          const auto add = [&](Eigen::Index c) {
+            if (J[a](i, c) != 0.0) row.emplace_back(static_cast<int>(o + c), J[a](i, c));
+          };
+          if (const std::vector<int>* used = f.columnsOf(a)) for (int c : *used) add(c);
+          else for (Eigen::Index c = 0; c < J[a].cols(); ++c) add(c);
+        }
+        std::sort(row.begin(), row.end());  // a factor's variables need not ascend
+        cols.clear(), vals.clear();
+        for (const auto& [c, v] : row) cols.push_back(c), vals.push_back(v);
+        envelope.addRow(cols.data(), vals.data(), static_cast<int>(cols.size()));
+      }
+    }
+    const Eigen::Index bad = envelope.finishRows();
+    if (bad >= 0) throwSingular(bad, diag);
+  }
+
   // H's diagonal = its undamped value (diag) + λ·max(diag, 1e-12).
   void setDamping(const Eigen::VectorXd& diag, double lambda) {
     double* H = use_envelope ? envelope.values() : chol.values();
@@ -791,6 +831,18 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     it.factorAtSolution();
     internal::flatten(values, s.factored_point);
     it.factored_cost = it.cost;
+  }
+  if (options_.covariance_by_qr && s.use_envelope) {  // at the point H was factored at
+    Eigen::VectorXd now;
+    internal::flatten(values, now);
+    if (now == s.factored_point) {
+      s.factorByRows(graph, values, it.diag);
+    } else {  // the last step taken without a linearization after it
+      Values at = values;
+      internal::unflatten(s.factored_point, at);
+      s.factorByRows(graph, at, it.diag);
+    }
+    ++sum.factorizations;
   }
   s.has_solution = true;
   restore.armed = false;

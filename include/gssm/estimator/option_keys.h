@@ -63,6 +63,9 @@ void optionKeys(Visitor& v, BatchSolverOptions& o) {
   v("initial_lambda", o.initial_lambda, "Levenberg–Marquardt damping λ₀, relative to diag(JᵀJ)");
   v("max_lambda", o.max_lambda, "largest damping before the solve gives up");
   v("newton_polish_steps", o.newton_polish_steps, "full Newton steps after convergence, for large residuals at the optimum (0: off)");
+  v("covariance_by_qr", o.covariance_by_qr,
+    "covariances from a QR of the Jacobian at the solution, not the normal equations (a stiff chain beside a weakly "
+    "seen constant)");
 }
 
 /// Collects the keys (optionKeyNames).

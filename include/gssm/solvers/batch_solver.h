@@ -67,6 +67,16 @@ struct BatchSolverOptions {
   /// envelope): its two halves side by side. The same bits with any count
   /// (the halves' sums are combined in one fixed order).
   int threads = 1;
+  /// Covariances from a QR of the whitened Jacobian at the solution
+  /// (Givens rotations, row by row) instead of the normal equations' factor:
+  /// JᵀJ squares J's condition number, and a stiff chain beside a constant
+  /// it nearly hides (an INS's IMU factors and its lever arm) loses digits
+  /// of that constant's variance in it: on the GNSS/INS drive the lever
+  /// arm's vertical sd moved by 3 % between two problems one ulp apart. The
+  /// same factor's pattern, so the same selected inverse; one more pass
+  /// over the factors. Where the envelope serves the graph (a chain in time
+  /// order, constants last; otherwise the normal equations).
+  bool covariance_by_qr = false;
   /// Empty when valid; otherwise says which field is wrong and why.
   bool validate(std::string* why = nullptr) const;
 };
