@@ -15,6 +15,7 @@
 #include <chrono>
 
 #include "gssm/analysis/metrics.h"
+#include "gssm/analysis/offline.h"
 #include "gssm/estimator/estimator.h"
 #include "gssm/factors/problem.h"
 #include "gssm/solvers/ekf.h"
@@ -105,6 +106,21 @@ void BM_InsLearningPass(benchmark::State& state) {
   state.counters["steps"] = static_cast<double>(schedule.size());
 }
 
+// The batch over the whole drive as the scenario ships it (rows at every
+// measurement with their covariances), the covariances from the normal
+// equations' factor (0) or from a QR of the Jacobian (1: [batch]
+// covariance_by_qr, the drive's setting).
+void BM_InsBatch(benchmark::State& state) {
+  const Drive& d = drive(true);
+  gssm::EstimatorOptions o = d.options;
+  o.method = gssm::Method::Batch;
+  o.batch.covariance_by_qr = state.range(0) != 0;
+  for (auto _ : state) {
+    const gssm::OfflineRun run = gssm::runBatch(*d.model, o, d.data.measurements, d.data.inputs);
+    benchmark::DoNotOptimize(run.rows.back().covariance.data());
+  }
+}
+
 void BM_InsEkf(benchmark::State& s) { streamDrive(s, gssm::Method::Ekf, s.range(0) != 0); }
 void BM_InsFixedLag(benchmark::State& s) { streamDrive(s, gssm::Method::FixedLag, s.range(0) != 0); }
 void BM_InsIncremental(benchmark::State& s) { streamDrive(s, gssm::Method::Incremental, s.range(0) != 0); }
@@ -116,4 +132,6 @@ BENCHMARK(BM_InsLearningPass)->Unit(benchmark::kMillisecond)->Iterations(10);
 BENCHMARK(BM_InsEkf)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_InsFixedLag)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_InsIncremental)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
+// Argument: 0 covariances from the normal equations, 1 by QR.
+BENCHMARK(BM_InsBatch)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_MAIN();
