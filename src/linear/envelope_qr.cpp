@@ -73,11 +73,14 @@ void EnvelopeCholesky::rotateInto(std::ptrdiff_t k) {
 
 void EnvelopeCholesky::addRow(const int* columns, const double* values, int count) {
   if (row_started_.size() != first_.size()) throw NumericalError("EnvelopeCholesky: addRow() before beginRows()");
-  for (int a = 0; a < count; ++a) {
+  for (int a = 0; a < count; ++a) {  // checked before any is placed: a refused row leaves R as it was
     const int j = columns[a];
     if (j < 0 || j >= static_cast<int>(first_.size()) || first_[static_cast<std::size_t>(j)] > columns[0] ||
         (a > 0 && j <= columns[a - 1]))
       throw NumericalError("EnvelopeCholesky: a row's columns must ascend inside the envelope (internal error)");
+  }
+  for (int a = 0; a < count; ++a) {
+    const int j = columns[a];
     if (values[a] == 0.0) continue;
     work_[static_cast<std::size_t>(j)] = values[a];
     queued_[static_cast<std::size_t>(j)] = 1;

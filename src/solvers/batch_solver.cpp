@@ -493,12 +493,15 @@ struct BatchSolver::Impl {
       const Factor& f = *graph[fi];
       std::vector<Eigen::MatrixXd>& J = s.jacobians[factor_shape[fi]];
       const std::size_t b = factor_begin[fi], count = factor_begin[fi + 1] - b;
-      for (std::size_t a = 0; a < count; ++a) s.x[a] = &(first + factor_vars[b + a])->second;
+      for (std::size_t a = 0; a < count; ++a) {
+        s.x[a] = &(first + factor_vars[b + a])->second;
+        s.offs[a] = offset[factor_vars[b + a]];
+      }
       f.linearizeRobustAt(s.x.data(), s.r, &J);
       for (Eigen::Index i = 0; i < s.r.size(); ++i) {
         row.clear();
         for (std::size_t a = 0; a < count; ++a) {
-          const Eigen::Index o = offset[factor_vars[b + a]];
+          const Eigen::Index o = s.offs[a];
           const auto add = [&](Eigen::Index c) {
             if (J[a](i, c) != 0.0) row.emplace_back(static_cast<int>(o + c), J[a](i, c));
           };
@@ -833,9 +836,7 @@ BatchSolverSummary BatchSolver::solve(const FactorGraph& graph, Values& values) 
     it.factored_cost = it.cost;
   }
   if (options_.covariance_by_qr && s.use_envelope) {  // at the point H was factored at
-    Eigen::VectorXd now;
-    internal::flatten(values, now);
-    if (now == s.factored_point) {
+    if (!it.factored_at_solution) {
       s.factorByRows(graph, values, it.diag);
     } else {  // the last step taken without a linearization after it
       Values at = values;
