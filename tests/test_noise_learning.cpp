@@ -386,6 +386,33 @@ TEST(NoiseLearning, ScoringReachesTheEmMaximumInFewerPasses) {
   EXPECT_GE(two.evaluations, r.evaluations);
 }
 
+// Learning from its own maximum: the given values, the start and scoring's
+// first point are one θ, and its filter pass runs once (beside the slope's
+// p passes), not three times; the values are what one pass gives.
+TEST(NoiseLearning, APassAtANoiseAlreadyRunIsNotRunAgain) {
+  const EmCase c;
+  NoiseLearningOptions o;
+  o.start = 1.0;
+  o.tolerance = 1e-10;
+  o.standard_errors = false;
+  o.optimizer = "scoring";
+  const NoiseLearningReport top = c.learn(o);
+  ASSERT_TRUE(top.converged) << top.toString();
+  o.start = 0;  // from the given values: the maximum
+  for (const int threads : {1, 2}) {
+    o.threads = threads;
+    const NoiseLearningReport again = learnNoise(*top.model, c.run.measurements, {}, 0.0, o);
+    ASSERT_TRUE(again.converged) << again.toString();
+    EXPECT_EQ(again.iterations, 1) << again.toString();
+    const int p = static_cast<int>(again.parameters.size());
+    EXPECT_EQ(again.evaluations, p + 1) << again.toString();
+    const double one_pass = predictionErrorLogLikelihood(*top.model, c.run.measurements, {}, 0.0);
+    EXPECT_NEAR(again.given_log_likelihood, one_pass, 1e-12 * std::abs(one_pass));
+    EXPECT_EQ(again.start_log_likelihood, again.given_log_likelihood);
+    EXPECT_EQ(again.final_log_likelihood, again.given_log_likelihood);
+  }
+}
+
 // A σ the log cannot tell from 0 (a process noise far below what the data
 // resolve) ends at the low end of its range, its gradient pointing out:
 // scoring holds it there and it is flagged, as with Nelder–Mead; where the

@@ -163,11 +163,16 @@ struct Objective {
   bool mixture = false;
   std::vector<double> outlier_log_density;
   int threads = 1;
-  int evaluations = 0;
+  int evaluations = 0;  ///< filter passes run (a θ met again is not run again)
+  /// The passes run so far, with their terms: learning meets the same θ
+  /// again (the given values, the start and the optimizer's first point
+  /// are one θ unless [learn] start moves it), and a pass is a whole
+  /// filter run. Exact θ only: the same θ gives the same bits.
+  std::vector<std::pair<Eigen::VectorXd, internal::LikelihoodTerms>> seen;
 
-  // The pass at θ = log σ: total −∞ (no terms) outside the domain or where
-  // the filter fails; the terms kept when asked (scoring's).
-  internal::LikelihoodTerms pass(const Eigen::VectorXd& theta, bool keep_terms) const {
+  // The pass at θ = log σ, with its terms (scoring's): total −∞ (no terms)
+  // outside the domain or where the filter fails.
+  internal::LikelihoodTerms pass(const Eigen::VectorXd& theta) const {
     internal::LikelihoodTerms failed{-std::numeric_limits<double>::infinity(), {}};
     if (!theta.allFinite()) return failed;
     try {  // beyond the search range: the value at its end (flat)
@@ -175,7 +180,7 @@ struct Objective {
       const auto n = static_cast<Eigen::Index>(family.names.size());
       const auto model = family.make(clamped.head(n).array().exp().matrix());
       ExtendedKalmanFilterOptions e = ekf;
-      e.keep_log_likelihood_terms = keep_terms;
+      e.keep_log_likelihood_terms = true;
       if (mixture) e.outlier_probability = 1.0 / (1.0 + std::exp(-clamped[n])), e.outlier_log_density = outlier_log_density;
       internal::LikelihoodTerms l = logLikelihoodAlong(*model, schedule, measurements, inputs, t0, e);
       return std::isfinite(l.total) ? l : failed;
@@ -183,19 +188,38 @@ struct Objective {
       return failed;
     }
   }
-  double logLikelihood(const Eigen::VectorXd& theta) {
-    ++evaluations;
-    return pass(theta, false).total;
-  }
-  // The passes at several θ, `threads` at a time.
-  std::vector<internal::LikelihoodTerms> passes(const std::vector<Eigen::VectorXd>& thetas, bool keep_terms) {
+  double logLikelihood(const Eigen::VectorXd& theta) { return passes({theta}).front().total; }
+  // The passes at several θ, `threads` at a time; a θ seen before, and one
+  // met twice here, is run once. Only the first few passes are kept (the
+  // repeats are at the start; Nelder–Mead's thousands of points are not).
+  std::vector<internal::LikelihoodTerms> passes(const std::vector<Eigen::VectorXd>& thetas) {
     std::vector<internal::LikelihoodTerms> out(thetas.size());
-    const auto errors = runJobs(thetas.size(), static_cast<std::size_t>(threads),
-                                [&](std::size_t k) { out[k] = pass(thetas[k], keep_terms); });
+    std::vector<std::size_t> run;  // the θs to run: the first of each not seen
+    std::vector<std::size_t> source(thetas.size());  // where each θ's pass is: seen[i] or out[run[i]]
+    std::vector<bool> from_seen(thetas.size());
+    for (std::size_t k = 0; k < thetas.size(); ++k) {
+      const auto known = findSeen(thetas[k]);
+      const auto earlier = std::find_if(run.begin(), run.end(), [&](std::size_t j) { return thetas[j] == thetas[k]; });
+      from_seen[k] = known < seen.size();
+      source[k] = from_seen[k] ? known : static_cast<std::size_t>(earlier - run.begin());
+      if (!from_seen[k] && earlier == run.end()) run.push_back(k);
+    }
+    const auto errors = runJobs(run.size(), static_cast<std::size_t>(threads),
+                                [&](std::size_t i) { out[run[i]] = pass(thetas[run[i]]); });
     for (const auto& e : errors)
       if (e) std::rethrow_exception(e);
-    evaluations += static_cast<int>(thetas.size());
+    evaluations += static_cast<int>(run.size());
+    for (std::size_t k = 0; k < thetas.size(); ++k)
+      if (from_seen[k] || run[source[k]] != k) out[k] = from_seen[k] ? seen[source[k]].second : out[run[source[k]]];
+    for (std::size_t i : run)
+      if (seen.size() < kSeenKept) seen.emplace_back(thetas[i], out[i]);
     return out;
+  }
+  static constexpr std::size_t kSeenKept = 32;
+  std::size_t findSeen(const Eigen::VectorXd& theta) const {
+    std::size_t i = 0;
+    while (i < seen.size() && !(seen[i].first.size() == theta.size() && seen[i].first == theta)) ++i;
+    return i;
   }
 };
 
@@ -236,15 +260,20 @@ Eigen::VectorXd maximizeByNelderMead(Objective& obj, const Eigen::VectorXd& thet
   return theta.cwiseMax(obj.lo).cwiseMin(obj.hi);
 }
 
-// Scoring from θ0 within the search range (learn/scoring.h).
-Eigen::VectorXd maximizeByScoring(Objective& obj, const Eigen::VectorXd& theta0, const NoiseLearningOptions& o,
-                                  NoiseLearningReport& r) {
+internal::ScoringOptions scoringOptions(const Objective& obj, const NoiseLearningOptions& o) {
   internal::ScoringOptions so;
   so.lo = obj.lo, so.hi = obj.hi;
   so.max_evaluations = o.max_evaluations - obj.evaluations;
   so.tolerance = o.tolerance;
   so.parallel_passes = o.threads;
-  const auto at = [&obj](const std::vector<Eigen::VectorXd>& thetas) { return obj.passes(thetas, true); };
+  return so;
+}
+
+// Scoring from θ0 within the search range (learn/scoring.h).
+Eigen::VectorXd maximizeByScoring(Objective& obj, const Eigen::VectorXd& theta0, const NoiseLearningOptions& o,
+                                  NoiseLearningReport& r) {
+  const internal::ScoringOptions so = scoringOptions(obj, o);
+  const auto at = [&obj](const std::vector<Eigen::VectorXd>& thetas) { return obj.passes(thetas); };
   const auto res = internal::maximizeByScoring(at, theta0, so, [&r](double l) { r.log_likelihood.push_back(l); });
   r.iterations += res.iterations;
   r.converged = res.converged;
@@ -274,7 +303,7 @@ Eigen::MatrixXd observedInformation(Objective& obj, const Eigen::VectorXd& theta
     add(i, 1, i, 0), add(i, -1, i, 0);
     for (Eigen::Index j = 0; j < i; ++j) add(i, 1, j, 1), add(i, 1, j, -1), add(i, -1, j, 1), add(i, -1, j, -1);
   }
-  const std::vector<internal::LikelihoodTerms> l = obj.passes(points, false);
+  const std::vector<internal::LikelihoodTerms> l = obj.passes(points);
   Eigen::MatrixXd I(n, n);
   std::size_t k = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -406,13 +435,21 @@ NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Meas
   r.measurements = measurements.size();
   r.optimizer = o.optimizer;
   const std::vector<ScheduledStep> schedule = stepSchedule(measurements, inputs, t0);
-  Objective obj{family, schedule, measurements, inputs, t0, o.ekf, {}, {}, false, {}, o.threads};
+  Objective obj{family, schedule, measurements, inputs, t0, o.ekf, {}, {}, false, {}, o.threads, 0, {}};
   const auto n = static_cast<Eigen::Index>(family.names.size());
-  Eigen::VectorXd theta(n);
+  Eigen::VectorXd theta(n), given(n);  // by one log, so that a start at the given values is the same θ
   for (Eigen::Index i = 0; i < n; ++i) theta[i] = std::log(r.parameters[static_cast<std::size_t>(i)].start);
+  for (Eigen::Index i = 0; i < n; ++i) given[i] = std::log(family.given[i]);
   obj.lo = theta.array() - std::log(o.search_range);
   obj.hi = theta.array() + std::log(o.search_range);
-  r.given_log_likelihood = obj.logLikelihood(family.given.array().log().matrix());
+  // Scoring's first round (the start and its slope) beside the given
+  // values' pass: the same passes, fewer rounds on several threads.
+  if (o.optimizer == "scoring") {
+    std::vector<Eigen::VectorXd> first = internal::firstScoringPoints(theta, scoringOptions(obj, o));
+    first.push_back(given);
+    obj.passes(first);
+  }
+  r.given_log_likelihood = obj.logLikelihood(given);
   r.start_log_likelihood = obj.logLikelihood(theta);
   if (!std::isfinite(r.start_log_likelihood))
     throw NumericalError("learnNoise: the EKF fails at the starting noise (" + family.names[0] +
@@ -423,6 +460,7 @@ NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Meas
   if (o.outliers) {
     r.mixture_from = r.log_likelihood.size();
     obj.mixture = true;
+    obj.seen.clear();  // another objective from here
     obj.outlier_log_density = outlierLogDensities(*family.make(family.given), measurements);
     Eigen::VectorXd with_eps(n + 1), lo(n + 1), hi(n + 1);
     with_eps << theta, std::log(0.01 / 0.99);

@@ -50,6 +50,11 @@ struct ScoringResult {
   bool converged = false;
 };
 
+/// The θs the maximization's first round runs at from x0: x0 (clamped
+/// into the box), then its slope's points. A caller may run them before,
+/// beside its own first passes, and serve them again from what it keeps.
+std::vector<Eigen::VectorXd> firstScoringPoints(const Eigen::VectorXd& x0, const ScoringOptions& o);
+
 /// Maximizes ℓ from x0 (clamped into the box); a θ at a bound whose
 /// gradient points outward stays there. `iteration` is called with the
 /// best value after each iteration.
