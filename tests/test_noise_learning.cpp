@@ -363,12 +363,19 @@ TEST(NoiseLearning, TheFiltersLikelihoodTermsSumToItsTotal) {
 // Scoring (gradient from every term's differences, BFGS from their outer
 // product) climbs to the maximum Shumway–Stoffer's EM converges to, in far
 // fewer filter passes than Nelder–Mead, and the same on two threads.
-TEST(NoiseLearning, ScoringReachesTheEmMaximumInFewerPasses) {
-  const EmCase c;
+// From every σ = 1 to a tight tolerance, no standard errors.
+NoiseLearningOptions fromOnesToTheTop(const std::string& optimizer) {
   NoiseLearningOptions o;
   o.start = 1.0;
   o.tolerance = 1e-10;
   o.standard_errors = false;
+  o.optimizer = optimizer;
+  return o;
+}
+
+TEST(NoiseLearning, ScoringReachesTheEmMaximumInFewerPasses) {
+  const EmCase c;
+  NoiseLearningOptions o = fromOnesToTheTop("nelder-mead");
   const NoiseLearningReport nm = c.learn(o);
   o.optimizer = "scoring";
   const NoiseLearningReport r = c.learn(o);
@@ -391,11 +398,7 @@ TEST(NoiseLearning, ScoringReachesTheEmMaximumInFewerPasses) {
 // p passes), not three times; the values are what one pass gives.
 TEST(NoiseLearning, APassAtANoiseAlreadyRunIsNotRunAgain) {
   const EmCase c;
-  NoiseLearningOptions o;
-  o.start = 1.0;
-  o.tolerance = 1e-10;
-  o.standard_errors = false;
-  o.optimizer = "scoring";
+  NoiseLearningOptions o = fromOnesToTheTop("scoring");
   const NoiseLearningReport top = c.learn(o);
   ASSERT_TRUE(top.converged) << top.toString();
   o.start = 0;  // from the given values: the maximum
