@@ -194,15 +194,14 @@ struct Objective {
   // repeats are at the start; Nelder–Mead's thousands of points are not).
   std::vector<internal::LikelihoodTerms> passes(const std::vector<Eigen::VectorXd>& thetas) {
     std::vector<internal::LikelihoodTerms> out(thetas.size());
-    std::vector<std::size_t> run;  // the θs to run: the first of each not seen
-    std::vector<std::size_t> source(thetas.size());  // where each θ's pass is: seen[i] or out[run[i]]
-    std::vector<bool> from_seen(thetas.size());
+    std::vector<std::size_t> run;  // the first of each θ not seen before
+    const auto firstRunOf = [&](std::size_t k) {
+      return std::find_if(run.begin(), run.end(), [&](std::size_t j) { return thetas[j] == thetas[k]; });
+    };
+    std::vector<bool> known(thetas.size(), false);
     for (std::size_t k = 0; k < thetas.size(); ++k) {
-      const auto known = findSeen(thetas[k]);
-      const auto earlier = std::find_if(run.begin(), run.end(), [&](std::size_t j) { return thetas[j] == thetas[k]; });
-      from_seen[k] = known < seen.size();
-      source[k] = from_seen[k] ? known : static_cast<std::size_t>(earlier - run.begin());
-      if (!from_seen[k] && earlier == run.end()) run.push_back(k);
+      if (const internal::LikelihoodTerms* s = findSeen(thetas[k])) out[k] = *s, known[k] = true;
+      else if (firstRunOf(k) == run.end()) run.push_back(k);
     }
     const auto errors = runJobs(run.size(), static_cast<std::size_t>(threads),
                                 [&](std::size_t i) { out[run[i]] = pass(thetas[run[i]]); });
@@ -210,16 +209,16 @@ struct Objective {
       if (e) std::rethrow_exception(e);
     evaluations += static_cast<int>(run.size());
     for (std::size_t k = 0; k < thetas.size(); ++k)
-      if (from_seen[k] || run[source[k]] != k) out[k] = from_seen[k] ? seen[source[k]].second : out[run[source[k]]];
+      if (!known[k] && *firstRunOf(k) != k) out[k] = out[*firstRunOf(k)];  // a repeat within this batch
     for (std::size_t i : run)
       if (seen.size() < kSeenKept) seen.emplace_back(thetas[i], out[i]);
     return out;
   }
   static constexpr std::size_t kSeenKept = 32;
-  std::size_t findSeen(const Eigen::VectorXd& theta) const {
-    std::size_t i = 0;
-    while (i < seen.size() && !(seen[i].first.size() == theta.size() && seen[i].first == theta)) ++i;
-    return i;
+  const internal::LikelihoodTerms* findSeen(const Eigen::VectorXd& theta) const {
+    for (const auto& s : seen)
+      if (s.first.size() == theta.size() && s.first == theta) return &s.second;
+    return nullptr;
   }
 };
 
