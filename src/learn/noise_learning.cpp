@@ -441,13 +441,14 @@ NoiseLearningReport learnNoise(const NoiseFamily& family, const std::vector<Meas
   for (Eigen::Index i = 0; i < n; ++i) given[i] = std::log(family.given[i]);
   obj.lo = theta.array() - std::log(o.search_range);
   obj.hi = theta.array() + std::log(o.search_range);
-  // Scoring's first round (the start and its slope) beside the given
-  // values' pass: the same passes, fewer rounds on several threads.
-  if (o.optimizer == "scoring") {
-    std::vector<Eigen::VectorXd> first = internal::firstScoringPoints(theta, scoringOptions(obj, o));
-    first.push_back(given);
-    obj.passes(first);
-  }
+  // The optimizer's first round (scoring's: the start and its slope;
+  // Nelder–Mead's: the start) beside the given values' pass, in one round
+  // on the threads; the passes below and the optimizer's first are then kept.
+  std::vector<Eigen::VectorXd> first =
+      o.optimizer == "scoring" ? internal::firstScoringPoints(theta, scoringOptions(obj, o))
+                               : std::vector<Eigen::VectorXd>{theta};
+  first.push_back(given);
+  obj.passes(first);
   r.given_log_likelihood = obj.logLikelihood(given);
   r.start_log_likelihood = obj.logLikelihood(theta);
   if (!std::isfinite(r.start_log_likelihood))

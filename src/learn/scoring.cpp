@@ -159,12 +159,18 @@ bool searchAlong(const LikelihoodTermsAt& at, const Eigen::VectorXd& x, const Ei
 }
 }  // namespace
 
-std::vector<Eigen::VectorXd> firstScoringPoints(const Eigen::VectorXd& x0, const ScoringOptions& o) {
-  const Eigen::VectorXd x = x0.cwiseMax(o.lo).cwiseMin(o.hi);
-  const SlopePoints sp = slopePoints(x, o, false);
+namespace {
+// x, then its slope's points: the first round's θs.
+std::vector<Eigen::VectorXd> startAndSlope(const Eigen::VectorXd& x, const SlopePoints& sp) {
   std::vector<Eigen::VectorXd> first{x};
   first.insert(first.end(), sp.points.begin(), sp.points.end());
   return first;
+}
+}  // namespace
+
+std::vector<Eigen::VectorXd> firstScoringPoints(const Eigen::VectorXd& x0, const ScoringOptions& o) {
+  const Eigen::VectorXd x = x0.cwiseMax(o.lo).cwiseMin(o.hi);
+  return startAndSlope(x, slopePoints(x, o, false));
 }
 
 ScoringResult maximizeByScoring(const LikelihoodTermsAt& at, const Eigen::VectorXd& x0, const ScoringOptions& o,
@@ -174,7 +180,7 @@ ScoringResult maximizeByScoring(const LikelihoodTermsAt& at, const Eigen::Vector
   // The start and its slope's passes in one batch (forward differences
   // need the start only to difference against).
   const SlopePoints sp = slopePoints(r.x, o, false);
-  std::vector<LikelihoodTerms> passes = passesAt(at, firstScoringPoints(x0, o), r.evaluations);
+  std::vector<LikelihoodTerms> passes = passesAt(at, startAndSlope(r.x, sp), r.evaluations);
   LikelihoodTerms here = std::move(passes.front());
   r.value = here.total;
   if (!std::isfinite(here.total)) return r;
