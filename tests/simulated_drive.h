@@ -68,6 +68,15 @@ inline Eigen::Vector3d accelReadingFor(const Eigen::VectorXd& constants, const E
       .cwiseQuotient(Eigen::Vector3d::Ones() - constants.segment<3>(Ins::kAccelScale));
 }
 
+/// White noise on one IMU reading held over T: the gyro's σ per axis (one
+/// for all or one each) and the accelerometer's, each /√T.
+inline Eigen::VectorXd readingNoise(const models::StrapdownIns::Params& p, double T, const NormalSampler& draw) {
+  Eigen::VectorXd sd(6);
+  for (int i = 0; i < 3; ++i) sd[i] = p.gyro_sd[p.gyro_sd.size() == 3 ? i : 0] / std::sqrt(T);
+  sd.tail<3>().setConstant(p.accel_sd / std::sqrt(T));
+  return sampleGaussian(Eigen::VectorXd::Zero(6), Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal()), draw);
+}
+
 /// Drives `seconds` with `model` (its T the IMU interval); the constants
 /// drawn from the model's prior, the start its prior mean; the body rocks
 /// in roll by roll_amplitude (rad) while driving. A constraint that reads
@@ -75,9 +84,15 @@ inline Eigen::Vector3d accelReadingFor(const Eigen::VectorXd& constants, const E
 /// an accelerometer reading of the path's specific force (the vehicle's
 /// acceleration along its nominal path less gravity, smooth: the body's
 /// give follows it, and a give following the jittering readings would feed
-/// back on itself).
+/// back on itself). The noise: by default the model's process noise on the
+/// state, each next reading steering back to the path (the state jitters
+/// about it); with noisy_readings, white noise on the readings instead (the
+/// model's gyro σ per axis and accelerometer σ, each /√T), the state on the
+/// path and the constraints' zeros drawn with their σs: the noise then
+/// accumulates as Q says and every channel is as noisy as R says, what a
+/// noise learner needs.
 inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double seconds, const NormalSampler& draw,
-                                    double roll_amplitude = 0.0) {
+                                    double roll_amplitude = 0.0, bool noisy_readings = false) {
   SimulatedDrive d;
   const double T = model.nominalStep();
   d.constants = sampleGaussian(model.priorConstants().mean, model.priorConstants().covariance, draw);
@@ -110,9 +125,12 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
     Eigen::VectorXd u(6);
     u << gyro, accel;
     u += bias;  // what the IMU reads
-    d.inputs.push_back({t, u});
+    Eigen::VectorXd read = u;
+    if (noisy_readings) read += readingNoise(model.params(), T, draw);
+    d.inputs.push_back({t, read});
     x = model.f(x, d.constants, u, T);
-    retractBlocks(x, sampleGaussian(Eigen::VectorXd::Zero(x.size()), model.processNoise(T), draw), model.rotationBlocks());
+    if (!noisy_readings)
+      retractBlocks(x, sampleGaussian(Eigen::VectorXd::Zero(x.size()), model.processNoise(T), draw), model.rotationBlocks());
     d.states.push_back(x);
     const double tn = (k + 1) * T;
     const int n = k + 1;
@@ -127,9 +145,12 @@ inline SimulatedDrive simulateDrive(const models::StrapdownIns& model, double se
       const bool standing = tn < 5.0;
       const int c = standing ? Ins::kZupt : Ins::kNhc;
       Eigen::VectorXd reading(model.channel(c).regressors);
-      if (reading.size() >= 3) reading.head<3>() = u.head<3>();
+      if (reading.size() >= 3) reading.head<3>() = read.head<3>();
       if (reading.size() == 6) reading.tail<3>() = accelReadingFor(d.constants, R_vb, F);
-      d.measurements.push_back({tn, Eigen::VectorXd::Zero(model.channel(c).dim()), c, {}, reading});
+      // The constraint holds on the path exactly: with the noise on the
+      // readings its σ is the measurement's (the model says it is noisy)
+      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.channel(c).dim());
+      d.measurements.push_back({tn, noisy_readings ? sampleGaussian(zero, model.channel(c).R, draw) : zero, c, {}, reading});
     }
   }
   return d;

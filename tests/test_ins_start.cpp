@@ -42,7 +42,7 @@ StrapdownIns::Params startParams() {
   p.T = 0.02;
   p.anchor = {40.0 * M_PI / 180, -105.0 * M_PI / 180, 1600.0};
   p.mount_rpy = Eigen::Vector3d(M_PI, -0.12, M_PI + 0.09);
-  p.gyro_sd = 1e-3, p.accel_sd = 0.02, p.gnss_sd = 0.02;
+  p.gyro_sd = Eigen::VectorXd::Constant(1, 1e-3), p.accel_sd = 0.02, p.gnss_sd = 0.02;
   p.gyro_bias_sd = 2e-3, p.accel_bias_sd = 0.02, p.mount_sd = 1e-6, p.delay_sd = 1e-6;
   return p;
 }

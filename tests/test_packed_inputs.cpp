@@ -152,7 +152,7 @@ TEST(PackedInputs, InsJacobiansOverAPackMatchTangentDifferences) {
 // at the same times.
 TEST(PackedInputs, AFilterOverPacksIsTheFilterAtEverySample) {
   StrapdownIns::Params p = insParams(1);
-  p.gyro_sd = 1e-10, p.accel_sd = 1e-10, p.clock_wander_sd = 1e-12;
+  p.gyro_sd = Eigen::VectorXd::Constant(1, 1e-10), p.accel_sd = 1e-10, p.clock_wander_sd = 1e-12;
   const StrapdownIns one(p);
   p.imu_per_state = 10;
   const StrapdownIns packed(p);

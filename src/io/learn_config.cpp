@@ -88,6 +88,7 @@ std::map<std::pair<std::string, std::string>, std::string> learntValues(const No
   IniDocument scratch;
   for (const auto& p : r.parameters) {
     if (p.index < 0) scratch.set(p.section, p.key, p.value);
+    else if (p.of_vector) scratch.set(p.section, p.key, Eigen::MatrixXd(r.values.vector(p.section, p.key).transpose()));
     else scratch.set(p.section, p.key, r.values.matrix(p.section, p.key));
     out[{prefix.empty() ? p.section : prefix + "." + p.section, p.key}] = scratch.getString(p.section, p.key);
   }

@@ -123,6 +123,15 @@ std::vector<LearntParameter> learnableParameters(const ModelType& type, const Pa
       if (spec->constants_prior) out.back().method = "em";
       continue;
     }
+    if (spec->kind == ParamKind::Vector) {  // σs: one value is learnt as the key itself
+      const Eigen::VectorXd v = values.vector(section, key);
+      for (Eigen::Index i = 0; i < v.size(); ++i)
+        if (v[i] > 0) {
+          add(section, key, v.size() == 1 ? -1 : static_cast<int>(i), v[i]);
+          out.back().of_vector = true;
+        }
+      continue;
+    }
     const Eigen::MatrixXd M = values.matrix(section, key);
     for (Eigen::Index i = 0; i < std::min(M.rows(), M.cols()); ++i)
       if (M(i, i) > 0) add(section, key, static_cast<int>(i), std::sqrt(M(i, i)));
@@ -400,6 +409,12 @@ ParamValues withSigmas(const ParamValues& base, const std::vector<LearntParamete
   for (std::size_t i = 0; i < ps.size(); ++i) {
     const LearntParameter& p = ps[i];
     const double sigma = sigmas[static_cast<Eigen::Index>(i)];
+    if (p.of_vector) {
+      Eigen::VectorXd entries = v.vector(p.section, p.key);
+      entries[std::max(p.index, 0)] = sigma;
+      v.vector(p.section, p.key, entries);
+      continue;
+    }
     if (p.index < 0) {
       v.real(p.section, p.key, sigma);
       continue;

@@ -76,9 +76,10 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
   if (nc > StrapdownIns::kStates)
     Q.block<3, 3>(StrapdownIns::kGyroWalk, StrapdownIns::kGyroWalk).diagonal().setConstant(
         p.gyro_bias_walk * p.gyro_bias_walk * dt);
-  const double g = p.gyro_sd * p.gyro_sd, a = p.accel_sd * p.accel_sd;
+  const double a = p.accel_sd * p.accel_sd;
   for (int i = 0; i < 3; ++i) {
-    Q(i, i) = g * dt;
+    const double g = p.gyro_sd[p.gyro_sd.size() == 3 ? i : 0];  // θ is in the IMU's axes
+    Q(i, i) = g * g * dt;
     Q(3 + i, 3 + i) = a * dt;
     Q(3 + i, 6 + i) = Q(6 + i, 3 + i) = a * dt * dt / 2;
     Q(6 + i, 6 + i) = a * dt * dt * dt / 3;
@@ -87,7 +88,10 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
 }
 
 ModelNoise insNoise(const StrapdownIns::Params& p) {
-  for (double v : {p.T, p.gyro_sd, p.accel_sd, p.gnss_sd, p.gnss_sd_scale, p.gnss_vel_sd, p.gnss_vel_sd_scale,
+  if ((p.gyro_sd.size() != 1 && p.gyro_sd.size() != 3) || !(p.gyro_sd.array() > 0).all() || !p.gyro_sd.allFinite())
+    throw InvalidArgument("StrapdownIns: gyro_sd must be one σ > 0 (every axis) or three (the IMU's x, y, z), got " +
+                          std::to_string(p.gyro_sd.size()) + " values");
+  for (double v : {p.T, p.accel_sd, p.gnss_sd, p.gnss_sd_scale, p.gnss_vel_sd, p.gnss_vel_sd_scale,
                    p.nhc_sd, p.nhc_down_sd, p.zupt_sd, p.zaru_sd, p.attitude_sd, p.velocity_sd,
                    p.position_sd, p.gyro_bias_sd, p.accel_bias_sd, p.lever_sd, p.mount_sd, p.delay_sd,
                    p.gyro_scale_sd, p.accel_scale_sd, p.clock_rate_sd, p.clock_wander_sd})
@@ -529,7 +533,8 @@ std::vector<ParamSpec> insParams() {
                    "the NED frame's origin: latitude, longitude (deg), ellipsoidal height (m), or first_fix: the "
                    "first fix of [dataset] gnss (an RTKLIB .pos, default gnss.pos)")),
       vector("model", "mount_rpy", "nominal IMU → vehicle rotation as roll, pitch, yaw (deg; vehicle axes forward, right, down)"),
-      learnable(real("model", "gyro_sd", "gyro white noise, rad/s/√Hz")),
+      learnable(vector("model", "gyro_sd",
+                       "gyro white noise, rad/s/√Hz: one σ for every axis, or three, one per IMU axis (x, y, z)")),
       learnable(real("model", "accel_sd", "accelerometer white noise, m/s²/√Hz")),
       learnable(real("model", "gnss_sd", "σ of each GNSS coordinate when a fix gives none (m)")),
       learnable(real("model", "gnss_sd_scale", "factor on the σs each GNSS fix reports (1: as reported)")),
@@ -674,7 +679,7 @@ void startFromData(const ParamSource& in, StrapdownIns::Params& p) {
 // T are apart.
 template <class P>
 auto modelReals(P& p) {
-  return std::array{std::pair{"gyro_sd", &p.gyro_sd}, std::pair{"accel_sd", &p.accel_sd},
+  return std::array{std::pair{"accel_sd", &p.accel_sd},
                     std::pair{"gnss_sd", &p.gnss_sd}, std::pair{"gnss_sd_scale", &p.gnss_sd_scale},
                     std::pair{"gnss_vel_sd", &p.gnss_vel_sd}, std::pair{"gnss_vel_sd_scale", &p.gnss_vel_sd_scale},
                     std::pair{"gnss_vel_latency", &p.gnss_vel_latency}, std::pair{"nhc_sd", &p.nhc_sd},
@@ -714,6 +719,10 @@ StrapdownIns::Params readIns(const ParamSource& in) {
   if (in.has("model", "mount_rpy")) p.mount_rpy = in.vector("model", "mount_rpy", 3) * kDeg;
   p.T = in.real("model", "T", p.T);
   for (auto [key, value] : modelReals(p)) *value = in.real("model", key, *value);
+  if (in.has("model", "gyro_sd")) p.gyro_sd = in.vector("model", "gyro_sd");
+  if (p.gyro_sd.size() != 1 && p.gyro_sd.size() != 3)
+    throw InputError(in.where("model", "gyro_sd") + ": expected one σ (every axis) or three (the IMU's x, y, z), got " +
+                     std::to_string(p.gyro_sd.size()));
   for (auto [key, value] : calibrationPriors(p))
     if (in.has("prior", key)) *value = in.vector("prior", key, 3);
   for (auto [key, value] : {std::pair{"nhc_point", &p.nhc_point}, {"nhc_point_sd", &p.nhc_point_sd}})
@@ -749,6 +758,7 @@ void writeIns(const StrapdownIns::Params& p, ParamSink& out) {
   out.vector("model", "anchor", Eigen::Vector3d(p.anchor.lat / kDeg, p.anchor.lon / kDeg, p.anchor.height));
   out.vector("model", "mount_rpy", p.mount_rpy / kDeg);
   for (auto [key, value] : modelReals(p)) out.real("model", key, *value);
+  out.vector("model", "gyro_sd", p.gyro_sd);
   writeLoss(p.nhc_loss, "model", out, "nhc_");
   out.vector("prior", "start_rpy", p.start_rpy / kDeg);
   out.vector("prior", "start_velocity", p.start_velocity);

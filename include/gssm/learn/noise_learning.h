@@ -25,12 +25,15 @@
 
 namespace gssm {
 
-/// One fitted σ: a learnable Real parameter, or one diagonal entry of a
-/// learnable Matrix (its square root).
+/// One fitted σ: a learnable Real parameter, one diagonal entry of a
+/// learnable Matrix (its square root), or one entry of a learnable Vector of σs.
 struct LearntParameter {
   std::string section;  ///< "model", or a sub-section ("channel.gps")
   std::string key;      ///< "range_sd", "Q", "R"
-  int index = -1;       ///< diagonal entry of a Matrix parameter; −1 for a Real
+  int index = -1;       ///< diagonal entry of a Matrix parameter, or entry of a Vector of σs; −1 for a Real
+  /// A learnable Vector of σs (its entry `index`, or its one value with index
+  /// −1), not a Real or a Matrix's diagonal.
+  bool of_vector = false;
   double given = 0;     ///< the model's σ before learning
   double start = 0;     ///< where learning started
   double value = 0;     ///< the learnt σ

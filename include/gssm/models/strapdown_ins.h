@@ -54,7 +54,10 @@ class StrapdownIns final : public Model {
     double T = 0.01;                           ///< nominal IMU interval (s)
     geodesy::Geodetic anchor;                  ///< the frame's origin (rad, rad, m)
     Eigen::Vector3d mount_rpy{0, 0, 0};        ///< R_vb0 as roll, pitch, yaw (rad), IMU → vehicle
-    double gyro_sd = 1e-3;                     ///< gyro white noise, rad/s/√Hz
+    /// Gyro white noise, rad/s/√Hz: one σ for every axis, or one per IMU
+    /// axis (x, y, z): an engine shakes a strapped-down IMU about some axes
+    /// more than about others.
+    Eigen::VectorXd gyro_sd = Eigen::VectorXd::Constant(1, 1e-3);
     double accel_sd = 1e-2;                    ///< accelerometer white noise, m/s²/√Hz
     double gnss_sd = 0.02;                     ///< σ of each GNSS coordinate (m) unless a fix gives its own
     double gnss_sd_scale = 1;                  ///< factor on the σs a fix gives (learnable: the receiver's honesty)
