@@ -5,8 +5,12 @@ set 11 s after, pooled with the first in the summary); its fixes
 counted from the .pos itself (RTK-fixed ones inside the windows) and found
 again in each method's withheld CSV and in metrics.json's withheld count;
 every method there guarded at today's level (docs/datasets/
-gnss-ins-drive.md: 1.45 / 1.51 / 1.30 m, EKF / incremental / fixed lag;
-the batch, with its own noise, 0.074 m).
+gnss-ins-drive.md: 1.66 / 1.54 / 1.36 m, EKF / incremental / fixed lag;
+the batch, with its own noise, 0.075 m). The EKF's guard rose from 1.55 m
+with the gyro's noise per axis: these windows lose (1.45 -> 1.66 m) where
+the withheld outages and the windows 3 and 11 s after them gain (pooled
+over all three offsets on the log and on it cut at 53 s, every method
+gains).
 
     heldout_outages.py BIN_DIR SOURCE_DIR WORK_DIR
 """
@@ -49,6 +53,6 @@ for name, m in pooled["methods"].items():
     rms = math.sqrt(sum(x["count"] * x["horizontal_rms_m"] ** 2 for x in sets) / n)
     check(m["count"] == n and abs(m["horizontal_rms_m"] - rms) < 1e-12,
           "%s pooled over both sets: %.3f m RMS at %d fixes" % (name, m["horizontal_rms_m"], n))
-for name, level in (("ekf", 1.55), ("incremental", 1.6), ("fixed-lag", 1.4), ("batch", 0.08)):
+for name, level in (("ekf", 1.75), ("incremental", 1.6), ("fixed-lag", 1.4), ("batch", 0.08)):
     e = result["methods"][name]["horizontal_rms_m"]
     check(e <= level, "%s in the held-out windows %.3f m RMS (today's level <= %.2f m)" % (name, e, level))
