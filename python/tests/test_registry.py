@@ -119,6 +119,12 @@ def test_strapdown_ins_from_its_registration():
     scaled = gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], gnss_sd_scale=2.0)
     assert scaled.channels[0].own_R_scale == 4.0 and scaled.channels[1].own_R_scale == 1.0
     assert gssm.models.from_ini(m.to_ini()).to_ini() == m.to_ini()
+    # the gyro's σ: one for every axis, or one per IMU axis (θ's noise in its axes)
+    per_axis = gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], gyro_sd=[0.001, 0.003, 0.0002])
+    np.testing.assert_allclose(per_axis.Q.diagonal()[:3], np.array([0.001, 0.003, 0.0002]) ** 2 * 0.01, rtol=1e-15)
+    np.testing.assert_array_equal(gssm.models.from_ini(per_axis.to_ini()).params["gyro_sd"], [0.001, 0.003, 0.0002])
+    with pytest.raises(Exception, match="gyro_sd.*one σ .every axis. or three"):
+        gssm.models.StrapdownIns(anchor=[40.0, -105.0, 1600.0], gyro_sd=[0.001, 0.003])
     x, b = m.prior_state[0], m.prior_constants[0]
     np.testing.assert_allclose(np.linalg.norm(x[:3]), np.radians(30.0), atol=1e-12)  # yaw 30° as a rotation vector
     nxt, J_x, J_b = m.f(x, b, u=[0, 0, 0, 0, 0, -9.797], dt=0.01, jacobians=True)
