@@ -72,7 +72,7 @@ inline Eigen::Vector3d accelReadingFor(const Eigen::VectorXd& constants, const E
 /// for all or one each) and the accelerometer's, each /√T.
 inline Eigen::VectorXd readingNoise(const models::StrapdownIns::Params& p, double T, const NormalSampler& draw) {
   Eigen::VectorXd sd(6);
-  for (int i = 0; i < 3; ++i) sd[i] = p.gyro_sd[p.gyro_sd.size() == 3 ? i : 0] / std::sqrt(T);
+  for (int i = 0; i < 3; ++i) sd[i] = p.gyroSdAbout(i) / std::sqrt(T);
   sd.tail<3>().setConstant(p.accel_sd / std::sqrt(T));
   return sampleGaussian(Eigen::VectorXd::Zero(6), Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal()), draw);
 }

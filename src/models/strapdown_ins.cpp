@@ -78,7 +78,7 @@ Eigen::MatrixXd insProcessNoise(const StrapdownIns::Params& p, double dt) {
         p.gyro_bias_walk * p.gyro_bias_walk * dt);
   const double a = p.accel_sd * p.accel_sd;
   for (int i = 0; i < 3; ++i) {
-    const double g = p.gyro_sd[p.gyro_sd.size() == 3 ? i : 0];  // θ is in the IMU's axes
+    const double g = p.gyroSdAbout(i);  // θ is in the IMU's axes
     Q(i, i) = g * g * dt;
     Q(3 + i, 3 + i) = a * dt;
     Q(3 + i, 6 + i) = Q(6 + i, 3 + i) = a * dt * dt / 2;

@@ -58,6 +58,8 @@ class StrapdownIns final : public Model {
     /// axis (x, y, z): an engine shakes a strapped-down IMU about some axes
     /// more than about others.
     Eigen::VectorXd gyro_sd = Eigen::VectorXd::Constant(1, 1e-3);
+    /// The gyro's σ about IMU axis `axis` (0, 1, 2) of gyro_sd.
+    double gyroSdAbout(int axis) const { return gyro_sd[gyro_sd.size() == 3 ? axis : 0]; }
     double accel_sd = 1e-2;                    ///< accelerometer white noise, m/s²/√Hz
     double gnss_sd = 0.02;                     ///< σ of each GNSS coordinate (m) unless a fix gives its own
     double gnss_sd_scale = 1;                  ///< factor on the σs a fix gives (learnable: the receiver's honesty)
