@@ -204,13 +204,16 @@ struct Objective {
   std::vector<internal::LikelihoodTerms> passes(const std::vector<Eigen::VectorXd>& thetas) {
     std::vector<internal::LikelihoodTerms> out(thetas.size());
     std::vector<std::size_t> run;  // the first of each θ not seen before
-    const auto firstRunOf = [&](std::size_t k) {
-      return std::find_if(run.begin(), run.end(), [&](std::size_t j) { return thetas[j] == thetas[k]; });
-    };
-    std::vector<bool> known(thetas.size(), false);
+    constexpr std::size_t kSeen = static_cast<std::size_t>(-1);
+    std::vector<std::size_t> first(thetas.size(), kSeen);  // each θ not seen: the θ in `run` that is it
     for (std::size_t k = 0; k < thetas.size(); ++k) {
-      if (const internal::LikelihoodTerms* s = findSeen(thetas[k])) out[k] = *s, known[k] = true;
-      else if (firstRunOf(k) == run.end()) run.push_back(k);
+      if (const internal::LikelihoodTerms* s = findSeen(thetas[k])) {
+        out[k] = *s;
+        continue;
+      }
+      const auto earlier = std::find_if(run.begin(), run.end(), [&](std::size_t j) { return thetas[j] == thetas[k]; });
+      first[k] = earlier == run.end() ? k : *earlier;
+      if (first[k] == k) run.push_back(k);
     }
     const auto errors = runJobs(run.size(), static_cast<std::size_t>(threads),
                                 [&](std::size_t i) { out[run[i]] = pass(thetas[run[i]]); });
@@ -218,7 +221,7 @@ struct Objective {
       if (e) std::rethrow_exception(e);
     evaluations += static_cast<int>(run.size());
     for (std::size_t k = 0; k < thetas.size(); ++k)
-      if (!known[k] && *firstRunOf(k) != k) out[k] = out[*firstRunOf(k)];  // a repeat within this batch
+      if (first[k] != kSeen && first[k] != k) out[k] = out[first[k]];  // a repeat within this batch
     for (std::size_t i : run)
       if (seen.size() < kSeenKept) seen.emplace_back(thetas[i], out[i]);
     return out;
