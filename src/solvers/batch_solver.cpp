@@ -12,6 +12,7 @@
 #include "linear/envelope_cholesky.h"
 #include "linear/normal_equations.h"
 #include "linear/sparse_cholesky.h"
+#include "solvers/anderson.h"
 #include "solvers/change_step.h"
 #include "solvers/damping.h"
 #include "solvers/newton.h"
@@ -53,6 +54,8 @@ bool BatchSolverOptions::validate(std::string* why) const {
   if (!(max_lambda > initial_lambda)) return fail("max_lambda must exceed initial_lambda");
   if (newton_polish_steps < 0) return fail("newton_polish_steps must be >= 0");
   if (threads < 1) return fail("threads must be >= 1, got " + std::to_string(threads));
+  if (anderson_memory < 0 || anderson_memory > 16)
+    return fail("anderson_memory must be 0 (off) to 16, got " + std::to_string(anderson_memory));
   if (!relinearize_at_solution && newton_polish_steps > 0)
     return fail("relinearize_at_solution = false needs no Newton polish (the polish relinearizes at the solution)");
   return true;
@@ -75,7 +78,11 @@ std::string BatchSolverSummary::toString() const {
   os << "BatchSolver: " << gssm::toString(termination) << " after " << iterations
      << " iterations (" << rejected_steps << " rejected, " << factorizations << " factorizations"
      << (linear_solver.empty() ? std::string() : ", " + linear_solver + " Cholesky")
-     << (newton_steps ? ", " + std::to_string(newton_steps) + " Newton" : std::string()) << "), cost " << initial_cost << " -> " << final_cost
+     << (newton_steps ? ", " + std::to_string(newton_steps) + " Newton" : std::string())
+     << (anderson_steps || anderson_rejected
+             ? ", " + std::to_string(anderson_steps) + " Anderson-mixed (" + std::to_string(anderson_rejected) + " refused)"
+             : std::string())
+     << "), cost " << initial_cost << " -> " << final_cost
      << ", max|gradient| " << gradient_norm << ", " << num_variables << " variables / "
      << num_factors << " factors / dim " << dimension << ", " << seconds << " s";
   return os.str();
@@ -659,6 +666,8 @@ struct BatchSolver::Impl::Iteration {
   // Values was 64 MB of fresh memory and a million small allocations at 10⁶
   // steps.
   Eigen::VectorXd x_before;
+  internal::AndersonMixing anderson{options.anderson_memory};
+  Eigen::VectorXd gauss_newton_step;  // the undamped step before the mix (anderson_memory > 0)
   bool factored_at_solution = false;  // the last step kept its factorization (relinearize_at_solution false)
   double factored_cost = 0;           // the cost where it was factored (g is that point's)
   internal::Retraction retraction;  // x ⊕ δ on rotation blocks (docs/DESIGN.md §12)
@@ -721,17 +730,38 @@ struct BatchSolver::Impl::Iteration {
       return false;
     }
     if (stepConverged(delta, x) || (policy.lambda() == 0 && predicted <= options.decrease_tolerance)) {
+      // λ already reached 0: the last steps were undamped, so there is no
+      // damping bias to remove by one more, identical factorization
+      if (policy.lambda() == 0 && !policy.undamped()) policy.converged();
       if (policy.undamped()) {  // a tiny undamped step is still the exact correction: take it
         internal::addStep(x, delta, x, &retraction);
         cost = s.linearize(graph, x, g, diag);
       }
       return !converge(Termination::StepConverged);
     }
-    return tryStep();
+    return tryStep(accelerate());
   }
 
-  // x ⊕ δ, kept if the policy accepts its cost; false when the solve is done.
-  bool tryStep() {
+  // An undamped step mixed with the last ones (anderson_memory; the tests
+  // above judged Gauss–Newton's own); true when δ is a mix.
+  bool accelerate() {
+    if (options.anderson_memory == 0) return false;
+    if (policy.lambda() != 0) {  // a damped step: no sequence of undamped ones to extrapolate
+      anderson.reset();
+      return false;
+    }
+    gauss_newton_step = delta;
+    if (!anderson.mix(gauss_newton_step, diag, delta)) return false;
+    if (g.dot(delta) < 0) return true;
+    delta = gauss_newton_step;  // the mix is not downhill: Gauss–Newton's step, and a fresh history
+    anderson.reset();
+    return false;
+  }
+
+  // x ⊕ δ, kept if the policy accepts its cost (a mix, under any method:
+  // as an undamped step, unless it raises the cost); false when the solve
+  // is done.
+  bool tryStep(bool mixed) {
     internal::flatten(x, x_before);
     internal::addStep(x, delta, x, &retraction);
     // Linearize at the candidate right away (its cost comes with it): one
@@ -739,13 +769,25 @@ struct BatchSolver::Impl::Iteration {
     // step refills H, g and the diagonal at the point it goes back to (so
     // no second gradient and diagonal are kept: 16 MB at 10⁶ steps).
     const double new_cost = s.linearize(graph, x, g, diag, true);
+    if (mixed && !internal::LevenbergMarquardtPolicy::acceptUndamped(new_cost, cost)) {
+      ++sum.anderson_rejected;
+      anderson.reset();  // back, and Gauss–Newton's own step next
+      internal::unflatten(x_before, x);
+      cost = s.linearize(graph, x, g, diag);
+      return true;
+    }
     if (!std::isfinite(new_cost) && !lm)  // Gauss–Newton cannot back off: say which factor
       s.linearize(graph, x, g, diag);
     if (!policy.accept(new_cost, cost)) {
       ++sum.rejected_steps;
+      anderson.reset();
       internal::unflatten(x_before, x);
       cost = s.linearize(graph, x, g, diag);
-      if (policy.undamped()) {  // the damped solution was already converged
+      // The damped solution was already converged; or λ had reached 0 and
+      // the step moved the cost by rounding alone (after a mix that landed
+      // on the minimum: more damping would only shrink a step to nothing)
+      if (policy.undamped() ||
+          (policy.lambda() == 0 && internal::LevenbergMarquardtPolicy::acceptUndamped(new_cost, cost))) {
         sum.termination = Termination::CostConverged;
         return false;
       }
@@ -756,6 +798,8 @@ struct BatchSolver::Impl::Iteration {
       return true;
     }
     ++sum.iterations;
+    if (mixed) ++sum.anderson_steps;
+    if (options.anderson_memory > 0) anderson.accepted(delta);
     const double old_cost = cost;
     cost = new_cost;
     policy.accepted();

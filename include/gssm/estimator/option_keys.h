@@ -66,6 +66,9 @@ void optionKeys(Visitor& v, BatchSolverOptions& o) {
   v("covariance_by_qr", o.covariance_by_qr,
     "covariances from a QR of the Jacobian at the solution, not the normal equations (a stiff chain beside a weakly "
     "seen constant)");
+  v("anderson_memory", o.anderson_memory,
+    "Anderson acceleration of the undamped steps: each mixed with this many previous ones (0: off), kept only if "
+    "it lowers the cost");
 }
 
 /// Collects the keys (optionKeyNames).
