@@ -978,11 +978,16 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
   for (const auto& k : keys) {
     const Var& v = vars_.at(k);
     const Factor::Rotations rot = rotationsOf(k);
-    if (rot.blocks) {
-      Eigen::MatrixXd J = Eigen::MatrixXd::Identity(v.dim(), v.dim());
-      chartJacobian(*rot.blocks, rot.offset, v.delta(), J);
-      S.middleRows(at, v.dim()) = (J * S.middleRows(at, v.dim())).eval();
-      S.middleCols(at, v.dim()) = (S.middleCols(at, v.dim()) * J.transpose()).eval();
+    if (rot.blocks && hasRotationIn(*rot.blocks, v.dim(), rot.offset)) {  // on those 3 rows and columns alone
+      const std::vector<Eigen::Matrix3d> Jr = blockRightJacobians(v.delta(), *rot.blocks, rot.offset);
+      std::vector<Eigen::Matrix3d> JrT(Jr.size());
+      for (std::size_t i = 0; i < Jr.size(); ++i) JrT[i] = Jr[i].transpose();
+      Eigen::MatrixXd part = S.middleRows(at, v.dim());
+      premultiplyBlocks(part, Jr, *rot.blocks, rot.offset);
+      S.middleRows(at, v.dim()) = part;
+      part = S.middleCols(at, v.dim());
+      postmultiplyBlocks(part, JrT, *rot.blocks, rot.offset);
+      S.middleCols(at, v.dim()) = part;
     }
     at += v.dim();
   }
