@@ -40,28 +40,33 @@ struct Axes {
   double py(double y) const { return bottom - (y - y0) / (y1 - y0) * (bottom - top); }
 };
 
-// Blends colours into an image's pixels. CImage's accessors check the image
-// (loaded, not empty, its size) on every call, and a ±2σ band blends tens of
-// thousands of pixels: the size, first row and row stride are read once.
+// Blends one colour at one opacity into an image's pixels. CImage's
+// accessors check the image (loaded, not empty, its size) on every call, and
+// a ±2σ band blends tens of thousands of pixels: the size, first row and row
+// stride are read once, and each channel's 256 blends are tabulated (the
+// same expression, so the same bytes, as computing it per pixel).
 class PixelBlender {
  public:
-  explicit PixelBlender(mrpt::img::CImage& img)
+  PixelBlender(mrpt::img::CImage& img, Color c, double a)
       : width_(static_cast<int>(img.getWidth())),
         height_(static_cast<int>(img.getHeight())),
         row0_(img.ptr<uint8_t>(0, 0)),
-        stride_(height_ > 1 ? img.ptr<uint8_t>(0, 1) - row0_ : 0) {}
-  // `c` into pixel (x, y) with opacity a (rounded to nearest, as lround).
-  void blend(int x, int y, Color c, double a) const {
+        stride_(height_ > 1 ? img.ptr<uint8_t>(0, 1) - row0_ : 0) {
+    const unsigned char bgr[3] = {c.b, c.g, c.r};  // CImage stores BGR
+    for (int k = 0; k < 3; ++k)
+      for (int v = 0; v < 256; ++v) table_[k][v] = static_cast<uint8_t>((1 - a) * v + a * bgr[k] + 0.5);  // as lround
+  }
+  void blend(int x, int y) const {
     if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
     uint8_t* p = row0_ + y * stride_ + 3 * x;
-    const unsigned char bgr[3] = {c.b, c.g, c.r};  // CImage stores BGR
-    for (int k = 0; k < 3; ++k) p[k] = static_cast<uint8_t>((1 - a) * p[k] + a * bgr[k] + 0.5);
+    for (int k = 0; k < 3; ++k) p[k] = table_[k][p[k]];
   }
 
  private:
   int width_, height_;
   uint8_t* row0_;
   std::ptrdiff_t stride_;
+  uint8_t table_[3][256];
 };
 
 // Clips segment to the axes rectangle (Liang–Barsky); false if outside.
@@ -114,7 +119,7 @@ void drawSeries(mrpt::img::CImage& img, const Axes& ax, const Series& s) {
 
 void drawBand(mrpt::img::CImage& img, const Axes& ax, const Band& b) {
   // Column by column between consecutive samples: each pixel once.
-  const PixelBlender pixels(img);
+  const PixelBlender pixels(img, b.color, b.alpha);
   int last_col = std::numeric_limits<int>::min();
   for (std::size_t i = 1; i < b.x.size(); ++i) {
     const double xa = ax.px(b.x[i - 1]), xb = ax.px(b.x[i]);
@@ -128,7 +133,7 @@ void drawBand(mrpt::img::CImage& img, const Axes& ax, const Band& b) {
       if (!std::isfinite(lo) || !std::isfinite(hi)) continue;
       const int r0 = std::max(ax.top, static_cast<int>(std::lround(ax.py(hi))));
       const int r1 = std::min(ax.bottom, static_cast<int>(std::lround(ax.py(lo))));
-      for (int row = r0; row <= r1; ++row) pixels.blend(col, row, b.color, b.alpha);
+      for (int row = r0; row <= r1; ++row) pixels.blend(col, row);
     }
   }
 }
@@ -310,12 +315,12 @@ void drawGrid(mrpt::img::CImage& img, const Layout& l) {
 void drawData(mrpt::img::CImage& img, const Axes& ax, const Figure& fig, const std::vector<Series>& series,
               const std::vector<Band>& bands) {
   for (const auto& b : bands) drawBand(img, ax, b);
-  const PixelBlender pixels(img);
   for (const auto& b : fig.bars) {
+    const PixelBlender pixels(img, b.color, 0.55);
     const int x0 = static_cast<int>(std::lround(ax.px(b.x0))), x1 = static_cast<int>(std::lround(ax.px(b.x1)));
     const int y = std::max(ax.top, static_cast<int>(std::lround(ax.py(b.height))));
     for (int col = std::max(x0, ax.left); col < std::min(x1, ax.right); ++col)
-      for (int row = y; row < ax.bottom; ++row) pixels.blend(col, row, b.color, 0.55);
+      for (int row = y; row < ax.bottom; ++row) pixels.blend(col, row);
   }
   for (const auto& s : series) drawSeries(img, ax, s);
   img.rectangle(ax.left, ax.top, ax.right, ax.bottom, kAxis);

@@ -141,7 +141,8 @@ const EstimatorReport& Estimator::report() const {
 }
 
 void Estimator::addInput(double t, const Eigen::VectorXd& u) {
-  requireVector(u, model_.dims().nu, std::string(methodName()) + ": input u at t = " + std::to_string(t));
+  if (!validVector(u, model_.dims().nu))  // the message only when it is needed: 27k inputs a drive
+    requireVector(u, model_.dims().nu, std::string(methodName()) + ": input u at t = " + std::to_string(t));
   // A time stamp within rounding of the newest state's (k·T computed two
   // ways) means "now".
   if (std::isfinite(t) && sameTime(t, t_)) t = t_;
