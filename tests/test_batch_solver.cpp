@@ -545,13 +545,17 @@ TEST(NewtonPolish, CurvaturePlusGaussNewtonEqualsTheNumericalHessianOfEachFactor
   }
 }
 
+namespace {
+// Seven steps of the paper scenario from its 143σ-wrong prior: the MAP keeps
+// a 50σ range residual, and Levenberg–Marquardt crawls toward it.
+Problem radarStartup(const models::Radar2D& radar) { return buildProblem(radar, radarPaperRun(radar, 7, 1).measurements); }
+}  // namespace
+
 TEST(NewtonPolish, BatchReachesTheSameRadarStartupMapFromDifferentStarts) {
-  // Seven steps of the paper scenario: the MAP has a 50σ range residual and
-  // LM crawls; polished, two different starts end at the same point with a
-  // vanishing gradient.
+  // Polished, two different starts end at the same point with a vanishing
+  // gradient.
   const models::Radar2D radar;
-  const SimulatedRun run = radarPaperRun(radar, 7, 1);
-  Problem p = buildProblem(radar, run.measurements);
+  Problem p = radarStartup(radar);
   BatchSolverOptions o;
   o.max_iterations = 5000;
   o.newton_polish_steps = 10;
@@ -937,8 +941,7 @@ TEST(AndersonMixing, AResetOrAStepNotKeptLeavesTheNextStepUnmixed) {
 // to a vanishing gradient, in a few dozen iterations at most.
 TEST(BatchSolver, AndersonMixedStepsReachTheNewtonPolishedMapFasterWhereGaussNewtonCrawls) {
   const models::Radar2D radar;
-  const SimulatedRun run = radarPaperRun(radar, 7, 1);
-  Problem p = buildProblem(radar, run.measurements);
+  Problem p = radarStartup(radar);
   BatchSolverOptions plain;
   plain.max_iterations = 5000;
   BatchSolverOptions polished = plain, mixed = plain;
