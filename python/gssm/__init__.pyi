@@ -51,6 +51,7 @@ class BatchOptions:
     max_lambda: float
     newton_polish_steps: int
     covariance_by_qr: bool
+    anderson_memory: int
     def __init__(self) -> None: ...
 
 class EstimatorOptions:
