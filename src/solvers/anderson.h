@@ -20,7 +20,6 @@ namespace gssm::internal {
 class AndersonMixing {
  public:
   explicit AndersonMixing(int memory = 0) : memory_(memory) {}
-  int memory() const { return memory_; }
   /// Forgets every step (a damped, rejected or singular one breaks the
   /// sequence the differences describe).
   void reset();

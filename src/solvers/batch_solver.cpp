@@ -799,7 +799,7 @@ struct BatchSolver::Impl::Iteration {
     }
     ++sum.iterations;
     if (mixed) ++sum.anderson_steps;
-    if (options.anderson_memory > 0) anderson.accepted(delta);
+    anderson.accepted(delta);  // records a step only after a mix() (anderson_memory > 0)
     const double old_cost = cost;
     cost = new_cost;
     policy.accepted();

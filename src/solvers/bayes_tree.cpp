@@ -980,14 +980,12 @@ Eigen::MatrixXd BayesTreeEngine::pathMarginalCovariance(const std::vector<Key>& 
     const Factor::Rotations rot = rotationsOf(k);
     if (rot.blocks && hasRotationIn(*rot.blocks, v.dim(), rot.offset)) {  // on those 3 rows and columns alone
       const std::vector<Eigen::Matrix3d> Jr = blockRightJacobians(v.delta(), *rot.blocks, rot.offset);
-      std::vector<Eigen::Matrix3d> JrT(Jr.size());
-      for (std::size_t i = 0; i < Jr.size(); ++i) JrT[i] = Jr[i].transpose();
-      Eigen::MatrixXd part = S.middleRows(at, v.dim());
+      Eigen::MatrixXd part = S.middleRows(at, v.dim());  // rows: Jr·, then columns: ·Jrᵀ = (Jr·)ᵀ
       premultiplyBlocks(part, Jr, *rot.blocks, rot.offset);
       S.middleRows(at, v.dim()) = part;
-      part = S.middleCols(at, v.dim());
-      postmultiplyBlocks(part, JrT, *rot.blocks, rot.offset);
-      S.middleCols(at, v.dim()) = part;
+      part = S.middleCols(at, v.dim()).transpose();
+      premultiplyBlocks(part, Jr, *rot.blocks, rot.offset);
+      S.middleCols(at, v.dim()) = part.transpose();
     }
     at += v.dim();
   }
@@ -1079,26 +1077,34 @@ Eigen::MatrixXd BayesTreeEngine::bayesNetCovariance(const std::vector<Key>& keys
     n += vars_.at(f).dim();
   }
   Eigen::Index m = 0;
-  for (const auto& k : keys) m += vars_.at(k).dim();
+  bool whole_path = true;  // the keys are the path's variables in its order: E = I
+  for (const auto& k : keys) {
+    whole_path = whole_path && off.at(k) == m;
+    m += vars_.at(k).dim();
+  }
+  whole_path = whole_path && m == n;
+  // Σ = R⁻¹ R⁻ᵀ, so Σ_req = Yᵀ Y with Y = R⁻ᵀ E. A short path (a newest
+  // state and the constants: 31 columns, asked for after every update)
+  // densely: assembling a sparse R took 3× the solves' time. For the whole
+  // path in its order (that newest state and the constants) E = I and Y is
+  // triangular: n³/3 products instead of n³ (the drive's 43 columns: ~3×
+  // faster; the same to rounding), and no E is formed.
+  const auto denseR = [&] {
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n);
+    forEachPathEntry(path, off, [&](Eigen::Index i, Eigen::Index j, double v) { R(i, j) = v; });
+    return R;
+  };
+  Eigen::MatrixXd Y;
+  if (n <= kDensePathColumns && whole_path) {
+    inverseTransposeOfUpper(denseR(), Y);
+    return gramOfLower(Y);
+  }
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, m);
   Eigen::Index c = 0;
   for (const auto& k : keys)
     for (Eigen::Index j = 0; j < vars_.at(k).dim(); ++j) E(off.at(k) + j, c++) = 1.0;
-  // Σ = R⁻¹ R⁻ᵀ, so Σ_req = Yᵀ Y with Y = R⁻ᵀ E. A short path (a newest
-  // state and the constants: 31 columns, asked for after every update)
-  // densely: assembling a sparse R took 3× the solves' time. Where the keys
-  // are the whole path in its order (that newest state and the constants)
-  // E = I, and Y is triangular: n³/3 products instead of n³ (the drive's
-  // 43 columns: ~3× faster; the same to rounding).
-  Eigen::MatrixXd Y;
   if (n <= kDensePathColumns) {
-    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n);
-    forEachPathEntry(path, off, [&](Eigen::Index i, Eigen::Index j, double v) { R(i, j) = v; });
-    if (m == n && E.isIdentity(0.0)) {
-      inverseTransposeOfUpper(R, Y);
-      return gramOfLower(Y);
-    }
-    Y = R.transpose().triangularView<Eigen::Lower>().solve(E);
+    Y = denseR().transpose().triangularView<Eigen::Lower>().solve(E);
   } else {
     std::vector<Eigen::Triplet<double>> trip;
     forEachPathEntry(path, off, [&](Eigen::Index i, Eigen::Index j, double v) { trip.emplace_back(i, j, v); });
